@@ -1,0 +1,1 @@
+"""Repository root marker: makes pytest put this checkout first on sys.path."""

@@ -1,0 +1,24 @@
+"""All numba configuration in one place.
+
+Every compiled kernel in the package is declared with :func:`jit`, so caching, fastmath and
+error-model choices are made once, here, with their reasons.
+
+- ``cache=True``: compiled machine code is written next to the sources and reused on the next
+  import; a fresh environment pays the compile cost once.
+- ``fastmath=False``: the elliptic kernels rely on IEEE semantics (no reassociation of the
+  compensated sums, NaN propagation for documented NaN outputs).
+- ``error_model="numpy"``: division by zero gives inf/NaN instead of raising inside kernels, so a
+  kernel never needs a Python exception path; the public wrappers validate input before calling.
+"""
+
+import numba
+
+JIT_OPTIONS = dict(nopython=True, cache=True, fastmath=False, error_model="numpy")
+
+
+def jit(function=None, **overrides):
+    """Compile ``function`` with the package's numba options (usable bare or with overrides)."""
+    options = {**JIT_OPTIONS, **overrides}
+    if function is None:
+        return lambda f: numba.njit(**options)(f)
+    return numba.njit(**options)(function)

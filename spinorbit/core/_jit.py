@@ -13,7 +13,7 @@ error-model choices are made once, here, with their reasons.
 
 import numba
 
-JIT_OPTIONS = dict(nopython=True, cache=True, fastmath=False, error_model="numpy")
+JIT_OPTIONS = dict(cache=True, fastmath=False, error_model="numpy")
 
 
 def jit(function=None, **overrides):

@@ -148,22 +148,21 @@ def euler313_to_attitude(phi, theta, psi):
 def attitude_to_euler313(r):
     """3-1-3 angles (φ, θ, ψ) of an attitude matrix, θ ∈ [0, π], φ and ψ in (−π, π].
 
-    With R = R3(ψ) R1(θ) R3(φ): R[2,2] = cos θ, R[2,0:2] = sin θ (sin φ, −cos φ),
-    R[0:2,2] = sin θ (sin ψ, cos ψ). θ is taken from atan2 of both sin and cos for accuracy near 0
-    and π. At θ = 0 or π only φ ± ψ is defined; then ψ = 0 and φ carries the whole angle.
+    With R = R3(ψ) R1(θ) R3(φ): R[2,2] = cos θ and R[0:2,2] = sin θ (sin ψ, cos ψ), while
+    R00 + R11 = (1 + cos θ) cos(φ + ψ), R01 − R10 = (1 + cos θ) sin(φ + ψ),
+    R00 − R11 = (1 − cos θ) cos(φ − ψ), R01 + R10 = (1 − cos θ) sin(φ − ψ).
+    Near θ = 0 only φ + ψ is well defined and near θ = π only φ − ψ, so ψ is taken from its own
+    column and φ from whichever combination is well conditioned: the round trip angles → matrix →
+    angles → matrix is then exact to rounding even at gimbal lock (θ = 0 or π gives ψ = 0).
     """
-    sin_theta = math.hypot(r[2, 0], r[2, 1])
+    sin_theta = math.hypot(r[0, 2], r[1, 2])
     theta = math.atan2(sin_theta, r[2, 2])
-    if sin_theta > 1e-300:
-        phi = math.atan2(r[2, 0], -r[2, 1])
-        psi = math.atan2(r[0, 2], r[1, 2])
+    psi = math.atan2(r[0, 2], r[1, 2]) if sin_theta > 0.0 else 0.0
+    if r[2, 2] >= 0.0:
+        phi = math.atan2(r[0, 1] - r[1, 0], r[0, 0] + r[1, 1]) - psi
     else:
-        # Gimbal lock: R = R3(ψ ± φ); put it all in φ.
-        psi = 0.0
-        if r[2, 2] > 0.0:
-            phi = math.atan2(r[0, 1], r[0, 0])
-        else:
-            phi = math.atan2(-r[0, 1], r[0, 0])
+        phi = math.atan2(r[0, 1] + r[1, 0], r[0, 0] - r[1, 1]) + psi
+    phi = math.atan2(math.sin(phi), math.cos(phi))  # back into (−π, π]
     return phi, theta, psi
 
 

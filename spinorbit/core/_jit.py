@@ -13,6 +13,8 @@ error-model choices are made once, here, with their reasons.
 
 import numba
 
+# No ``nopython`` key: njit is always nopython, and numba 0.68 warns (an error under the test
+# suite's ``filterwarnings = error``) when it is passed explicitly.
 JIT_OPTIONS = dict(cache=True, fastmath=False, error_model="numpy")
 
 

@@ -2,4 +2,12 @@
 
 Nothing under ``spinorbit.core`` imports astropy, skyfield or rebound (a test enforces this), so the
 core can be called from numba-compiled loops and from REBOUND callbacks without Python overhead.
+
+Paper-named entry points: :func:`andoyer_to_canonical` (Fukushima eq. 4) and
+:func:`canonical_to_andoyer` (eqs. 7–8).
 """
+
+from .elements import andoyer_to_canonical, canonical_to_andoyer
+from .errors import SingularElementsError, SpinorbitError
+
+__all__ = ["andoyer_to_canonical", "canonical_to_andoyer", "SingularElementsError", "SpinorbitError"]

@@ -381,64 +381,75 @@ def state_from_elements(elements, flip, ic):
     return flip_attitude(working, flip), np.array([fx * mx, fy * my, fz * mz])
 
 
-@jit
-def uniform_rotation(attitude, momentum, big_a, big_b, big_c, t):
-    """Attitude at time t of a permanent rotation (ω = I⁻¹M parallel to M, constant in both frames).
-
-    R(t) = R_ω(t) R0 where R_ω(t) is the passive rotation by |ω| t about ω: the body turns about
-    ω at the rate |ω| (Rodrigues' formula on the attitude matrix).
-    """
-    wx, wy, wz = momentum[0] / big_a, momentum[1] / big_b, momentum[2] / big_c
-    rate = math.sqrt(wx * wx + wy * wy + wz * wz)
-    if rate == 0.0:
-        return attitude.copy()
-    kx, ky, kz = wx / rate, wy / rate, wz / rate
-    angle = rate * t
-    ca, sa = math.cos(angle), math.sin(angle)
-    k = np.array([kx, ky, kz])
-    skew = np.array([[0.0, -kz, ky], [kz, 0.0, -kx], [-ky, kx, 0.0]])
-    # passive rotation by +angle about k: cos·1 + (1 − cos) k kᵀ − sin [k]×
-    rot_k = ca * np.eye(3) + (1.0 - ca) * np.outer(k, k) - sa * skew
-    return rot_k @ attitude
+# Status codes of the paper-named kernels (the Python wrappers turn them into exceptions).
+STATUS_OK, STATUS_PERMANENT_ROTATION, STATUS_SEPARATRIX_ARC = 0, 1, 2
 
 
 @jit
-def torque_free_attitudes(attitude, momentum, big_a, big_b, big_c, times):
-    """Exact torque-free attitudes at many times (paper eq. 12), as (N, 3, 3) attitude matrices.
+def canonical_from_andoyer_scalar(big_l, big_g, big_h, l, g, h, ic):
+    """Paper eq. (4) for one state, all senses: (S, Z, H, s, z, h, status); S < 0 for −C / −A.
 
-    The motion constants, the elliptic constants and the node frame R1(I) R3(h) are computed once;
-    each time then costs one sn/cn/dn, one pn and one sin/cos.
+    The working-frame phase comes from (sin l, cos l) themselves in SAM — φ = atan2(√(b−c) cos l,
+    √(a−c) sin l), eq. (5)'s tan φ = cot l/√(1+f) — so the caller's split of l + g is kept at J = 0.
     """
-    ic = inertia_constants(big_a, big_b, big_c)
-    n = times.shape[0]
-    out = np.empty((n, 3, 3))
-    mo, flip = motion_from_momentum(momentum[0], momentum[1], momentum[2], ic)
+    nan = np.nan
+    transverse = math.sqrt(max((big_g - big_l) * (big_g + big_l), 0.0))
+    sl, cl = math.sin(l), math.cos(l)
+    mx, my, mz = transverse * sl, transverse * cl, big_l
+    mo, flip = motion_from_momentum(mx, my, mz, ic)
     if mo[MO_MODE] == MODE_UNIFORM:
-        for i in range(n):
-            out[i] = uniform_rotation(attitude, momentum, big_a, big_b, big_c, times[i])
-        return out
-    elements, flip, _ = elements_from_state(attitude, momentum, ic)
+        return nan, nan, nan, nan, nan, nan, STATUS_PERMANENT_ROTATION
+    if flip == FLIP_A or flip == FLIP_C:
+        return nan, nan, nan, nan, nan, nan, STATUS_SEPARATRIX_ARC
+    if flip == FLIP_B:  # (L, l, g) → (−L, −l, g + π): the body frame turned by π about B
+        mx, mz, sl, l, g = -mx, -mz, -sl, -l, g + math.pi
     mk, pk = elliptic_constants(mo)
-    big_z, big_h, s0, z, h = elements[1], elements[2], elements[3], elements[4], elements[5]
-    sin_i = math.sqrt(max((big_z - big_h) * (big_z + big_h), 0.0)) / big_z
-    frame = node_frame(big_h / big_z, sin_i, h)
-    fx, fy, fz = flip_signs(flip)
-    for i in range(n):
-        s = s0 + mo[MO_S_RATE] * times[i]
-        arg = s * mo[MO_ARG_PER_S]
-        mx, my, mz, sin_l, cos_l = body_from_argument(arg, mo, mk)
-        g = z + mo[MO_G_PER_S] * s + mo[MO_PN_COEFF] * pn_k(arg, mk, pk)
-        sin_j = math.hypot(mx, my) / big_z
-        cos_j = mz / big_z
-        cg, sg = math.cos(g), math.sin(g)
-        # W R3(g) with W = R3(l) R1(J), written out: rows of the body axes in the node frame.
-        w0 = (cos_l, sin_l * cos_j, sin_l * sin_j)
-        w1 = (-sin_l, cos_l * cos_j, cos_l * sin_j)
-        w2 = (0.0, -sin_j, cos_j)
-        m = np.empty((3, 3))
-        for row, w, sign in ((0, w0, fx), (1, w1, fy), (2, w2, fz)):
-            m[row, 0] = sign * (w[0] * cg - w[1] * sg)
-            m[row, 1] = sign * (w[0] * sg + w[1] * cg)
-            m[row, 2] = sign * w[2]
-        out[i] = m @ frame
-    return out
+    a_b, b_c, a_c = ic[3], ic[4], ic[5]
+    if mo[MO_MODE] == MODE_SAM:
+        amplitude = math.atan2(math.sqrt(b_c) * cl, math.sqrt(a_c) * sl)
+    else:
+        amplitude = math.atan2(math.sqrt(a_b) * my, math.sqrt(a_c) * mz)
+    arg = ellipf_k(amplitude, mk)
+    s = arg / mo[MO_ARG_PER_S]
+    z = reduce_angle(g - mo[MO_G_PER_S] * s - mo[MO_PN_COEFF] * pn_k(arg, mk, pk))
+    big_s = mo[MO_S]
+    if flip == FLIP_B:
+        big_s, s = -big_s, -s
+    return big_s, big_g, big_h, s, z, h, STATUS_OK
+
+
+@jit
+def andoyer_from_canonical_scalar(big_s, big_z, big_h, s, z, h, ic):
+    """Paper eqs. (7)–(8) for one state, all senses: (L, G, H, l, g, h, status), angles in (−π, π]."""
+    flipped = big_s < 0.0
+    if flipped:
+        big_s, s = -big_s, -s
+    mo = motion_from_elements(big_s, big_z, ic)
+    if mo[MO_MODE] == MODE_UNIFORM:
+        return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, STATUS_PERMANENT_ROTATION
+    mk, pk = elliptic_constants(mo)
+    arg = s * mo[MO_ARG_PER_S]
+    _, _, mz, sin_l, cos_l = body_from_argument(arg, mo, mk)
+    g = z + mo[MO_G_PER_S] * s + mo[MO_PN_COEFF] * pn_k(arg, mk, pk)
+    l = math.atan2(sin_l, cos_l)
+    if flipped:
+        mz, l, g = -mz, -l, g + math.pi
+    return mz, big_z, big_h, reduce_angle(l), reduce_angle(g), h, STATUS_OK
+
+
+@jit
+def canonical_from_andoyer_many(big_l, big_g, big_h, l, g, h, big_a, big_b, big_c, out, status):
+    """Loop of :func:`canonical_from_andoyer_scalar` over flat arrays; out is (6, N)."""
+    for i in range(big_l.shape[0]):
+        ic = inertia_constants(big_a[i], big_b[i], big_c[i])
+        r = canonical_from_andoyer_scalar(big_l[i], big_g[i], big_h[i], l[i], g[i], h[i], ic)
+        out[0, i], out[1, i], out[2, i], out[3, i], out[4, i], out[5, i], status[i] = r
+
+
+@jit
+def andoyer_from_canonical_many(big_s, big_z, big_h, s, z, h, big_a, big_b, big_c, out, status):
+    """Loop of :func:`andoyer_from_canonical_scalar` over flat arrays; out is (6, N)."""
+    for i in range(big_s.shape[0]):
+        ic = inertia_constants(big_a[i], big_b[i], big_c[i])
+        r = andoyer_from_canonical_scalar(big_s[i], big_z[i], big_h[i], s[i], z[i], h[i], ic)
+        out[0, i], out[1, i], out[2, i], out[3, i], out[4, i], out[5, i], status[i] = r

@@ -1,0 +1,154 @@
+"""spinorbit.coupling.rebound_adapter: offline DE421 simulations, raw-pointer forces, perturbers."""
+
+import numpy as np
+import pytest
+import rebound
+from _offline import no_network  # noqa: F401  (autouse socket guard)
+from astropy.time import Time
+
+from spinorbit.coupling.rebound_adapter import (
+    DEFAULT_BODIES,
+    ForceInstallError,
+    MissingBodyError,
+    body_index,
+    install_extra_forces,
+    perturber_positions,
+    simulation_from_de421,
+)
+from spinorbit.ephemeris import barycentric_state_au, barycentric_state_km, de421_constants
+
+J2000 = Time(2451545.0, format="jd", scale="tdb")
+ONE_YEAR_DAYS = 365.25
+
+#: Moon geocentric position after one year from J2000, 11 bodies + EIH + Earth J2, vs DE421.
+#: Measured 497.36 m (REBOUNDx gr_full + gravitational_harmonics on the same sim: 497.35 m; the
+#: shared note measured 564 m with its set-up). What is missing is DE421's lunar figure (degree 2–4,
+#: worth ≈ 500 m per the note), tides and asteroids. 600 m leaves room for platform rounding, and
+#: fails if either force breaks (without J2: 23 km; without GR: 3.2 km).
+MOON_ONE_YEAR_TOLERANCE_M = 600.0
+#: Same physics as REBOUNDx's forces on the same initial conditions: only integration noise differs.
+REBOUNDX_AGREEMENT_M = 0.5
+
+
+def _moon_error_m(sim, t_days):
+    au_km = de421_constants().au_km
+    particles = sim.particles
+    geocentric = np.array(particles["Moon"].xyz) - np.array(particles["Earth"].xyz)
+    moon, _ = barycentric_state_km("moon", t_days)
+    earth, _ = barycentric_state_km("earth", t_days)
+    return np.linalg.norm(geocentric * au_km - (moon - earth)) * 1e3
+
+
+def test_simulation_is_de421_at_the_epoch():
+    time = Time("2010-03-04T05:06:07", scale="tt")
+    sim = simulation_from_de421(time)
+    assert sim.N == len(DEFAULT_BODIES)
+    assert sim.exact_finish_time == 1
+    assert sim.G == pytest.approx(de421_constants().gm["sun"], rel=1e-14)
+    assert sim.t == pytest.approx((time.tdb.jd1 - 2451545.0) + time.tdb.jd2, abs=1e-11)
+    assert sim.particles["Moon"].m * sim.G == pytest.approx(de421_constants().gm["moon"], rel=1e-14)
+    # Moving to the centre of mass shifts every body by the same vector: relative positions stay.
+    moon, _ = barycentric_state_au("moon", sim.t)
+    earth, _ = barycentric_state_au("earth", sim.t)
+    geocentric = np.array(sim.particles["Moon"].xyz) - np.array(sim.particles["Earth"].xyz)
+    np.testing.assert_allclose(geocentric, moon - earth, atol=1e-14)
+
+
+@pytest.mark.validation
+def test_moon_after_one_year_with_j2_and_eih():
+    sim = simulation_from_de421(J2000)
+    install_extra_forces(sim, earth_j2=True, gr=True)
+    sim.integrate(ONE_YEAR_DAYS)
+    assert sim.t == ONE_YEAR_DAYS  # exact_finish_time
+    assert _moon_error_m(sim, ONE_YEAR_DAYS) < MOON_ONE_YEAR_TOLERANCE_M
+
+
+@pytest.mark.validation
+def test_extra_forces_match_reboundx():
+    reboundx = pytest.importorskip("reboundx")
+    c = de421_constants()
+    ours = simulation_from_de421(J2000)
+    install_extra_forces(ours)
+    ours.integrate(ONE_YEAR_DAYS)
+
+    theirs = simulation_from_de421(J2000)
+    extras = reboundx.Extras(theirs)
+    gr = extras.load_force("gr_full")
+    extras.add_force(gr)
+    gr.params["c"] = c.c_km_s * 86400.0 / c.au_km
+    harmonics = extras.load_force("gravitational_harmonics")
+    extras.add_force(harmonics)
+    theirs.particles["Earth"].params["J2"] = c.earth_j2
+    theirs.particles["Earth"].params["R_eq"] = c.earth_radius_km / c.au_km
+    theirs.integrate(ONE_YEAR_DAYS)
+    assert abs(_moon_error_m(ours, ONE_YEAR_DAYS) - _moon_error_m(theirs, ONE_YEAR_DAYS)) < REBOUNDX_AGREEMENT_M
+    difference = np.array(ours.particles["Moon"].xyz) - np.array(theirs.particles["Moon"].xyz)
+    assert np.linalg.norm(difference) * c.au_km * 1e3 < REBOUNDX_AGREEMENT_M
+
+
+def test_each_force_moves_the_moon_the_right_way():
+    errors = {}
+    for j2, gr in [(False, False), (True, True)]:
+        sim = simulation_from_de421(J2000)
+        if j2 or gr:
+            install_extra_forces(sim, earth_j2=j2, gr=gr)
+        sim.integrate(90.0)
+        errors[(j2, gr)] = _moon_error_m(sim, 90.0)
+    assert errors[(True, True)] < errors[(False, False)] / 10.0
+
+
+def test_perturber_positions_are_body_centric():
+    sim = simulation_from_de421(J2000)
+    positions, gm, names = perturber_positions(sim, "moon")
+    assert names == tuple(name.capitalize() for name in DEFAULT_BODIES if name != "moon")
+    assert positions.shape == (len(DEFAULT_BODIES) - 1, 3) and gm.shape == (len(DEFAULT_BODIES) - 1,)
+    earth_row = names.index("Earth")
+    expected = np.array(sim.particles["Earth"].xyz) - np.array(sim.particles["Moon"].xyz)
+    np.testing.assert_array_equal(positions[earth_row], expected)
+    assert gm[earth_row] == pytest.approx(de421_constants().gm["earth"], rel=1e-14)
+    # A chosen subset, in the order asked; and it follows the running simulation.
+    sim.integrate(1.0)
+    positions, _, names = perturber_positions(sim, "Moon", perturbers=["Sun", "earth"])
+    assert names == ("Sun", "Earth")
+    expected = np.array(sim.particles["Sun"].xyz) - np.array(sim.particles["Moon"].xyz)
+    np.testing.assert_array_equal(positions[0], expected)
+
+
+def test_missing_body_is_named():
+    sim = simulation_from_de421(J2000, bodies=("sun", "jupiter"))
+    with pytest.raises(MissingBodyError, match="no particle named 'Moon'.*'Sun', 'Jupiter'"):
+        perturber_positions(sim, "Moon")
+    with pytest.raises(MissingBodyError, match="'earth'"):
+        install_extra_forces(sim)
+    assert body_index(sim, "JUPITER") == 1
+
+
+def test_double_install_and_reboundx_are_refused():
+    sim = simulation_from_de421(J2000, bodies=("sun", "earth", "moon"))
+    install_extra_forces(sim)
+    with pytest.raises(ForceInstallError, match="already installed"):
+        install_extra_forces(sim)
+    reboundx = pytest.importorskip("reboundx")
+    other = simulation_from_de421(J2000, bodies=("sun", "earth", "moon"))
+    reboundx.Extras(other)
+    with pytest.raises(ForceInstallError, match="REBOUNDx"):
+        install_extra_forces(other)
+
+
+def test_bad_inputs():
+    with pytest.raises(TypeError, match="scalar Time"):
+        simulation_from_de421(Time([2451545.0, 2451546.0], format="jd", scale="tdb"))
+    with pytest.raises(ValueError, match="unit 3-vector"):
+        install_extra_forces(simulation_from_de421(J2000, bodies=("earth", "moon")), earth_pole=(0, 0, 2))
+
+
+def test_forces_survive_garbage_collection():
+    # The cfunc pointer and its parameters must live as long as the simulation, not as the handle.
+    import gc
+
+    sim = simulation_from_de421(J2000, bodies=("sun", "earth", "moon"))
+    install_extra_forces(sim)  # handle discarded on purpose
+    gc.collect()
+    sim.integrate(30.0)
+    assert np.all(np.isfinite(sim.particles["Moon"].xyz))
+    assert isinstance(sim, rebound.Simulation)

@@ -1,0 +1,155 @@
+"""A rigid body: principal moments, the map from the user's body axes to A ≤ B ≤ C, mass and size.
+
+The core works in principal axes ordered A ≤ B ≤ C (``docs/conventions.md``). Users describe bodies
+in their own axes (a shape model's x, y, z); :class:`RigidBody` keeps the proper rotation that takes
+user-axis components to principal-axis components, so every state can be given and returned in the
+user's axes.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from astropy import units as u
+
+__all__ = ["RigidBody", "InvalidBodyError"]
+
+# Relative slack for the triangle inequality A + B ≥ C: a flat plate has A + B = C exactly, and
+# moments computed from a shape model carry rounding of a few ulp.
+TRIANGLE_SLACK = 1e-12
+
+
+class InvalidBodyError(ValueError):
+    """The moments of inertia cannot belong to a rigid body."""
+
+
+def _as_moments(moments) -> tuple[np.ndarray, u.Unit]:
+    if isinstance(moments, u.Quantity):
+        if moments.unit.physical_type not in ("moment of inertia", "dimensionless"):
+            raise u.UnitTypeError(
+                f"moments of inertia need a unit like kg m² (or none, for ratios); got {moments.unit!s}. "
+                "Convert them, e.g. moments.to(u.kg * u.m**2)."
+            )
+        values, unit = np.asarray(moments.value, dtype=float), moments.unit
+    else:
+        try:
+            values, unit = np.asarray(moments, dtype=float), u.dimensionless_unscaled
+        except (TypeError, ValueError):
+            raise TypeError(f"moments must be three numbers or a Quantity; got {moments!r}.") from None
+    if values.shape != (3,):
+        raise InvalidBodyError(
+            f"a rigid body needs exactly three principal moments (about its x, y, z axes); got shape {values.shape}."
+        )
+    if not np.all(np.isfinite(values)):
+        raise InvalidBodyError(f"principal moments must be finite; got {values.tolist()}.")
+    if np.any(values <= 0):
+        raise InvalidBodyError(
+            f"principal moments must be positive; got {values.tolist()}. A moment of inertia is a sum of m r² ≥ 0, "
+            "and zero only for a body on a line."
+        )
+    return values, unit
+
+
+def _principal_permutation(values: np.ndarray) -> np.ndarray:
+    """Proper rotation P (det +1) with (A, B, C) = sorted moments and v_principal = P v_user."""
+    order = np.argsort(values, kind="stable")
+    rows = np.eye(3)[order]
+    if np.linalg.det(rows) < 0:  # an odd permutation: flip one axis to keep a right-handed frame
+        rows[2] *= -1.0
+    return rows
+
+
+@dataclass(frozen=True)
+class RigidBody:
+    """A rigid body described by its principal moments of inertia.
+
+    Parameters
+    ----------
+    moments : array_like or Quantity, shape (3,)
+        Moments about the user's body x, y, z axes (which must be principal axes), in kg m² or as
+        dimensionless ratios. Any order: the body keeps the rotation to A ≤ B ≤ C.
+    mass : Quantity, optional
+        Mass (kg), needed for the figure's gravity field beyond degree 2 and for back-reaction.
+    radius : Quantity, optional
+        Reference radius (km) of the body's gravity field.
+    name : str, optional
+
+    Raises
+    ------
+    InvalidBodyError
+        Non-finite or non-positive moments, or moments violating A + B ≥ C (no mass distribution
+        has them).
+
+    Notes
+    -----
+    f = (a − b)/(b − c) = C (B − A) / (A (C − B)) is the paper's f (eq. 5); it is 0 for A = B and
+    infinite for B = C. A sphere (A = B = C) has no triaxial elements but still rotates (uniformly).
+
+    Examples
+    --------
+    >>> body = RigidBody([3.0836, 3.235, 1.0])  # Toutatis-like, long axis along user z
+    >>> body.principal_moments
+    (1.0, 3.0836, 3.235)
+    """
+
+    moments: object
+    mass: u.Quantity | None = None
+    radius: u.Quantity | None = None
+    name: str | None = None
+    _values: np.ndarray = field(init=False, repr=False, compare=False)
+    _unit: u.Unit = field(init=False, repr=False, compare=False)
+    _to_principal: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        values, unit = _as_moments(self.moments)
+        big_a, big_b, big_c = np.sort(values)
+        if big_a + big_b < big_c * (1.0 - TRIANGLE_SLACK):
+            raise InvalidBodyError(
+                f"moments {values.tolist()} violate the triangle inequality A + B ≥ C "
+                f"({big_a!r} + {big_b!r} < {big_c!r}); no mass distribution has them. Check the values and their axes."
+            )
+        if self.mass is not None and (not isinstance(self.mass, u.Quantity) or self.mass.unit.physical_type != "mass"):
+            raise u.UnitTypeError(f"mass must be a Quantity in a mass unit (e.g. 6e10 * u.kg); got {self.mass!r}.")
+        if self.radius is not None and (
+            not isinstance(self.radius, u.Quantity) or self.radius.unit.physical_type != "length"
+        ):
+            raise u.UnitTypeError(f"radius must be a Quantity in a length unit (e.g. 0.2 * u.km); got {self.radius!r}.")
+        object.__setattr__(self, "_values", values)
+        object.__setattr__(self, "_unit", unit)
+        object.__setattr__(self, "_to_principal", _principal_permutation(values))
+
+    @property
+    def principal_moments(self) -> tuple[float, float, float]:
+        """(A, B, C), A ≤ B ≤ C, as plain floats in :attr:`moment_unit`."""
+        big_a, big_b, big_c = np.sort(self._values)
+        return float(big_a), float(big_b), float(big_c)
+
+    @property
+    def moment_unit(self) -> u.Unit:
+        """Unit of the moments (dimensionless when given as ratios)."""
+        return self._unit
+
+    @property
+    def to_principal(self) -> np.ndarray:
+        """Proper rotation P: principal-axis components = P @ user-axis components."""
+        return self._to_principal.copy()
+
+    @property
+    def f(self) -> float:
+        """The paper's f = (a − b)/(b − c) = C (B − A)/(A (C − B)) (eq. 5); inf for B = C."""
+        big_a, big_b, big_c = self.principal_moments
+        if big_c == big_b:
+            return math.inf
+        return big_c * (big_b - big_a) / (big_a * (big_c - big_b))
+
+    @property
+    def is_sphere(self) -> bool:
+        big_a, _, big_c = self.principal_moments
+        return big_a == big_c
+
+    @property
+    def is_axisymmetric(self) -> bool:
+        big_a, big_b, big_c = self.principal_moments
+        return big_a == big_b or big_b == big_c

@@ -1,0 +1,341 @@
+"""Rotation states: attitude and spin of a rigid body, with the canonical elements and the exact free motion.
+
+Attitudes are given and returned in the user's body axes (see :class:`spinorbit.RigidBody`); the
+core works in principal axes A ≤ B ≤ C. Spins are Quantities (rad/s, deg/day, …); a plain float is
+read as rad/day, the core's unit. Conventions: ``docs/conventions.md``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from astropy import units as u
+
+from .body import RigidBody
+from .core import canonical as _canonical
+from .core import elliptic as _elliptic
+from .core import rotations as _rotations
+from .core import torque_free as _torque_free
+from .core.errors import SingularElementsError
+
+__all__ = ["RotationState", "CanonicalElements", "InvalidStateError"]
+
+RAD_PER_DAY = u.rad / u.day
+# A quaternion further than this from unit norm is refused rather than silently normalized: it is
+# more likely a wrong input (a vector, a scalar-last quaternion scaled by hand) than rounding.
+QUATERNION_NORM_TOLERANCE = 1e-6
+# Rotation matrices must be orthonormal to this level (rows of a rounded matrix typed from a paper
+# are good to ~1e-9; anything worse is not a rotation).
+MATRIX_ORTHONORMALITY_TOLERANCE = 1e-9
+# The Andoyer angles h, I are referred to a frame whose z axis is at least this far (sin I) from the
+# angular momentum; closer than that, "auto" turns the reference frame by 90° about x (I = 0 is a
+# singular set of the elements).
+AUTO_REFERENCE_MIN_SIN_I = 0.1
+
+MODE_NAMES = {
+    _canonical.MODE_SAM: "SAM",
+    _canonical.MODE_LAM: "LAM",
+    _canonical.MODE_UNIFORM: "permanent rotation",
+}
+
+
+class InvalidStateError(ValueError):
+    """The attitude or spin given cannot describe a rotation state."""
+
+
+def _as_quaternion(q) -> np.ndarray:
+    q = np.asarray(q, dtype=float)
+    if q.shape != (4,):
+        raise InvalidStateError(f"a quaternion has 4 components (w, x, y, z), scalar first; got shape {q.shape}.")
+    if not np.all(np.isfinite(q)):
+        raise InvalidStateError(f"quaternion components must be finite; got {q.tolist()}.")
+    norm = float(np.linalg.norm(q))
+    if abs(norm - 1.0) > QUATERNION_NORM_TOLERANCE:
+        raise InvalidStateError(
+            f"attitude quaternions must have unit norm; got |q| = {norm!r}. Normalize it (q / |q|) if that is "
+            "what you meant; spinorbit does not guess."
+        )
+    return q / norm
+
+
+def _as_rotation_matrix(matrix) -> np.ndarray:
+    m = np.asarray(matrix, dtype=float)
+    if m.shape != (3, 3):
+        raise InvalidStateError(f"an attitude matrix is 3×3; got shape {m.shape}.")
+    if not np.all(np.isfinite(m)):
+        raise InvalidStateError("attitude matrix entries must be finite.")
+    error = float(np.abs(m @ m.T - np.eye(3)).max())
+    if error > MATRIX_ORTHONORMALITY_TOLERANCE or np.linalg.det(m) < 0:
+        raise InvalidStateError(
+            f"the attitude matrix is not a rotation (|R Rᵀ − 1| = {error:.2e}, det = {np.linalg.det(m):.6f}); "
+            "give an orthonormal matrix with determinant +1 (inertial → body)."
+        )
+    return m
+
+
+def _as_angular_velocity(omega) -> np.ndarray:
+    if isinstance(omega, u.Quantity):
+        try:
+            values = omega.to_value(RAD_PER_DAY, equivalencies=u.dimensionless_angles())
+        except u.UnitConversionError:
+            raise u.UnitTypeError(
+                f"angular velocity needs an angle per time unit (rad/s, deg/day); got {omega.unit!s}."
+            ) from None
+    else:
+        values = omega
+    values = np.asarray(values, dtype=float)
+    if values.shape != (3,):
+        raise InvalidStateError(f"the angular velocity is a 3-vector in body axes; got shape {values.shape}.")
+    if not np.all(np.isfinite(values)):
+        raise InvalidStateError(f"angular velocity components must be finite; got {values.tolist()}.")
+    return values
+
+
+@dataclass(frozen=True)
+class CanonicalElements:
+    """Fukushima's canonical elements of one state (paper eqs. 4–8).
+
+    S, Z, H are in the body's moment unit × rad/day; s is in day × (moment unit × rad/day)⁻¹… i.e.
+    ds/dt = a S with a = 1/A; z, h in radians. ``flip`` is the body-frame turn that puts the state on
+    the paper's branch (``spinorbit.core.canonical.FLIP_*``); ``reference`` the passive rotation from
+    the inertial frame to the frame of H and h.
+    """
+
+    S: float
+    Z: float
+    H: float
+    s: float
+    z: float
+    h: float
+    flip: int
+    mode: str
+    reference: np.ndarray
+
+
+class RotationState:
+    """Attitude and spin of a rigid body at one instant.
+
+    Parameters
+    ----------
+    body : RigidBody
+    quaternion : array_like, shape (4,)
+        Unit quaternion (w, x, y, z), scalar first, taking inertial axes to the user's body axes
+        (v_inertial = M(q) v_body).
+    angular_velocity : Quantity or array_like, shape (3,)
+        Body angular velocity in the user's body axes (rad/day if plain floats).
+
+    Use :meth:`from_matrix`, :meth:`from_euler313` or :meth:`from_angular_momentum` for other inputs.
+    """
+
+    def __init__(self, body: RigidBody, quaternion, angular_velocity):
+        if not isinstance(body, RigidBody):
+            raise TypeError(f"body must be a spinorbit.RigidBody; got {type(body).__name__}.")
+        self._body = body
+        self._q = _as_quaternion(quaternion)
+        self._omega = _as_angular_velocity(angular_velocity)
+
+    # -- constructors --------------------------------------------------------------------------
+    @classmethod
+    def from_matrix(cls, body, attitude_matrix, angular_velocity):
+        """From an attitude matrix R (inertial → user body axes)."""
+        return cls(body, _rotations.attitude_to_quat(_as_rotation_matrix(attitude_matrix)), angular_velocity)
+
+    @classmethod
+    def from_euler313(cls, body, phi, theta, psi, angular_velocity):
+        """From passive 3-1-3 Euler angles (Quantities or radians): R = R3(ψ) R1(θ) R3(φ)."""
+        angles = [a.to_value(u.rad) if isinstance(a, u.Quantity) else float(a) for a in (phi, theta, psi)]
+        return cls.from_matrix(body, _rotations.euler313_to_attitude(*angles), angular_velocity)
+
+    @classmethod
+    def from_angular_momentum(cls, body, quaternion, angular_momentum):
+        """From the body angular momentum (user axes) instead of the angular velocity: ω = I⁻¹ M."""
+        if isinstance(angular_momentum, u.Quantity):
+            values = angular_momentum.to_value(body.moment_unit * RAD_PER_DAY, equivalencies=u.dimensionless_angles())
+        else:
+            values = np.asarray(angular_momentum, dtype=float)
+        return cls(body, quaternion, np.asarray(values, dtype=float) / body._values)
+
+    # -- what users read -----------------------------------------------------------------------
+    @property
+    def body(self) -> RigidBody:
+        return self._body
+
+    @property
+    def quaternion(self) -> np.ndarray:
+        """(w, x, y, z), scalar first, user body axes → inertial."""
+        return self._q.copy()
+
+    @property
+    def attitude_matrix(self) -> np.ndarray:
+        """R, inertial → user body axes."""
+        return _rotations.quat_to_attitude(self._q)
+
+    @property
+    def angular_velocity(self) -> u.Quantity:
+        """Body angular velocity in the user's body axes (rad/day)."""
+        return self._omega * RAD_PER_DAY
+
+    @property
+    def angular_momentum(self) -> u.Quantity:
+        """Body angular momentum I ω in the user's body axes (moment unit × rad/day)."""
+        return self._body._values * self._omega * (self._body.moment_unit * RAD_PER_DAY)
+
+    @property
+    def angular_momentum_direction(self) -> np.ndarray:
+        """Unit vector of the angular momentum in the inertial frame (fixed in free rotation)."""
+        inertial = self.attitude_matrix.T @ (self._body._values * self._omega)
+        return inertial / np.linalg.norm(inertial)
+
+    # -- principal-axis view used by the core ---------------------------------------------------
+    def _principal(self):
+        p = self._body._to_principal
+        attitude = p @ self.attitude_matrix
+        momentum = p @ (self._body._values * self._omega)
+        return attitude, momentum
+
+    def _motion(self):
+        big_a, big_b, big_c = self._body.principal_moments
+        ic = _canonical.inertia_constants(big_a, big_b, big_c)
+        _, momentum = self._principal()
+        if not np.any(momentum):
+            raise InvalidStateError("the body is not rotating (zero spin): it has no rotation mode or elements.")
+        mo, flip = _canonical.motion_from_momentum(momentum[0], momentum[1], momentum[2], ic)
+        return mo, flip, momentum, (big_a, big_b, big_c)
+
+    @property
+    def mode(self) -> str:
+        """'SAM' (short-axis mode, about C), 'LAM' (long-axis mode, about A), 'separatrix' or 'permanent rotation'."""
+        mo, _, _, _ = self._motion()
+        if mo[_canonical.MO_MODE] == _canonical.MODE_SAM and mo[_canonical.MO_PARAM_C] == 0.0:
+            return "separatrix"
+        return MODE_NAMES[int(mo[_canonical.MO_MODE])]
+
+    @property
+    def sense(self) -> str:
+        """'+C' / '−C' in SAM, '+A' / '−A' in LAM: the sign of the momentum on the circulation axis."""
+        mo, _, momentum, _ = self._motion()
+        if mo[_canonical.MO_MODE] == _canonical.MODE_LAM:
+            return "+A" if momentum[0] > 0 else "-A"
+        return "+C" if momentum[2] >= 0 else "-C"
+
+    @property
+    def energy_ratio(self) -> float:
+        """E/E0 = 2 T C / G²: kinetic energy over that of rotation about C with the same momentum.
+
+        1 for principal-axis rotation about C; C/A for rotation about A; C/B on the separatrix.
+        """
+        _, momentum = self._principal()
+        moments = np.array(self._body.principal_moments)
+        return float(np.sum(momentum**2 / moments) * moments[2] / np.sum(momentum**2))
+
+    @property
+    def periods(self) -> tuple[u.Quantity, u.Quantity]:
+        """(P_ψ, P_φ): rotation and precession periods in the tumbling-asteroid convention (Pravec et al. 2005).
+
+        P_ψ = 4K/ν is the period of the body momentum's circulation (SAM: about C; LAM: about A), with
+        ν the rate of the elliptic argument. P_φ is the mean precession period about the momentum of
+        the circulation axis: in SAM the C axis, whose azimuth follows g, so P_φ = 2π/⟨ġ⟩ with
+        ⟨ġ⟩ = c G + PN_COEFF · Π(n|p)/K(p) · ν (eq. 7 averaged over a period); in LAM the long axis A,
+        which gains one turn less per polhode period: P_φ = 2π/(⟨ġ⟩ − 2π/P_ψ). Checked: the Takahashi
+        et al. (2013) Toutatis state gives 5.369 d / 7.412 d (tests/test_state.py). Both are
+        infinite on the separatrix; a permanent rotation has P_ψ = ∞ and P_φ = 2π/|ω|.
+        """
+        mo, _, momentum, moments = self._motion()
+        if mo[_canonical.MO_MODE] == _canonical.MODE_UNIFORM:
+            rate = np.linalg.norm(momentum / np.array(moments))
+            return math.inf * u.day, (2 * math.pi / rate) * u.day
+        param, param_c = mo[_canonical.MO_PARAM], mo[_canonical.MO_PARAM_C]
+        if param_c == 0.0:
+            return math.inf * u.day, math.inf * u.day
+        quarter = _elliptic.ellipk(param, param_c)
+        complete_pi = _elliptic.characteristic_constants(mo[_canonical.MO_PN_N], param, param_c)[_elliptic.NK_COMPLETE]
+        nu = mo[_canonical.MO_ARG_PER_S] * mo[_canonical.MO_S_RATE]
+        mean_g_rate = mo[_canonical.MO_G] / moments[2] + mo[_canonical.MO_PN_COEFF] * complete_pi / quarter * nu
+        rotation_period = 4 * quarter / nu
+        if mo[_canonical.MO_MODE] == _canonical.MODE_LAM:
+            # In LAM, l librates and the long axis A circulates about the momentum: its azimuth gains
+            # one turn less than g per polhode period.
+            mean_g_rate -= 2 * math.pi / rotation_period
+        return rotation_period * u.day, (2 * math.pi / mean_g_rate) * u.day
+
+    def canonical_elements(self, reference="auto") -> CanonicalElements:
+        """Fukushima's canonical elements (paper eq. 4) of this state.
+
+        Parameters
+        ----------
+        reference : {"auto", "inertial"} or (3, 3) array
+            Frame of H and h. "inertial" uses the inertial frame as is; "auto" does too unless the
+            angular momentum is within asin(0.1) ≈ 5.7° of its z axis (near the Andoyer I = 0
+            singularity), in which case it uses the frame turned by 90° about x. A matrix gives the
+            passive rotation inertial → reference frame.
+
+        Raises
+        ------
+        SingularElementsError
+            For permanent rotations, which have no finite elements.
+        """
+        mo, _, _, moments = self._motion()
+        if mo[_canonical.MO_MODE] == _canonical.MODE_UNIFORM:
+            raise SingularElementsError(
+                "this state is a permanent rotation (spin about a principal axis that makes s infinite): it has no "
+                "finite canonical elements. propagate_torque_free still works (uniform rotation)."
+            )
+        attitude, momentum = self._principal()
+        if isinstance(reference, str):
+            if reference not in ("auto", "inertial"):
+                raise ValueError(f"reference must be 'auto', 'inertial' or a 3×3 rotation; got {reference!r}.")
+            frame = np.eye(3)
+            direction = self.angular_momentum_direction
+            if reference == "auto" and math.hypot(direction[0], direction[1]) < AUTO_REFERENCE_MIN_SIN_I:
+                frame = _rotations.rot1(math.pi / 2)
+        else:
+            frame = _as_rotation_matrix(reference)
+        ic = _canonical.inertia_constants(*moments)
+        elements, flip, mode = _canonical.elements_from_state(attitude @ frame.T, momentum, ic)
+        return CanonicalElements(*(float(x) for x in elements), flip=int(flip), mode=MODE_NAMES[mode], reference=frame)
+
+    @classmethod
+    def from_canonical_elements(cls, body: RigidBody, elements: CanonicalElements) -> "RotationState":
+        """The state of given canonical elements (paper eqs. 7–8), in the elements' reference frame."""
+        ic = _canonical.inertia_constants(*body.principal_moments)
+        values = np.array([elements.S, elements.Z, elements.H, elements.s, elements.z, elements.h])
+        attitude_ref, momentum = _canonical.state_from_elements(values, elements.flip, ic)
+        p = body._to_principal
+        attitude_user = p.T @ attitude_ref @ elements.reference
+        return cls.from_matrix(body, attitude_user, (p.T @ momentum) / body._values)
+
+    def propagate_torque_free(self, dt) -> tuple[np.ndarray, u.Quantity]:
+        """Exact torque-free motion (paper eq. 12) at times ``dt`` after this state.
+
+        Parameters
+        ----------
+        dt : Quantity or array_like
+            Time offsets (days if plain floats), scalar or 1-D.
+
+        Returns
+        -------
+        quaternions : ndarray, shape (N, 4)
+            Scalar-first quaternions, user body axes → inertial.
+        angular_velocity : Quantity, shape (N, 3)
+            Body angular velocity in user axes (rad/day).
+        """
+        times = dt.to_value(u.day) if isinstance(dt, u.Quantity) else np.asarray(dt, dtype=float)
+        times = np.atleast_1d(np.asarray(times, dtype=float))
+        if times.ndim != 1 or not np.all(np.isfinite(times)):
+            raise ValueError("dt must be a finite scalar or 1-D array of time offsets.")
+        attitude, momentum = self._principal()
+        moments = self._body.principal_moments
+        attitudes = _torque_free.torque_free_attitudes(attitude, momentum, *moments, times)
+        p = self._body._to_principal
+        user_attitudes = np.einsum("ji,njk->nik", p, attitudes)
+        quaternions = _rotations.attitude_to_quat_many(user_attitudes)
+        inertial_momentum = attitude.T @ momentum
+        body_momentum = np.einsum("nij,j->ni", user_attitudes, inertial_momentum)
+        return quaternions, (body_momentum / self._body._values) * RAD_PER_DAY
+
+    def __repr__(self):
+        omega = ", ".join(f"{w:.6g}" for w in self._omega)
+        q = ", ".join(f"{c:.6g}" for c in self._q)
+        return f"RotationState(q=({q}), ω=({omega}) rad/day)"

@@ -1,0 +1,125 @@
+"""RigidBody and RotationState: validation, axes, elements, and the published Toutatis periods."""
+
+import math
+
+import numpy as np
+import pytest
+from astropy import units as u
+
+from spinorbit.body import InvalidBodyError, RigidBody
+from spinorbit.core import SingularElementsError
+from spinorbit.state import InvalidStateError, RotationState
+
+# Takahashi, Busch & Scheeres 2013 (AJ 146, 95), Table 2: torque-free from their state gives
+# 5.369 d / 7.412 d (anchors.md); quoted to 4 digits, so compare to half a unit of the last digit.
+TOUTATIS_PERIODS_DAY = (5.369, 7.412)
+QUOTED_DIGITS_TOLERANCE = 0.0005  # day
+
+
+def toutatis():
+    body = RigidBody([3.0836, 3.235, 1.0], name="Toutatis")  # z = long axis (smallest moment)
+    return RotationState.from_euler313(
+        body, 145.498 * u.deg, 65.865 * u.deg, 241.524 * u.deg, [14.51, 33.529, -98.709] * u.deg / u.day
+    )
+
+
+def test_toutatis_periods_match_takahashi_2013():
+    state = toutatis()
+    assert state.mode == "LAM"
+    rotation, precession = state.periods
+    assert rotation.to_value(u.day) == pytest.approx(TOUTATIS_PERIODS_DAY[0], abs=QUOTED_DIGITS_TOLERANCE)
+    assert precession.to_value(u.day) == pytest.approx(TOUTATIS_PERIODS_DAY[1], abs=QUOTED_DIGITS_TOLERANCE)
+
+
+def test_body_orders_axes_with_a_proper_rotation():
+    body = RigidBody([3.0836, 3.235, 1.0])
+    assert body.principal_moments == (1.0, 3.0836, 3.235)
+    p = body.to_principal
+    assert np.allclose(p @ p.T, np.eye(3)) and np.linalg.det(p) == pytest.approx(1.0)
+    assert np.allclose(np.abs(p @ np.diag([3.0836, 3.235, 1.0]) @ p.T), np.diag(body.principal_moments))
+
+
+@pytest.mark.parametrize(
+    "moments, error, message",
+    [
+        ([1.0, 2.0, -1.0], InvalidBodyError, "positive"),
+        ([1.0, 1.0, 3.0], InvalidBodyError, "triangle"),
+        ([1.0, 2.0], InvalidBodyError, "three"),
+        ([1.0, math.nan, 2.0], InvalidBodyError, "finite"),
+        ([1.0, 2.0, 2.5] * u.m, u.UnitTypeError, "kg m"),
+    ],
+)
+def test_bad_bodies_are_named(moments, error, message):
+    with pytest.raises(error, match=message):
+        RigidBody(moments)
+
+
+def test_state_elements_round_trip_in_user_axes():
+    body = RigidBody([2.5, 1.0, 2.0] * u.kg * u.m**2)
+    q = np.array([0.3, -0.5, 0.2, 0.7])
+    state = RotationState(body, q / np.linalg.norm(q), [0.4, -1.1, 0.3] * u.rad / u.s)
+    back = RotationState.from_canonical_elements(body, state.canonical_elements())
+    assert np.abs(back.attitude_matrix - state.attitude_matrix).max() < 1e-13
+    assert np.abs((back.angular_velocity - state.angular_velocity) / state.angular_velocity.max()).max() < 1e-13
+
+
+def test_auto_reference_frame_keeps_away_from_i_zero():
+    body = RigidBody([1.0, 2.0, 2.5])
+    state = RotationState.from_angular_momentum(body, [1.0, 0.0, 0.0, 0.0], [0.02, 0.03, 1.0])  # momentum 2° from z
+    elements = state.canonical_elements()
+    assert abs(elements.H) < 0.2 * elements.Z  # the reference frame was turned: I is near 90°
+    back = RotationState.from_canonical_elements(body, elements)
+    assert np.abs(back.attitude_matrix - state.attitude_matrix).max() < 1e-13
+
+
+def test_energy_ratio_and_modes_at_principal_axes():
+    body = RigidBody([1.0, 2.0, 2.5])
+    about_c = RotationState(body, [1, 0, 0, 0], [0.0, 0.0, 1.0])
+    about_a = RotationState(body, [1, 0, 0, 0], [-1.0, 0.0, 0.0])
+    about_b = RotationState(body, [1, 0, 0, 0], [0.0, 1.0, 0.0])
+    assert about_c.energy_ratio == pytest.approx(1.0) and about_c.mode == "SAM" and about_c.sense == "+C"
+    assert about_a.energy_ratio == pytest.approx(2.5) and about_a.mode == "LAM" and about_a.sense == "-A"
+    assert about_b.mode == "permanent rotation"
+    with pytest.raises(SingularElementsError):
+        about_b.canonical_elements()
+
+
+def test_torque_free_propagation_keeps_momentum_and_energy():
+    state = toutatis()
+    quaternions, omega = state.propagate_torque_free(np.linspace(0, 400, 9) * u.day)
+    moments = np.array([3.0836, 3.235, 1.0])
+    momentum_body = omega.value * moments
+    inertial = np.array([RotationState(state.body, q, w).angular_momentum_direction for q, w in zip(quaternions, omega.value)])
+    assert np.abs(inertial - inertial[0]).max() < 1e-12
+    energy = np.sum(momentum_body**2 / moments, axis=1)
+    assert np.abs(energy / energy[0] - 1).max() < 1e-13
+    assert np.abs(quaternions[0] - state.quaternion).max() < 1e-14 or np.abs(quaternions[0] + state.quaternion).max() < 1e-14
+
+
+def test_permanent_rotation_about_b_propagates_uniformly():
+    body = RigidBody([1.0, 2.0, 2.5])
+    state = RotationState(body, [1, 0, 0, 0], [0.0, 2 * math.pi, 0.0])  # one turn a day about B
+    quaternions, _ = state.propagate_torque_free([0.25, 1.0])
+    assert abs(abs(quaternions[1][0]) - 1.0) < 1e-14  # back where it started after a day
+    assert abs(quaternions[0][0]) == pytest.approx(math.cos(math.pi / 4))
+
+
+@pytest.mark.parametrize(
+    "quaternion, omega, message",
+    [
+        ([1.0, 0.0, 0.0], [1.0, 0.0, 0.0], "4 components"),
+        ([0.0, 0.0, 0.0, 0.0], [1.0, 0.0, 0.0], "unit norm"),
+        ([2.0, 0.0, 0.0, 0.0], [1.0, 0.0, 0.0], "unit norm"),
+        ([1.0, 0.0, 0.0, 0.0], [1.0, math.inf, 0.0], "finite"),
+    ],
+)
+def test_bad_states_are_named(quaternion, omega, message):
+    with pytest.raises(InvalidStateError, match=message):
+        RotationState(RigidBody([1.0, 2.0, 2.5]), quaternion, omega)
+
+
+def test_rotation_matrix_must_be_a_rotation():
+    with pytest.raises(InvalidStateError, match="not a rotation"):
+        RotationState.from_matrix(RigidBody([1.0, 2.0, 2.5]), np.diag([1.0, 1.0, -1.0]), [1.0, 0, 0])
+    with pytest.raises(u.UnitTypeError, match="angle per time"):
+        RotationState(RigidBody([1.0, 2.0, 2.5]), [1, 0, 0, 0], [1.0, 0, 0] * u.m / u.s)

@@ -342,10 +342,19 @@ def parameter_constants(m, mc):
     For m > 1: μ = 1/m, μ_c = −mc/m (from the supplied mc, never 1 − 1/m; note §6.2), K = K(μ)
     (quarter period of the functions of v = √m u), head + tail = 2K(μ)/√m (half period in u).
     For m = 1 (mc == 0): K = head = ∞ and the kernels use closed forms (note §6.7).
+    NaN m or mc gives all-NaN constants, so every kernel then returns NaN.
     head has 24 significant bits so ``j*head`` is exact for |j| < 2^29 (note §6.1).
     """
+    if m != m or mc != mc:
+        nan = math.nan
+        return (nan, nan, nan, nan, nan, nan, nan, nan, nan, nan)
     if mc > 0.0:
         mu, muc_hi, muc_lo, sqrt_m = m, mc, 0.0, 1.0
+        if m < 0.5:
+            # Here the double m is the datum and 1 − m may not be a double: carry it exactly, or
+            # its rounding (≤ 5.6e-17) would shift K and hence the phase at |u| = 1e6 by ~1e-11.
+            # For m ≥ 0.5 the supplied mc is the datum (m = 1 − mc may be the rounded one).
+            muc_hi, muc_lo = _two_sum(1.0, -m)
     elif mc < 0.0:
         mu = 1.0 / m
         # μ_c = −mc/m as a double-double: the exact remainder of the division comes from two_prod.

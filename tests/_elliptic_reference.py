@@ -85,6 +85,6 @@ def pn(u, n_exact, m, mc):
 
 
 def relative_error(value, reference):
-    if reference == 0:
+    if abs(reference) < mp.mpf(10) ** -35:  # an exact zero, up to mpmath's own 40-digit rounding
         return abs(value)
     return float(abs((mp.mpf(value) - reference) / reference))

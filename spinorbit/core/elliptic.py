@@ -187,10 +187,12 @@ def rf(x, y, z):
 
 
 @jit
-def _rc_from_difference(x, y_minus_x):
-    """R_C(x, x + d) for x ≥ 0, x + d > 0, with d = y − x supplied by the caller (DLMF 19.2.17–19).
+def _rc_from_difference(x, y, y_minus_x):
+    """R_C(x, y) for x ≥ 0, y > 0, with d = y − x supplied by the caller (DLMF 19.2.17–19).
 
     Exact when d is known without cancellation (note §6.4: y − x = s²(1 + m + f + g)).
+    y > x: atan2(√d, √x)/√d. y < x: atanh(√(−d/x))/√(−d) while −d/x ≤ ½, else the logarithm
+    ln((√x + √(−d))/√y)/√(−d), because atanh near 1 would amplify the rounding of its argument.
     """
     d = y_minus_x
     if d > 0.0:
@@ -198,7 +200,9 @@ def _rc_from_difference(x, y_minus_x):
         return math.atan2(sd, math.sqrt(x)) / sd
     if d < 0.0:
         sd = math.sqrt(-d)
-        return math.atanh(sd / math.sqrt(x)) / sd
+        if -d <= 0.5 * x:
+            return math.atanh(sd / math.sqrt(x)) / sd
+        return math.log((math.sqrt(x) + sd) / math.sqrt(y)) / sd
     return 1.0 / math.sqrt(x)
 
 
@@ -206,23 +210,10 @@ def _rc_from_difference(x, y_minus_x):
 def rc(x, y):
     """Carlson's R_C(x, y) = ½∫₀^∞ dt / ((t+y)√(t+x)) for x ≥ 0, y > 0 (DLMF 19.2.17–19).
 
-    Closed form with atan/atanh; y − x is exact when x and y are close (Sterbenz), so there is no
-    cancellation in the argument.
+    Closed forms with atan/atanh/log; y − x is exact when x and y are close (Sterbenz), so there
+    is no cancellation in the argument.
     """
-    return _rc_from_difference(x, y - x)
-
-
-@jit
-def _rc_one_plus(e):
-    """R_C(1, 1 + e) for e > −1, accurate for small |e| (series DLMF 19.36.2 form)."""
-    if abs(e) < 1e-3:
-        # 1 − e/3 + e²/5 − e³/7 + e⁴/9 − e⁵/11: truncation < 1e-3^6/13 < ε
-        return 1.0 + e * (-1.0 / 3.0 + e * (0.2 + e * (-1.0 / 7.0 + e * (1.0 / 9.0 - e / 11.0))))
-    if e > 0.0:
-        se = math.sqrt(e)
-        return math.atan(se) / se
-    se = math.sqrt(-e)
-    return math.atanh(se) / se
+    return _rc_from_difference(x, y, y - x)
 
 
 @jit
@@ -267,23 +258,24 @@ def rd(x, y, z):
 def rj(x, y, z, p):
     """Carlson's R_J(x, y, z, p) = 3/2 ∫₀^∞ dt / ((t+p)√((t+x)(t+y)(t+z))) for p > 0 (DLMF 19.16.2).
 
-    x, y, z ≥ 0, at most one zero. Carlson (1995) algorithm with δ = (p−x)(p−y)(p−z),
-    d_k = (√p_k+√x_k)(√p_k+√y_k)(√p_k+√z_k), e_k = 4^-3k δ/d_k² and the R_C(1, 1+e_k) sum.
+    x, y, z ≥ 0, at most one zero. Duplication (DLMF 19.26.20) with the duplication terms
+    3 Σ 4^-k R_C(α_k, β_k), α_k = (p_k(√x_k+√y_k+√z_k) + √(x_k y_k z_k))², β_k = p_k(p_k+λ_k)²
+    (Carlson 1995): α and β are sums of positive terms, so R_C stays well conditioned even for
+    p ≪ x, y, z, where the equivalent R_C(1, 1 + δ/d²) form sits next to its log singularity.
     """
     a0 = (x + y + z + 2.0 * p) / 5.0
-    delta = (p - x) * (p - y) * (p - z)
     q = RDJ_STOP * max(abs(a0 - x), abs(a0 - y), abs(a0 - z), abs(a0 - p))
     a = a0
     power4 = 1.0
-    power64 = 1.0
     total = 0.0
     while q >= abs(a):
-        sx, sy, sz, sp = math.sqrt(x), math.sqrt(y), math.sqrt(z), math.sqrt(p)
+        sx, sy, sz = math.sqrt(x), math.sqrt(y), math.sqrt(z)
         lam = sx * sy + sx * sz + sy * sz
-        d = (sp + sx) * (sp + sy) * (sp + sz)
-        total += power4 * _rc_one_plus(power64 * delta / (d * d)) / d
+        alpha = p * (sx + sy + sz) + sx * sy * sz
+        alpha *= alpha
+        beta = p * (p + lam) * (p + lam)
+        total += power4 * rc(alpha, beta)
         power4 *= 0.25
-        power64 *= 1.0 / 64.0
         x = 0.25 * (x + lam)
         y = 0.25 * (y + lam)
         z = 0.25 * (z + lam)
@@ -304,7 +296,7 @@ def rj(x, y, z, p):
         1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0
         - 9.0 * e2 * e3 / 52.0 + 3.0 * e5 / 26.0
     )
-    return 6.0 * total + power4 * series / (a * math.sqrt(a))
+    return 3.0 * total + power4 * series / (a * math.sqrt(a))
 
 
 # --------------------------------------------------------------------------------------------------
@@ -342,10 +334,19 @@ def parameter_constants(m, mc):
     For m > 1: μ = 1/m, μ_c = −mc/m (from the supplied mc, never 1 − 1/m; note §6.2), K = K(μ)
     (quarter period of the functions of v = √m u), head + tail = 2K(μ)/√m (half period in u).
     For m = 1 (mc == 0): K = head = ∞ and the kernels use closed forms (note §6.7).
+    NaN m or mc gives all-NaN constants, so every kernel then returns NaN.
     head has 24 significant bits so ``j*head`` is exact for |j| < 2^29 (note §6.1).
     """
+    if m != m or mc != mc:
+        nan = math.nan
+        return (nan, nan, nan, nan, nan, nan, nan, nan, nan, nan)
     if mc > 0.0:
         mu, muc_hi, muc_lo, sqrt_m = m, mc, 0.0, 1.0
+        if m < 0.5:
+            # Here the double m is the datum and 1 − m may not be a double: carry it exactly, or
+            # its rounding (≤ 5.6e-17) would shift K and hence the phase at |u| = 1e6 by ~1e-11.
+            # For m ≥ 0.5 the supplied mc is the datum (m = 1 − mc may be the rounded one).
+            muc_hi, muc_lo = _two_sum(1.0, -m)
     elif mc < 0.0:
         mu = 1.0 / m
         # μ_c = −mc/m as a double-double: the exact remainder of the division comes from two_prod.
@@ -620,7 +621,8 @@ def _pi_principal(s, c2, delta2, f_part, nk):
         one_g = 1.0 + g * s2
         x = c2 * delta2
         # y − x = s²(1 + m + f + g) exactly, because f·g = m (note §6.4)
-        rc_term = _rc_from_difference(x, s2 * (1.0 + m_term + f + g))
+        y_minus_x = s2 * (1.0 + m_term + f + g)
+        rc_term = _rc_from_difference(x, x + y_minus_x, y_minus_x)
         result = s * rc_term
         if g != 0.0:
             result += g * (s * s2 / 3.0) * rj(c2, delta2, 1.0, one_g)

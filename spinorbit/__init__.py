@@ -9,19 +9,30 @@ The front door. Public names are listed here; everything else is an implementati
   ``canonical_to_andoyer``).
 """
 
-from .body import InvalidBodyError, RigidBody
-from .core.errors import SingularElementsError, SpinorbitError
-from .state import CanonicalElements, InvalidStateError, RotationState
-
 __version__ = "0.1.0.dev0"
 
-__all__ = [
-    "RigidBody",
-    "RotationState",
-    "CanonicalElements",
-    "InvalidBodyError",
-    "InvalidStateError",
-    "SingularElementsError",
-    "SpinorbitError",
-    "__version__",
-]
+# The front door is lazy (PEP 562): importing ``spinorbit.core`` — e.g. inside a REBOUND callback or a
+# numba-only worker — must not pull in astropy through this package's __init__.
+_PUBLIC = {
+    "RigidBody": ".body",
+    "InvalidBodyError": ".body",
+    "RotationState": ".state",
+    "CanonicalElements": ".state",
+    "InvalidStateError": ".state",
+    "SingularElementsError": ".core.errors",
+    "SpinorbitError": ".core.errors",
+}
+
+__all__ = [*_PUBLIC, "__version__"]
+
+
+def __getattr__(name):
+    if name in _PUBLIC:
+        import importlib
+
+        return getattr(importlib.import_module(_PUBLIC[name], __name__), name)
+    raise AttributeError(f"module 'spinorbit' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(__all__)

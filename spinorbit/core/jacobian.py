@@ -74,8 +74,6 @@ from .elliptic import (
     MK_HEAD,
     MK_K_HI,
     MK_K_LO,
-    MK_M,
-    MK_MC,
     MK_MU,
     MK_MUC,
     MK_SQRT_MUC,
@@ -231,7 +229,7 @@ def _working_derivatives(big_s, big_z, s, ic):
     if mode == MODE_SAM:
         f = a_b / b_c
         sn, cn, dn, jm, _, _ = associate_integrals(x, mk, f)
-        dsn, dcn, ddn, dam = jacobi_parameter_derivatives(sn, cn, dn, jm, q)
+        _, _, ddn, dam = jacobi_parameter_derivatives(sn, cn, dn, jm, q)
         x_d = -a * x / (2.0 * d * a_d)
         q_d = f * a_c / (a_d * a_d)
         big_l = amp_z * dn
@@ -250,7 +248,7 @@ def _working_derivatives(big_s, big_z, s, ic):
     else:
         f = a_d / d_c  # −n′ of pn(v, n′|μ); only cn² T is used below
         sn, cn, dn, jm, _, cn2_t = associate_integrals(x, mk, f)
-        dsn, dcn, ddn, dam = jacobi_parameter_derivatives(sn, cn, dn, jm, q)
+        _, dcn, _, _ = jacobi_parameter_derivatives(sn, cn, dn, jm, q)
         x_d = c * x / (2.0 * d * d_c)
         q_d = -b_c * a_c / (a_b * d_c * d_c)
         big_l = amp_z * cn

@@ -266,14 +266,22 @@ def body_from_argument(arg, mo, mk):
 
 
 @jit
-def attitude_from_parts(mx, my, mz, big_g, sin_l, cos_l, g, cos_i, sin_i, h):
-    """R = R3(l) R1(J) R3(g) R1(I) R3(h), with J from the momentum (sin J = |M⊥|/G, cos J = M_z/G)."""
-    sin_j = math.hypot(mx, my) / big_g
-    cos_j = mz / big_g
+def node_to_body(sin_l, cos_l, sin_j, cos_j):
+    """W = R3(l) R1(J): from the frame of the angular momentum's node to the body frame.
+
+    Its third column is M/G = (sin J sin l, sin J cos l, cos J).
+    """
     w = np.empty((3, 3))
     w[0, 0], w[0, 1], w[0, 2] = cos_l, sin_l * cos_j, sin_l * sin_j
     w[1, 0], w[1, 1], w[1, 2] = -sin_l, cos_l * cos_j, cos_l * sin_j
     w[2, 0], w[2, 1], w[2, 2] = 0.0, -sin_j, cos_j
+    return w
+
+
+@jit
+def attitude_from_parts(mx, my, mz, big_g, sin_l, cos_l, g, cos_i, sin_i, h):
+    """R = R3(l) R1(J) R3(g) R1(I) R3(h), with J from the momentum (sin J = |M⊥|/G, cos J = M_z/G)."""
+    w = node_to_body(sin_l, cos_l, math.hypot(mx, my) / big_g, mz / big_g)
     cg, sg = math.cos(g), math.sin(g)
     r3g = np.zeros((3, 3))
     r3g[0, 0], r3g[0, 1], r3g[1, 0], r3g[1, 1], r3g[2, 2] = cg, sg, -sg, cg, 1.0
@@ -293,12 +301,7 @@ def node_angles(attitude, momentum, sin_l, cos_l):
     sin_i = math.hypot(inertial[0], inertial[1]) / big_g
     cos_i = big_h / big_g
     h = math.atan2(inertial[0], -inertial[1])
-    sin_j = math.hypot(momentum[0], momentum[1]) / big_g
-    cos_j = momentum[2] / big_g
-    w = np.empty((3, 3))
-    w[0, 0], w[0, 1], w[0, 2] = cos_l, sin_l * cos_j, sin_l * sin_j
-    w[1, 0], w[1, 1], w[1, 2] = -sin_l, cos_l * cos_j, cos_l * sin_j
-    w[2, 0], w[2, 1], w[2, 2] = 0.0, -sin_j, cos_j
+    w = node_to_body(sin_l, cos_l, math.hypot(momentum[0], momentum[1]) / big_g, momentum[2] / big_g)
     r3g = w.T @ attitude @ node_frame(cos_i, sin_i, h).T
     return big_h, cos_i, sin_i, h, math.atan2(r3g[0, 1], r3g[0, 0])
 

@@ -28,7 +28,9 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import pkgutil
+import re
 import sys
 
 __all__ = ["main", "build_parser", "CommandError", "EXIT_USAGE"]
@@ -37,14 +39,25 @@ __all__ = ["main", "build_parser", "CommandError", "EXIT_USAGE"]
 EXIT_USAGE = 2
 #: Exit status after Ctrl-C (128 + SIGINT), as shells report it.
 EXIT_INTERRUPTED = 130
+#: Exit status when stdout is closed early (128 + SIGPIPE), as shells report it.
+EXIT_BROKEN_PIPE = 141
 
 
 class CommandError(Exception):
     """A user-input or output problem, reported as one line and exit status 2."""
 
 
+# What argparse must read as a negative number, not an option. Its own pattern (Python < 3.13) misses
+# exponents, so ``--omega 1e-4 0 -3e-4`` would fail with "expected 3 arguments".
+_NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$", re.IGNORECASE)
+
+
 class _Parser(argparse.ArgumentParser):
     """ArgumentParser whose errors are one line with a pointer to ``--help`` (not usage + error)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = _NEGATIVE_NUMBER
 
     def error(self, message):
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message}. Run '{self.prog} --help' for usage.\n")
@@ -109,11 +122,16 @@ def main(argv=None) -> int:
     Returns
     -------
     int
-        0 on success, 2 for bad input or an output that cannot be written, 130 after Ctrl-C.
+        0 on success, 2 for bad input or an output that cannot be written, 130 after Ctrl-C, 141 if
+        stdout was closed early.
     """
     args = build_parser().parse_args(argv)
     try:
         return args._run(args)
+    except BrokenPipeError:
+        # stdout was closed early (`spinorbit ... | head`): stop quietly, as Unix tools do on SIGPIPE.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE
     except KeyboardInterrupt:
         print(f"{args._prog}: interrupted; no output was written for the unfinished run.", file=sys.stderr)
         return EXIT_INTERRUPTED

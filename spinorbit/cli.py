@@ -80,7 +80,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Rotation of rigid bodies (tumbling asteroids, librating moons) with Fukushima's "
         "canonical elements. Each command below has its own help: spinorbit COMMAND --help.",
         epilog="example:\n  spinorbit torque-free --moments 3.0836 3.235 1 --omega 14.51 33.529 -98.709\n\n"
-        "Documentation: docs/index.md in the source tree (build it with sphinx-build docs docs/_build/html).",
+        "Documentation: in a source checkout, sphinx-build docs docs/_build/html builds it (offline);\n"
+        "docs/cli.md explains every option and the output table.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--version", action="version", version=f"spinorbit {__version__}")

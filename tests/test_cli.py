@@ -81,8 +81,8 @@ def test_toutatis_ecsv_reads_back_with_columns_units_and_initial_state(capsys, t
 def test_n_times_and_omega_unit(capsys, tmp_path):
     path = tmp_path / "run.ecsv"
     rad_per_s = (np.array([14.51, 33.529, -98.709]) * u.deg / u.day).to_value(u.rad / u.s)
-    status, out, err = run_cli(capsys, "--moments", "3.0836", "3.235", "1", "--omega", *(repr(float(w)) for w in rad_per_s),
-                               "--omega-unit", "rad/s", "--euler313", "145.498", "65.865", "241.524",
+    omega = [repr(float(w)) for w in rad_per_s]  # one is negative with an exponent (-1.99e-05)
+    status, out, err = run_cli(capsys, "--moments", "3.0836", "3.235", "1", "--omega", *omega, "--omega-unit", "rad/s", "--euler313", "145.498", "65.865", "241.524",
                                "--span", "2 yr", "--n-times", "7", "--output", str(path))
     assert status == 0, err
     assert periods(out) == pytest.approx((P_PSI_D, P_PHI_D), abs=PERIOD_TOLERANCE_D)

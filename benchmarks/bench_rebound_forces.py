@@ -62,7 +62,7 @@ def main():
         rows.append(f"| {label} | {seconds * 1e3:.1f} | {steps} | {seconds / baseline:.2f} |")
     table = "\n".join(
         [
-            "### Extra forces in REBOUND: raw cfunc pointer vs Python callbacks",
+            "## Extra forces in REBOUND: raw cfunc pointer vs Python callbacks",
             "",
             machine_line(),
             "One year, 11 DE421 bodies, IAS15, best of 5 (`benchmarks/bench_rebound_forces.py`).",

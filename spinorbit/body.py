@@ -108,7 +108,7 @@ class RigidBody:
         if big_a + big_b < big_c * (1.0 - TRIANGLE_SLACK):
             raise InvalidBodyError(
                 f"moments {values.tolist()} violate the triangle inequality A + B ≥ C "
-                f"({big_a!r} + {big_b!r} < {big_c!r}); no mass distribution has them. Check the values and their axes."
+                f"({float(big_a)!r} + {float(big_b)!r} < {float(big_c)!r}); no mass distribution has them. Check the values and their axes."
             )
         if self.mass is not None and (not isinstance(self.mass, u.Quantity) or self.mass.unit.physical_type != "mass"):
             raise u.UnitTypeError(f"mass must be a Quantity in a mass unit (e.g. 6e10 * u.kg); got {self.mass!r}.")

@@ -126,6 +126,8 @@ class RotationState:
     angular_velocity : Quantity or array_like, shape (3,)
         Body angular velocity in the user's body axes (rad/day if plain floats).
 
+    Notes
+    -----
     Use :meth:`from_matrix`, :meth:`from_euler313` or :meth:`from_angular_momentum` for other inputs.
     """
 

@@ -1,0 +1,266 @@
+"""The ``spinorbit`` command line: the Toutatis run, its ECSV table, --help, and errors in words."""
+
+import io
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import astropy.units as u
+import numpy as np
+import pytest
+from _offline import no_network  # noqa: F401
+from astropy.table import Table
+
+from spinorbit import RigidBody, RotationState, cli
+from spinorbit.commands import _common, torque_free
+
+ROOT = Path(__file__).resolve().parents[1]
+
+# (4179) Toutatis, Takahashi et al. (2013), as in README.md and tests/test_state.py.
+TOUTATIS = ["--moments", "3.0836", "3.235", "1", "--omega", "14.51", "33.529", "-98.709",
+            "--euler313", "145.498", "65.865", "241.524"]
+P_PSI_D, P_PHI_D = 5.369, 7.412
+PERIOD_TOLERANCE_D = 1e-3  # the published periods are given to 1e-3 d
+COLUMNS = ["time", "q_w", "q_x", "q_y", "q_z", "omega_x", "omega_y", "omega_z"]
+# The first row is the input state itself: the exact flow at t = 0 must return it to rounding.
+INITIAL_STATE_TOLERANCE = 1e-12
+
+
+def run_cli(capsys, *args):
+    status = cli.main(["torque-free", *args])
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def periods(stdout):
+    match = re.search(r"P_psi = ([\d.]+) d .* P_phi = ([\d.]+) d", stdout)
+    assert match, stdout
+    return float(match[1]), float(match[2])
+
+
+# -- the Toutatis run -----------------------------------------------------------------------------
+
+
+def test_toutatis_summary_in_process(capsys, tmp_path):
+    status, out, err = run_cli(capsys, *TOUTATIS, "--output", str(tmp_path / "t.ecsv"))
+    assert status == 0, err
+    assert err == ""
+    assert re.search(r"mode\s+LAM, sense -A", out)
+    p_psi, p_phi = periods(out)
+    assert p_psi == pytest.approx(P_PSI_D, abs=PERIOD_TOLERANCE_D)
+    assert p_phi == pytest.approx(P_PHI_D, abs=PERIOD_TOLERANCE_D)
+
+
+def test_toutatis_ecsv_reads_back_with_columns_units_and_initial_state(capsys, tmp_path):
+    path = tmp_path / "toutatis.ecsv"
+    status, _, err = run_cli(capsys, *TOUTATIS, "--span", "10", "d", "--step", "0.5 d", "--output", str(path))
+    assert status == 0, err
+    table = Table.read(path, format="ascii.ecsv")
+    assert table.colnames == COLUMNS
+    assert len(table) == 21
+    assert table["time"].unit == u.day
+    assert table["omega_x"].unit == u.deg / u.day
+    assert all(table[f"q_{c}"].unit is None for c in "wxyz")
+    assert table.meta["mode"] == "LAM" and table.meta["sense"] == "-A"
+    np.testing.assert_allclose(table["time"], np.arange(21) * 0.5)
+
+    q = np.column_stack([table[f"q_{c}"] for c in "wxyz"])
+    omega = np.column_stack([table[f"omega_{c}"] for c in "xyz"])
+    np.testing.assert_allclose(np.linalg.norm(q, axis=1), 1.0, atol=INITIAL_STATE_TOLERANCE)
+    np.testing.assert_allclose(omega[0], [14.51, 33.529, -98.709], rtol=INITIAL_STATE_TOLERANCE)
+    body = RigidBody([3.0836, 3.235, 1.0])
+    state = RotationState.from_euler313(body, 145.498 * u.deg, 65.865 * u.deg, 241.524 * u.deg,
+                                        [14.51, 33.529, -98.709] * u.deg / u.day)
+    assert abs(np.dot(q[0], state.quaternion)) == pytest.approx(1.0, abs=INITIAL_STATE_TOLERANCE)
+    # q and -q are one attitude; the table keeps the sign continuous (no jumps between rows)
+    assert np.all(np.einsum("ij,ij->i", q[1:], q[:-1]) > 0)
+
+
+def test_n_times_and_omega_unit(capsys, tmp_path):
+    path = tmp_path / "run.ecsv"
+    rad_per_s = (np.array([14.51, 33.529, -98.709]) * u.deg / u.day).to_value(u.rad / u.s)
+    omega = [repr(float(w)) for w in rad_per_s]  # one is negative with an exponent (-1.99e-05)
+    status, out, err = run_cli(capsys, "--moments", "3.0836", "3.235", "1", "--omega", *omega, "--omega-unit", "rad/s", "--euler313", "145.498", "65.865", "241.524",
+                               "--span", "2 yr", "--n-times", "7", "--output", str(path))
+    assert status == 0, err
+    assert periods(out) == pytest.approx((P_PSI_D, P_PHI_D), abs=PERIOD_TOLERANCE_D)
+    table = Table.read(path)
+    assert len(table) == 7 and table["time"][-1] == pytest.approx(2 * 365.25)
+    assert table["omega_x"].unit == u.rad / u.s
+
+
+def test_plot_is_a_png(capsys, tmp_path):
+    pytest.importorskip("matplotlib")
+    path = tmp_path / "run.png"
+    status, _, err = run_cli(capsys, *TOUTATIS, "--span", "20 d", "--plot", str(path))
+    assert status == 0, err
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert [p.name for p in tmp_path.iterdir()] == ["run.png"]
+
+
+def test_subprocess_python_m_spinorbit(tmp_path):
+    path = tmp_path / "t.ecsv"
+    result = subprocess.run([sys.executable, "-m", "spinorbit", "torque-free", *TOUTATIS, "--output", str(path)],
+                            capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert result.returncode == 0, result.stderr
+    assert "LAM" in result.stdout
+    assert periods(result.stdout) == pytest.approx((P_PSI_D, P_PHI_D), abs=PERIOD_TOLERANCE_D)
+    assert len(Table.read(path)) == 101
+
+
+# -- help -----------------------------------------------------------------------------------------
+
+
+def test_help_lists_commands_and_examples(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(["--help"])
+    assert exit_info.value.code == 0
+    assert "torque-free" in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        cli.main(["torque-free", "--help"])
+    out = capsys.readouterr().out
+    for text in ("--moments", "--omega-unit", "--euler313", "--span", "--n-times", "--output", "--plot",
+                 "examples:", "spinorbit torque-free --moments 3.0836 3.235 1", "exit status"):
+        assert text in out
+
+
+def test_every_command_module_is_registered():
+    parser_help = cli.build_parser().format_help()
+    for module in cli._command_modules():
+        for attribute in ("NAME", "SUMMARY", "DESCRIPTION", "EXAMPLES", "add_arguments", "run"):
+            assert hasattr(module, attribute), f"{module.__name__} lacks {attribute}"
+        assert module.NAME in parser_help
+
+
+# -- errors in words --------------------------------------------------------------------------------
+
+VALID = ["--moments", "1", "2", "2.5", "--omega", "1", "2", "3"]
+BAD_INPUT = {
+    "negative moment": (["--moments", "-1", "2", "2.5", "--omega", "1", "2", "3"], "positive"),
+    "triangle violated": (["--moments", "1", "1", "3", "--omega", "1", "2", "3"], "triangle inequality"),
+    "non-numeric moment": (["--moments", "1", "two", "2.5", "--omega", "1", "2", "3"], "expected a number, got 'two'"),
+    "two moments": (["--moments", "1", "2", "--omega", "1", "2", "3"], "expected 3 arguments"),
+    "no spin": (["--moments", "1", "2", "2.5", "--omega", "0", "0", "0"], "non-zero angular velocity"),
+    "infinite spin": (["--moments", "1", "2", "2.5", "--omega", "1", "inf", "3"], "finite number"),
+    "minus infinite spin": (["--moments", "1", "2", "2.5", "--omega", "1", "-inf", "3"], "finite number"),
+    "omega unit is a length": ([*VALID, "--omega-unit", "km"], "unit of angular velocity"),
+    "omega unit unknown": ([*VALID, "--omega-unit", "furlongs"], "unit of angular velocity"),
+    "span in kg": ([*VALID, "--span", "3", "kg"], "--span expects a time"),
+    "span zero": ([*VALID, "--span", "0"], "non-zero duration"),
+    "negative step": ([*VALID, "--step", "-1", "d"], "positive spacing"),
+    "too many times": ([*VALID, "--span", "1e9", "d"], "output times"),
+    "step and n-times": ([*VALID, "--step", "1", "--n-times", "5"], "not allowed with"),
+    "missing omega": (["--moments", "1", "2", "2.5"], "required: --omega"),
+}
+
+
+def assert_one_clean_line(status, err, expected):
+    assert status == 2
+    assert "Traceback" not in err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith("spinorbit torque-free: error:")
+    assert expected in lines[0]
+
+
+def run_expecting_usage_error(capsys, args):
+    try:
+        status = cli.main(["torque-free", *args])
+    except SystemExit as exit_info:  # argparse's own checks exit from inside parse_args
+        status = exit_info.code
+    return status, capsys.readouterr().err
+
+
+@pytest.mark.parametrize("case", sorted(BAD_INPUT))
+def test_bad_input_is_one_line_exit_2_and_no_file(capsys, tmp_path, case):
+    args, expected = BAD_INPUT[case]
+    status, err = run_expecting_usage_error(capsys, [*args, "--output", str(tmp_path / "out.ecsv")])
+    assert_one_clean_line(status, err, expected)
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("where", ["missing directory", "a directory"])
+def test_unwritable_output_fails_before_the_run(capsys, tmp_path, where):
+    target = tmp_path / "no" / "such" / "out.ecsv" if where == "missing directory" else tmp_path
+    status, out, err = run_cli(capsys, *VALID, "--output", str(target))
+    assert_one_clean_line(status, err, "--output")
+    assert out == ""  # refused before any work was done
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_failed_write_leaves_nothing_behind(capsys, tmp_path, monkeypatch):
+    def half_write(self, path, **kwargs):
+        Path(path).write_text("# %ECSV 1.0\n# half")
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(Table, "write", half_write)
+    status, _, err = run_cli(capsys, *VALID, "--output", str(tmp_path / "out.ecsv"))
+    assert_one_clean_line(status, err, "No space left on device")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_bug_keeps_its_traceback_and_leaves_no_file(capsys, tmp_path, monkeypatch):
+    def broken(*args, **kwargs):
+        raise RuntimeError("a bug")
+
+    monkeypatch.setattr(torque_free, "_plot", broken)
+    with pytest.raises(RuntimeError, match="a bug"):
+        cli.main(["torque-free", *VALID, "--plot", str(tmp_path / "run.png")])
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_plot_without_matplotlib_says_how_to_install(capsys, tmp_path, monkeypatch):
+    monkeypatch.setitem(sys.modules, "matplotlib", None)  # makes `import matplotlib` fail
+    status, _, err = run_cli(capsys, *VALID, "--plot", str(tmp_path / "run.png"))
+    assert_one_clean_line(status, err, "pip install 'spinorbit[plot]'")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_subprocess_bad_input_has_no_traceback(tmp_path):
+    path = tmp_path / "out.ecsv"
+    result = subprocess.run([sys.executable, "-m", "spinorbit", "torque-free", "--moments", "1", "1", "3",
+                             "--omega", "1", "2", "3", "--output", str(path)],
+                            capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert_one_clean_line(result.returncode, result.stderr, "triangle inequality")
+    assert result.stdout == ""
+    assert not path.exists()
+
+
+# -- progress bar -----------------------------------------------------------------------------------
+
+
+class FakeTerminal(io.StringIO):
+    def __init__(self, tty):
+        super().__init__()
+        self.tty = tty
+
+    def isatty(self):
+        return self.tty
+
+
+@pytest.mark.parametrize("tty", [True, False])
+def test_progress_bar_only_on_a_terminal_and_only_when_slow(monkeypatch, tty):
+    clock = iter(np.arange(0.0, 100.0, 1.0))
+    monkeypatch.setattr(_common.time, "monotonic", lambda: next(clock))
+    stream = FakeTerminal(tty)
+    progress = _common.Progress(10, "propagating", stream=stream)  # started at t = 0 s
+    progress.advance(1)  # t = 1 s: too early to show anything
+    assert stream.getvalue() == ""
+    progress.advance(4)  # t = 2 s: slow enough
+    progress.close()
+    assert ("50%" in stream.getvalue() and stream.getvalue().endswith("\n")) is tty
+    assert (stream.getvalue() == "") is not tty
+
+
+def test_quick_run_draws_no_bar(capsys):
+    status, _, err = run_cli(capsys, *VALID, "--n-times", "1000")
+    assert status == 0 and err == ""
+
+
+def test_worktree_first_on_path():
+    # The subprocess tests run `python -m spinorbit` with cwd = this checkout; make sure that is the
+    # package under test here too.
+    assert Path(cli.__file__).resolve().is_relative_to(ROOT)
+    assert os.path.samefile(Path(torque_free.__file__).parents[2], ROOT)

@@ -8,6 +8,8 @@ Veltkamp's split, so the results are the same on every IEEE-754 machine.
 
 import math
 
+import numpy as np
+
 from ._jit import jit
 
 # Veltkamp split factor 2^27 + 1: splits a double into two 26-bit halves (Dekker's exact product).
@@ -90,7 +92,7 @@ def dd_remainder(xh, xl, ph, pl):
     x and the period p are double-doubles; j·p is formed exactly from two products, so r keeps an
     absolute error ≈ ε·|r| + |j|·|p|·1e-32: a phase carried this way does not drift with |x|.
     """
-    j = float(round(xh / ph))
+    j = np.rint(xh / ph)
     qh, ql = two_prod(j, ph)
     ql += j * pl
     rh, rl = dd_add(xh, xl, -qh, -ql)

@@ -86,6 +86,16 @@ def dd_sqrt(ah, al):
 
 
 @jit
+def dd_remainder_dd(xh, xl, ph, pl):
+    """(j, r_hi, r_lo) with j = rint(x / p) and r = x − j·p kept as a double-double."""
+    j = np.rint(xh / ph)
+    qh, ql = two_prod(j, ph)
+    ql += j * pl
+    rh, rl = dd_add(xh, xl, -qh, -ql)
+    return j, rh, rl
+
+
+@jit
 def dd_remainder(xh, xl, ph, pl):
     """(j, r) with j = rint(x / p) and r = x − j·p as a double (|r| ≤ p/2 plus rounding).
 

@@ -8,7 +8,7 @@ the elliptic argument (u in SAM, v in LAM) and the Andoyer angle g are, from eqs
     arg(t) = arg0 + ν t,
     g(t)   = g0 + c G t + κ · (pn(arg(t)) − pn(arg0)),
 
-with the argument rate ν = d(arg)/dt (ν = u/s · a S), c G the secular rate of g and κ = ``MO_PN_COEFF``:
+with the argument rate ν = d(arg)/dt (ν = u/s · a S), c G the secular rate of g and κ (``MO_PN_COEFF``):
 
     SAM  ν = √(((a−b) M_y² + (a−c) M_z²)(b−c)),   LAM  ν = √(((a−c) M_x² + (b−c) M_y²)(a−b)),
     κ = (a − c) G / ν  (both modes),
@@ -30,8 +30,9 @@ double inputs (A, B, C, M):
   double-double, so K and Π belong to the exact inputs and not to their rounded ratios;
 * arg(t) = j · 2K + r with j = rint(arg/2K) and |r| ≤ K, both from the double-double arg; pn advances
   by 2Π per half period, so g(t) = [g0 − κ pn(arg0) + c G t + 2κΠ j] + κ pn(r): the bracket is
-  a double-double reduced modulo 4π (half angles feed the quaternion) before the bounded κ pn(r)
-  is added in double.
+  a double-double; κ pn(r) joins it in double-double (with κ r formed exactly where pn(r) ≈ r: for
+  nearly symmetric bodies κ is huge), and the sum is reduced modulo 4π (half angles feed the
+  quaternion).
 
 The reduced r then goes to the double kernels (one sn/cn/dn, one Π of the principal range: the
 pn of r), whose errors are bounded and do not grow. Measured errors are in ``docs/torque_free.md``.
@@ -55,7 +56,6 @@ from .canonical import (
     MO_MODE,
     MO_PARAM,
     MO_PARAM_C,
-    MO_PN_COEFF,
     MO_SIN_L_W,
     MO_X_AMP,
     MO_Y_AMP,
@@ -78,6 +78,7 @@ from .ddouble import (
     dd_div,
     dd_mul,
     dd_remainder,
+    dd_remainder_dd,
     dd_sqrt,
     two_prod,
     two_sum,
@@ -88,11 +89,15 @@ from .elliptic import (
     MK_M,
     MK_MC,
     MK_SQRT_MUC,
+    METHOD_LARGE_NEGATIVE,
+    NK_METHOD,
     PI_HI,
     PI_LO,
     _pi_principal,
     _sncndn_reduced,
     ellipf_k,
+    parameter_constants,
+    pn_constants,
     pn_k,
     sncndn_k,
 )
@@ -134,8 +139,10 @@ AGM_MAX_STEPS = 200
     FL_M0_X,  # body momentum at t = 0 (constant in a uniform rotation)
     FL_M0_Y,
     FL_M0_Z,
-) = range(27)
-FLOW_SIZE = 27
+    FL_KAPPA_HI,  # κ = (a−c) G / ν, the coefficient of pn in g (rad per unit of pn)
+    FL_KAPPA_LO,
+) = range(29)
+FLOW_SIZE = 29
 
 
 # --------------------------------------------------------------------------------------------------
@@ -236,11 +243,14 @@ def phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c):
 
     Returns
     -------
-    tuple of 9 floats
-        (ν_hi, ν_lo, P_hi, P_lo, cG_hi, cG_lo, W_hi, W_lo, ok): the argument rate ν (rad of argument
-        per time unit), the half period P = 2K(p) of the argument, the secular rate c G of g
-        (rad per time unit) and the advance W = 2 κ Π(n|p) of g per half period (rad); ok = 0 when
-        the double-double complementary parameter is not positive (the separatrix), 1 otherwise.
+    tuple of 14 floats
+        (ν_hi, ν_lo, P_hi, P_lo, cG_hi, cG_lo, W_hi, W_lo, κ_hi, κ_lo, p, p_c, n, ok): the argument
+        rate ν (argument per time unit), the half period P = 2K(p) of the argument, the secular rate
+        c G of g (rad per time unit), the advance W = 2 κ Π(n|p) of g per half period (rad), the pn
+        coefficient κ (rad), and the parameter, complementary parameter and characteristic rounded
+        once from their double-double values (for the double kernels: near the separatrix p_c from
+        doubles would lose ε/p_c); ok = 0 when the double-double p_c is not positive (the
+        separatrix), 1 otherwise.
 
     Notes
     -----
@@ -267,23 +277,26 @@ def phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c):
         nu2h, nu2l = denh, denl
         ah_, al_ = dd_mul(ach, acl, rh, rl)
         fh, fl = dd_div(abh, abl, bch, bcl)
+        numh, numl = dd_mul(abh, abl, qh, ql)
     else:
         denh, denl = dd_mul(abh, abl, qh, ql)
         nu2h, nu2l = denh, denl
         ah_, al_ = dd_mul(-ach, -acl, rh, rl)
         fh, fl = dd_div(pah, pal, qh, ql)
+        numh, numl = dd_mul(pah, pal, bch, bcl)
     pch, pcl = dd_div(ah_, al_, denh, denl)
+    param = dd_div(numh, numl, denh, denl)[0]
     nuh, nul = dd_sqrt(nu2h, nu2l)
     ch, cl = dd_div(1.0, 0.0, big_c, 0.0)
     cgh, cgl = dd_mul(ch, cl, gh, gl)
+    # κ = (a−c) G / ν
+    kah, kal = dd_mul(ach, acl, gh, gl)
+    kah, kal = dd_div(kah, kal, nuh, nul)
     if not pch > 0.0:
-        return nuh, nul, math.inf, 0.0, cgh, cgl, 0.0, 0.0, 0.0
+        return nuh, nul, math.inf, 0.0, cgh, cgl, 0.0, 0.0, kah, kal, param, pch, -fh, 0.0
     kh, kl, pih, pil = complete_k_pi_dd(fh, fl, pch, pcl)
-    # κ · 2Π = 2 (a−c) G Π / ν
-    wh, wl = dd_mul(ach, acl, gh, gl)
-    wh, wl = dd_mul(wh, wl, 2.0 * pih, 2.0 * pil)
-    wh, wl = dd_div(wh, wl, nuh, nul)
-    return nuh, nul, 2.0 * kh, 2.0 * kl, cgh, cgl, wh, wl, 1.0
+    wh, wl = dd_mul(kah, kal, 2.0 * pih, 2.0 * pil)
+    return nuh, nul, 2.0 * kh, 2.0 * kl, cgh, cgl, wh, wl, kah, kal, param, pch, -fh, 1.0
 
 
 @jit
@@ -348,6 +361,17 @@ def flow_constants(quaternion, momentum, big_a, big_b, big_c):
         flow[FL_QN_Y], flow[FL_QN_Z] = quaternion[2], quaternion[3]
         return flow, mo, mk, pk
     mx, my, mz = fx * momentum[0], fy * momentum[1], fz * momentum[2]
+    (nuh, nul, perh, perl, cgh, cgl, wh, wl, kah, kal, param, param_c, char_n, ok) = (
+        phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c)
+    )
+    if ok > 0.0 and mk[MK_MC] > 0.0:
+        # kernel constants from the once-rounded double-double p, p_c, n (not from ratios of rounded
+        # differences: near the separatrix those lose ε/p_c in p_c)
+        mk = parameter_constants(param, param_c)
+        pk = pn_constants(char_n, param, param_c)
+        periodic = True
+    else:
+        periodic = False
     working = flip_attitude(quat_to_attitude(quaternion), flip)
     arg0 = ellipf_k(amplitude_from_momentum(mx, my, mz, mo, ic), mk)
     _, _, _, sin_l, cos_l = body_from_argument(arg0, mo, mk)
@@ -355,25 +379,23 @@ def flow_constants(quaternion, momentum, big_a, big_b, big_c):
     qn = matrix_to_quat(node_frame(cos_i, sin_i, h).T.copy())
     flow[FL_QN_W], flow[FL_QN_X], flow[FL_QN_Y], flow[FL_QN_Z] = qn[0], qn[1], qn[2], qn[3]
     flow[FL_ARG0] = arg0
-    nuh, nul, perh, perl, cgh, cgl, wh, wl, ok = phase_constants_dd(
-        mode, mx, my, mz, big_a, big_b, big_c
-    )
-    periodic = ok > 0.0 and mk[MK_MC] > 0.0
     flow[FL_PERIODIC] = 1.0 if periodic else 0.0
     flow[FL_RATE_HI], flow[FL_RATE_LO] = nuh, nul
     flow[FL_PERIOD_HI], flow[FL_PERIOD_LO] = perh, perl
     flow[FL_G_RATE_HI], flow[FL_G_RATE_LO] = cgh, cgl
     flow[FL_G_ADVANCE_HI], flow[FL_G_ADVANCE_LO] = wh, wl
-    # g0 − κ pn(arg0), with pn(arg0) = 2Π j0 + pn(r0) split the same way as at every later time
+    flow[FL_KAPPA_HI], flow[FL_KAPPA_LO] = kah, kal
+    # g0 − κ pn(arg0), with pn(arg0) = 2Π j0 + pn(r0) split as at every later time, so that the
+    # large parts cancel exactly at t = 0 (κ pn is huge for nearly symmetric bodies)
     if periodic:
-        j0, r0 = dd_remainder(arg0, 0.0, perh, perl)
-        s, c, d = _sncndn_reduced(r0, mk[MK_M], mk[MK_MC], mk[MK_SQRT_MUC], mk[MK_K_HI], mk[MK_K_LO])
-        pn0 = _pi_principal(s, c * c, d * d, r0, pk)
-        ch, cl = two_sum(g0, -mo[MO_PN_COEFF] * pn0)
+        j0, r0h, r0l = dd_remainder_dd(arg0, 0.0, perh, perl)
+        s, c, d = _sncndn_reduced(r0h, mk[MK_M], mk[MK_MC], mk[MK_SQRT_MUC], mk[MK_K_HI], mk[MK_K_LO])
+        ph, pl = _kappa_pn(kah, kal, r0h, r0l, s, c, d, pk)
         jwh, jwl = _dd_scale(wh, wl, j0)
-        ch, cl = dd_add(ch, cl, -jwh, -jwl)
+        ph, pl = dd_add(ph, pl, jwh, jwl)
     else:
-        ch, cl = two_sum(g0, -mo[MO_PN_COEFF] * pn_k(arg0, mk, pk))
+        ph, pl = dd_mul(kah, kal, pn_k(arg0, mk, pk), 0.0)
+    ch, cl = dd_add(g0, 0.0, -ph, -pl)
     flow[FL_G_CONST_HI], flow[FL_G_CONST_LO] = ch, cl
     return flow, mo, mk, pk
 
@@ -381,6 +403,21 @@ def flow_constants(quaternion, momentum, big_a, big_b, big_c):
 # --------------------------------------------------------------------------------------------------
 # Per-time evaluation
 # --------------------------------------------------------------------------------------------------
+
+
+@jit
+def _kappa_pn(kah, kal, rh, rl, s, c, d, pk):
+    """κ · pn(r) as a double-double for |r| ≤ K, from sn, cn, dn of r and r as a double-double.
+
+    Carlson form (|n| < 1): pn(r) = r + (n/3) s³ R_J (F(am r) = r), and κ r is formed in
+    double-double: for nearly symmetric bodies (A ≈ B) κ is large while pn(r) ≈ r, and κ · pn(r)
+    rounded as a whole would cost ε·κ·r rad. R_C form (n ≤ −1): pn(r) is far from r (≈ r/(1 − n)),
+    so splitting r off would cancel; κ · pn(r) is formed from the whole value.
+    """
+    if pk[NK_METHOD] == METHOD_LARGE_NEGATIVE:
+        return dd_mul(kah, kal, _pi_principal(s, c * c, d * d, rh, pk), 0.0)
+    xh, xl = dd_add(rh, rl, _pi_principal(s, c * c, d * d, 0.0, pk), 0.0)
+    return dd_mul(kah, kal, xh, xl)
 
 
 @jit
@@ -435,9 +472,10 @@ def evaluate_flow(t, flow, mo, mk, pk, q_out, m_out):
     gh, gl = _dd_scale(flow[FL_G_RATE_HI], flow[FL_G_RATE_LO], t)
     gh, gl = dd_add(gh, gl, flow[FL_G_CONST_HI], flow[FL_G_CONST_LO])
     if flow[FL_PERIODIC] > 0.0:
-        j, r = dd_remainder(ah, al, flow[FL_PERIOD_HI], flow[FL_PERIOD_LO])
-        s, c, d = _sncndn_reduced(r, mk[MK_M], mk[MK_MC], mk[MK_SQRT_MUC], mk[MK_K_HI], mk[MK_K_LO])
-        pn_r = _pi_principal(s, c * c, d * d, r, pk)
+        j, rh, rl = dd_remainder_dd(ah, al, flow[FL_PERIOD_HI], flow[FL_PERIOD_LO])
+        s, c, d = _sncndn_reduced(rh, mk[MK_M], mk[MK_MC], mk[MK_SQRT_MUC], mk[MK_K_HI], mk[MK_K_LO])
+        ph, pl = _kappa_pn(flow[FL_KAPPA_HI], flow[FL_KAPPA_LO], rh, rl, s, c, d, pk)
+        gh, gl = dd_add(gh, gl, ph, pl)
         if j != 0.0:
             wh, wl = _dd_scale(flow[FL_G_ADVANCE_HI], flow[FL_G_ADVANCE_LO], j)
             gh, gl = dd_add(gh, gl, wh, wl)
@@ -446,8 +484,9 @@ def evaluate_flow(t, flow, mo, mk, pk, q_out, m_out):
     else:  # separatrix (m = 1): no period; closed forms in the kernels
         r = ah + al
         s, c, d = sncndn_k(r, mk)
-        pn_r = pn_k(r, mk, pk)
-    half_g = _reduced_half(gh, gl) + 0.5 * mo[MO_PN_COEFF] * pn_r
+        ph, pl = dd_mul(flow[FL_KAPPA_HI], flow[FL_KAPPA_LO], pn_k(r, mk, pk), 0.0)
+        gh, gl = dd_add(gh, gl, ph, pl)
+    half_g = _reduced_half(gh, gl)
     if mo[MO_MODE] == MODE_SAM:
         first, third = c, d
     else:

@@ -54,7 +54,6 @@ from .canonical import (
     MO_COS_L_W,
     MO_G,
     MO_MODE,
-    MO_PARAM,
     MO_PARAM_C,
     MO_SIN_L_W,
     MO_X_AMP,
@@ -334,7 +333,6 @@ def flow_constants(quaternion, momentum, big_a, big_b, big_c):
     """
     ic = inertia_constants(big_a, big_b, big_c)
     mo, flip = motion_from_momentum(momentum[0], momentum[1], momentum[2], ic)
-    mk, pk = elliptic_constants(mo)
     flow = np.zeros(FLOW_SIZE)
     mode = int(mo[MO_MODE])
     flow[FL_MODE] = mode
@@ -359,18 +357,20 @@ def flow_constants(quaternion, momentum, big_a, big_b, big_c):
             flow[FL_AXIS_X], flow[FL_AXIS_Y], flow[FL_AXIS_Z] = oxh / rh, oyh / rh, ozh / rh
         flow[FL_QN_W], flow[FL_QN_X] = quaternion[0], quaternion[1]
         flow[FL_QN_Y], flow[FL_QN_Z] = quaternion[2], quaternion[3]
+        mk, pk = elliptic_constants(mo)  # unused by a uniform rotation; returned for one signature
         return flow, mo, mk, pk
     mx, my, mz = fx * momentum[0], fy * momentum[1], fz * momentum[2]
     (nuh, nul, perh, perl, cgh, cgl, wh, wl, kah, kal, param, param_c, char_n, ok) = (
         phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c)
     )
-    if ok > 0.0 and mk[MK_MC] > 0.0:
+    if ok > 0.0 and mo[MO_PARAM_C] > 0.0:
         # kernel constants from the once-rounded double-double p, p_c, n (not from ratios of rounded
         # differences: near the separatrix those lose ε/p_c in p_c)
         mk = parameter_constants(param, param_c)
         pk = pn_constants(char_n, param, param_c)
         periodic = True
-    else:
+    else:  # the separatrix: the kernels' closed forms, from the motion constants
+        mk, pk = elliptic_constants(mo)
         periodic = False
     working = flip_attitude(quat_to_attitude(quaternion), flip)
     arg0 = ellipf_k(amplitude_from_momentum(mx, my, mz, mo, ic), mk)

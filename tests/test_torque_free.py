@@ -256,3 +256,37 @@ def test_bad_shapes_name_the_parameter():
         torque_free_states_many(np.ones((2, 4)), np.ones((3, 3)), APOPHIS_MOMENTS, [0.0])
     with pytest.raises(ValueError, match="moments"):
         torque_free_states_many(np.ones((2, 4)), np.ones((2, 3)), (2.0, 1.0, 3.0), [0.0])
+
+
+# Permanent rotations about a principal axis: closed form q(t) = q0 ⊗ (cos(ωt/2), e sin(ωt/2)) in
+# 40 digits at a long time. Spin about A and C go through the elliptic path (p = 0), about B through
+# the uniform-rotation path; both must keep M exactly constant and not drift in phase.
+UNIFORM_LONG_TIME = 1.0e6  # time units (≈ 2e5 turns)
+UNIFORM_TOLERANCE = 2e-15  # rad; ε-level, no growth with t
+
+
+@pytest.mark.parametrize("axis", [0, 1, 2])
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_spin_about_a_principal_axis_is_a_uniform_rotation(axis, sign):
+    momentum = np.zeros(3)
+    momentum[axis] = sign * 0.73
+    times = np.array([0.3, 1e3 + 0.1, UNIFORM_LONG_TIME + 0.7])
+    q, m = torque_free_states(TILTED, momentum, *APOPHIS_MOMENTS, times)
+    np.testing.assert_array_equal(m[:, axis], momentum[axis])
+    assert np.abs(np.delete(m, axis, axis=1)).max() < 1e-300
+    with mp.workdps(40):
+        rate = mp.mpf(momentum[axis]) / mp.mpf(APOPHIS_MOMENTS[axis])
+        expected = []
+        for t in times:
+            half = rate * mp.mpf(float(t)) / 2
+            e = [mp.mpf(0)] * 3
+            e[axis] = mp.sin(half)
+            w0, x0, y0, z0 = (mp.mpf(float(v)) for v in TILTED)
+            c, (ex, ey, ez) = mp.cos(half), e
+            expected.append([float(v) for v in (
+                w0 * c - x0 * ex - y0 * ey - z0 * ez,
+                w0 * ex + x0 * c + y0 * ez - z0 * ey,
+                w0 * ey - x0 * ez + y0 * c + z0 * ex,
+                w0 * ez + x0 * ey - y0 * ex + z0 * c,
+            )])
+    assert rotation_angle(np.array(expected), q).max() < UNIFORM_TOLERANCE

@@ -42,6 +42,16 @@ import math
 import numpy as np
 
 from spinorbit.core._jit import jit
+from spinorbit.core.ddouble import (
+    dd_add as _dd_add,
+    dd_div as _dd_div,
+    dd_mul as _dd_mul,
+    dd_sqrt as _dd_sqrt,
+    quick_two_sum as _quick_two_sum,
+    split as _split,
+    two_prod as _two_prod,
+    two_sum as _two_sum,
+)
 
 # --------------------------------------------------------------------------------------------------
 # Constants
@@ -60,9 +70,8 @@ PI_HI = math.pi
 PI_LO = 1.2246467991473532e-16
 HALF_PI = 0.5 * math.pi
 
-# Veltkamp split factors: 2^27 + 1 splits into two 26-bit halves (Dekker's exact product);
-# 2^29 + 1 leaves a 24-bit head, so head*j stays exact for |j| < 2^29 (|u| / period up to 5e8).
-SPLIT_26 = 134217729.0
+# Veltkamp split factor (the 26-bit one lives in ``ddouble``): 2^29 + 1 leaves a 24-bit head, so
+# head*j stays exact for |j| < 2^29 (|u| / period up to 5e8).
 SPLIT_24 = 536870913.0
 
 # Maclaurin series of sn, cn, dn are used below this |u|; each is truncated where the first omitted
@@ -90,70 +99,9 @@ def _split_pi():
 PI_HEAD, PI_MID = _split_pi()
 
 # --------------------------------------------------------------------------------------------------
-# Error-free transformations and double-double arithmetic (Dekker 1971; Knuth TAOCP 4.2.2)
+# Error-free transformations and double-double arithmetic: one copy, in ``ddouble`` (shared with the
+# long-span torque-free flow); the private names are kept so the kernels below read unchanged.
 # --------------------------------------------------------------------------------------------------
-
-
-@jit
-def _two_sum(a, b):
-    """a + b = s + e exactly."""
-    s = a + b
-    bb = s - a
-    return s, (a - (s - bb)) + (b - bb)
-
-
-@jit
-def _quick_two_sum(a, b):
-    """a + b = s + e exactly, assuming |a| ≥ |b|."""
-    s = a + b
-    return s, b - (s - a)
-
-
-@jit
-def _split(a, factor):
-    """Veltkamp split: a = head + tail with head of (53 − log2(factor − 1)) significant bits."""
-    t = factor * a
-    head = t - (t - a)
-    return head, a - head
-
-
-@jit
-def _two_prod(a, b):
-    """a * b = p + e exactly (Dekker's product, no FMA needed)."""
-    p = a * b
-    ah, al = _split(a, SPLIT_26)
-    bh, bl = _split(b, SPLIT_26)
-    return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
-
-
-@jit
-def _dd_add(ah, al, bh, bl):
-    s, e = _two_sum(ah, bh)
-    return _quick_two_sum(s, e + (al + bl))
-
-
-@jit
-def _dd_mul(ah, al, bh, bl):
-    p, e = _two_prod(ah, bh)
-    return _quick_two_sum(p, e + (ah * bl + al * bh))
-
-
-@jit
-def _dd_div(ah, al, bh, bl):
-    q1 = ah / bh
-    ph, pl = _dd_mul(bh, bl, q1, 0.0)
-    rh, rl = _dd_add(ah, al, -ph, -pl)
-    return _quick_two_sum(q1, rh / bh)
-
-
-@jit
-def _dd_sqrt(ah, al):
-    h = math.sqrt(ah)
-    if h == 0.0:
-        return 0.0, 0.0
-    p, e = _two_prod(h, h)
-    return _quick_two_sum(h, (((ah - p) - e) + al) / (2.0 * h))
-
 
 # --------------------------------------------------------------------------------------------------
 # Carlson symmetric integrals (Carlson 1995, arXiv:math/9409227; DLMF 19.36.1–2)

@@ -11,15 +11,16 @@ r is the perturber's position in the body frame, r = R r_inertial with R = M(q)�
 (the numba integrator, scipy's ``solve_ivp`` through :func:`scipy_rhs`, the benchmark peers) calls
 :func:`rhs`; nothing else defines the dynamics.
 
-**The model** is one plain tuple of arrays (numba caches functions of tuples; jitclasses cannot be
-cached)::
+**The model** is ONE flat float64 array (jitclasses cannot be cached; a tuple of arrays costs two
+atomic reference-count updates per array at every numba call boundary, measured ~130 ns per RHS call
+with eight arrays, more than the whole torque-free RHS)::
 
-    model = (body, stokes_c, stokes_s, kinds, mus, params, sample_t, sample_xv)
+    model = concatenate([figure (FIGURE_SIZE floats, gravity_field.make_body),
+                         perturber block (perturbers.pack_perturbers, at offset MODEL_PERTURBERS)])
 
-``body, stokes_c, stokes_s`` from :func:`gravity_field.make_body`; the rest from
-:func:`perturbers.pack_perturbers`. Build it with :func:`make_model`. Any other integrator (the
-canonical-element equations, a splitting scheme) takes the same tuple and calls
-:func:`total_torque` / :func:`force_function`.
+Build it with :func:`make_model`. Any other integrator (the canonical-element equations, a splitting
+scheme) takes the same array and calls :func:`force_function_and_torque_xyz` (scalars, no allocation)
+or :func:`total_torque` / :func:`force_function`.
 
 Energy: with time-independent perturbers, E = T − U (T = ½ ωᵀ I ω) is conserved, because
 dT/dt = ω·N and dU/dt = (∂U/∂r)·(−ω × r) = ω·N (tested).
@@ -30,14 +31,13 @@ import math
 import numpy as np
 
 from ._jit import jit
-from .gravity_field import BODY_A, BODY_B, BODY_C, figure_force_function_and_gradient, make_body, torque_from_gradient
-from .perturbers import pack_perturbers, perturber_position
+from .gravity_field import BODY_A, BODY_B, BODY_C, FIGURE_SIZE, figure_force_function_and_gradient_xyz, make_body
+from .perturbers import PERTURBER_ROW, pack_perturbers, perturber_position_xyz
 
 STATE_SIZE = 7
 
-# Positions of the arrays inside the model tuple.
-MODEL_BODY, MODEL_STOKES_C, MODEL_STOKES_S = 0, 1, 2
-MODEL_KINDS, MODEL_MUS, MODEL_PARAMS, MODEL_SAMPLE_T, MODEL_SAMPLE_XV = 3, 4, 5, 6, 7
+#: Offset of the perturber block in the model array (the figure comes first).
+MODEL_PERTURBERS = FIGURE_SIZE
 
 
 def make_model(moments, sources=(), mass=0.0, reference_radius=1.0, stokes_c=None, stokes_s=None,
@@ -53,44 +53,68 @@ def make_model(moments, sources=(), mass=0.0, reference_radius=1.0, stokes_c=Non
 
     Returns
     -------
-    tuple
-        ``(body, stokes_c, stokes_s, kinds, mus, params, sample_t, sample_xv)``.
+    model : ndarray (float64, 1-d)
+        [figure, number of perturbers, perturber rows, samples] (see the module docstring).
     """
-    body, c, s = make_body(moments, mass, reference_radius, stokes_c, stokes_s, normalized)
-    return (body, c, s) + tuple(pack_perturbers(sources))
+    figure = make_body(moments, mass, reference_radius, stokes_c, stokes_s, normalized)
+    return np.ascontiguousarray(np.concatenate([figure, pack_perturbers(sources, base=MODEL_PERTURBERS)]))
+
+
+def perturber_count(model):
+    """Number of perturbers in a model array."""
+    return int(model[MODEL_PERTURBERS])
+
+
+@jit
+def body_frame_xyz(q0, q1, q2, q3, rx, ry, rz):
+    """r_body = M(q)ᵀ r_inertial for a quaternion of any non-zero norm (divides by |q|²), as 3 floats.
+
+    Dividing by |q|² makes the right-hand side well defined at the RK stages, where q is off the unit
+    sphere by the local error; the integrator renormalises after each step. The result depends on q
+    only through q/|q|.
+    """
+    w, x, y, z = q0, q1, q2, q3
+    inv = 1.0 / (w * w + x * x + y * y + z * z)
+    return (inv * ((w * w + x * x - y * y - z * z) * rx + 2.0 * (x * y + w * z) * ry + 2.0 * (x * z - w * y) * rz),
+            inv * (2.0 * (x * y - w * z) * rx + (w * w - x * x + y * y - z * z) * ry + 2.0 * (y * z + w * x) * rz),
+            inv * (2.0 * (x * z + w * y) * rx + 2.0 * (y * z - w * x) * ry + (w * w - x * x - y * y + z * z) * rz))
 
 
 @jit
 def body_frame_position(q, r_inertial):
-    """r_body = M(q)ᵀ r_inertial for a quaternion of any non-zero norm (divides by |q|²).
+    """Array form of :func:`body_frame_xyz`."""
+    x, y, z = body_frame_xyz(q[0], q[1], q[2], q[3], r_inertial[0], r_inertial[1], r_inertial[2])
+    return np.array([x, y, z])
 
-    Dividing by |q|² makes the right-hand side well defined at the RK stages, where q is off the unit
-    sphere by the local error; the integrator renormalises after each step.
+
+@jit(inline="always")  # RHS hot path: no array crosses a call boundary (see perturbers.py)
+def force_function_and_torque_xyz(t, q0, q1, q2, q3, model):
+    """(U, Nx, Ny, Nz) summed over all perturbers: the one torque definition, allocation-free.
+
+    U in energy units (force function, −potential energy); N = Σ (∂U/∂r) × r in the body frame.
     """
-    w, x, y, z = q[0], q[1], q[2], q[3]
-    inv = 1.0 / (w * w + x * x + y * y + z * z)
-    rx, ry, rz = r_inertial[0], r_inertial[1], r_inertial[2]
-    out = np.empty(3)
-    out[0] = inv * ((w * w + x * x - y * y - z * z) * rx + 2.0 * (x * y + w * z) * ry + 2.0 * (x * z - w * y) * rz)
-    out[1] = inv * (2.0 * (x * y - w * z) * rx + (w * w - x * x + y * y - z * z) * ry + 2.0 * (y * z + w * x) * rz)
-    out[2] = inv * (2.0 * (x * z + w * y) * rx + 2.0 * (y * z - w * x) * ry + (w * w - x * x - y * y + z * z) * rz)
-    return out
+    u = 0.0
+    nx = 0.0
+    ny = 0.0
+    nz = 0.0
+    for k in range(int(model[MODEL_PERTURBERS])):
+        row = MODEL_PERTURBERS + 1 + k * PERTURBER_ROW
+        ix, iy, iz = perturber_position_xyz(t, model, row)
+        x, y, z = body_frame_xyz(q0, q1, q2, q3, ix, iy, iz)
+        u_k, gx, gy, gz = figure_force_function_and_gradient_xyz(x, y, z, model[row + 1], model)
+        u += u_k
+        # N = (∂U/∂r) × r
+        nx += gy * z - gz * y
+        ny += gz * x - gx * z
+        nz += gx * y - gy * x
+    return u, nx, ny, nz
 
 
 @jit
 def total_force_function_and_torque(t, q, model):
-    """U (energy) and body-frame torque N (energy) summed over all perturbers at time t, attitude q."""
-    body, stokes_c, stokes_s = model[0], model[1], model[2]
-    kinds, mus, params, sample_t, sample_xv = model[3], model[4], model[5], model[6], model[7]
-    u = 0.0
-    torque = np.zeros(3)
-    for k in range(kinds.shape[0]):
-        r_inertial = perturber_position(t, k, kinds, params, sample_t, sample_xv)
-        r = body_frame_position(q, r_inertial)
-        u_k, grad = figure_force_function_and_gradient(r, mus[k], body, stokes_c, stokes_s)
-        u += u_k
-        torque += torque_from_gradient(r, grad)
-    return u, torque
+    """U (energy) and body-frame torque N (energy, (3,) array) of all perturbers at time t, attitude q."""
+    u, nx, ny, nz = force_function_and_torque_xyz(t, q[0], q[1], q[2], q[3], model)
+    return u, np.array([nx, ny, nz])
 
 
 @jit
@@ -102,26 +126,24 @@ def total_torque(t, q, model):
 @jit
 def force_function(t, q, model):
     """Force function U(t, q) of all perturbers (energy units; U = −potential energy)."""
-    return total_force_function_and_torque(t, q, model)[0]
+    return force_function_and_torque_xyz(t, q[0], q[1], q[2], q[3], model)[0]
 
 
-@jit
+@jit(inline="always")
 def rhs_into(t, y, model, dy):
-    """Write dy/dt into ``dy`` (no allocation of the result; the integrator's inner call)."""
-    body = model[0]
-    a_mom, b_mom, c_mom = body[BODY_A], body[BODY_B], body[BODY_C]
-    q = y[0:4]
+    """Write dy/dt into ``dy`` (no allocation; the integrators' inner call)."""
+    a_mom, b_mom, c_mom = model[BODY_A], model[BODY_B], model[BODY_C]
+    q0, q1, q2, q3 = y[0], y[1], y[2], y[3]
     wx, wy, wz = y[4], y[5], y[6]
-    if model[3].shape[0] > 0:
-        torque = total_torque(t, q, model)
-        nx, ny, nz = torque[0], torque[1], torque[2]
+    if model[MODEL_PERTURBERS] > 0.0:
+        _, nx, ny, nz = force_function_and_torque_xyz(t, q0, q1, q2, q3, model)
     else:
         nx = ny = nz = 0.0
     # q̇ = ½ q ⊗ (0, ω)
-    dy[0] = 0.5 * (-q[1] * wx - q[2] * wy - q[3] * wz)
-    dy[1] = 0.5 * (q[0] * wx + q[2] * wz - q[3] * wy)
-    dy[2] = 0.5 * (q[0] * wy - q[1] * wz + q[3] * wx)
-    dy[3] = 0.5 * (q[0] * wz + q[1] * wy - q[2] * wx)
+    dy[0] = 0.5 * (-q1 * wx - q2 * wy - q3 * wz)
+    dy[1] = 0.5 * (q0 * wx + q2 * wz - q3 * wy)
+    dy[2] = 0.5 * (q0 * wy - q1 * wz + q3 * wx)
+    dy[3] = 0.5 * (q0 * wz + q1 * wy - q2 * wx)
     # Euler: A ω̇x = (B − C) ωy ωz + Nx, cyclic.
     dy[4] = ((b_mom - c_mom) * wy * wz + nx) / a_mom
     dy[5] = ((c_mom - a_mom) * wz * wx + ny) / b_mom
@@ -139,8 +161,7 @@ def rhs(t, y, model):
 @jit
 def kinetic_energy(y, model):
     """T = ½ ωᵀ I ω (energy)."""
-    body = model[0]
-    return 0.5 * (body[BODY_A] * y[4] ** 2 + body[BODY_B] * y[5] ** 2 + body[BODY_C] * y[6] ** 2)
+    return 0.5 * (model[BODY_A] * y[4] ** 2 + model[BODY_B] * y[5] ** 2 + model[BODY_C] * y[6] ** 2)
 
 
 @jit
@@ -152,11 +173,9 @@ def total_energy(t, y, model):
 @jit
 def inertial_angular_momentum(y, model):
     """Angular momentum M(q) I ω in the inertial frame (mass·length²/time)."""
-    body = model[0]
-    q = y[0:4]
-    w, x, yy, z = q[0], q[1], q[2], q[3]
+    w, x, yy, z = y[0], y[1], y[2], y[3]
     inv = 1.0 / (w * w + x * x + yy * yy + z * z)
-    lx, ly, lz = body[BODY_A] * y[4], body[BODY_B] * y[5], body[BODY_C] * y[6]
+    lx, ly, lz = model[BODY_A] * y[4], model[BODY_B] * y[5], model[BODY_C] * y[6]
     out = np.empty(3)
     out[0] = inv * ((w * w + x * x - yy * yy - z * z) * lx + 2.0 * (x * yy - w * z) * ly + 2.0 * (x * z + w * yy) * lz)
     out[1] = inv * (2.0 * (x * yy + w * z) * lx + (w * w - x * x + yy * yy - z * z) * ly + 2.0 * (yy * z - w * x) * lz)

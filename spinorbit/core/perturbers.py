@@ -5,24 +5,21 @@
 quaternion q refers to). For a Sun–asteroid pair described by the asteroid's heliocentric elements,
 pass ``sign=-1`` to :func:`kepler_source` (the Sun is at minus the asteroid's heliocentric position).
 
-A set of perturbers is carried as plain arrays (numba cannot cache jitclasses)::
+A set of perturbers is carried as one flat float64 array block (numba cannot cache jitclasses, and a
+single array keeps reference counting off the hot path)::
 
-    kinds   int64 (k,)        KIND_KEPLER, KIND_SAMPLED or KIND_FIXED
-    mus     float (k,)        G M_p of each perturber (length³/time²)
-    params  float (k, PARAM_SIZE)   per-kind parameters, see the KIND_* constants
-    sample_t   float (N,)     sample times of all sampled sources, concatenated
-    sample_xv  float (N, 6)   positions and velocities at those times
+    [k, row_0, …, row_{k−1}, sample data…]     row = [kind, μ = G M_p, params (PARAM_SIZE)]
 
-Build them with :func:`kepler_source`, :func:`sampled_source`, :func:`sampled_source_from_callable`,
+Build it with :func:`kepler_source`, :func:`sampled_source`, :func:`sampled_source_from_callable`,
 :func:`fixed_source` and :func:`pack_perturbers`.
 
 Kinds:
 
-- ``KIND_KEPLER`` params = [μ_orbit, a, e, i, Ω, ω, M₀, t₀, sign]: a two-body orbit of the relative
+- ``KIND_KEPLER`` params = [μ_orbit, a, e, i, Ω, ω, M₀, t₀, sign, n, √|1−e²|, sign·P, sign·Q]: a two-body orbit of the relative
   position (a < 0 and e > 1 for a hyperbola, angles in radians, M₀ the mean anomaly at t₀). Kepler's
   equation is solved by Newton's method safeguarded by bisection on a bracket that always contains
   the root, so it converges for every e ≠ 1 (parabolas are rejected by the builder).
-- ``KIND_SAMPLED`` params = [first index, count]: piecewise cubic Hermite interpolation of positions
+- ``KIND_SAMPLED`` params = [index of the first time, count, index of the first x]: piecewise cubic Hermite interpolation of positions
   and velocities. The interpolation error on an interval of length h is at most
   h⁴/384 · max|x⁽⁴⁾| (position); for a Keplerian orbit sampled n_s times per orbit near a circular
   orbit of radius a this is about a (2π/n_s)⁴/384. Outside the sampled span the kernel returns NaN;
@@ -39,7 +36,12 @@ from ._jit import jit
 KIND_KEPLER = 0
 KIND_SAMPLED = 1
 KIND_FIXED = 2
-PARAM_SIZE = 9
+# Layout of a KIND_KEPLER parameter row (derived quantities precomputed by kepler_source).
+K_MU, K_A, K_E, K_INC, K_NODE, K_ARGP, K_M0, K_T0, K_SIGN, K_MEAN_MOTION, K_ROOT = range(11)
+K_P = 11  # sign·P (3 values): perifocal x unit vector in the inertial frame
+K_Q = 14  # sign·Q (3 values): perifocal y unit vector
+PARAM_SIZE = 17
+PERTURBER_ROW = 2 + PARAM_SIZE  # [kind, μ, params]
 
 #: Relative convergence threshold of the Kepler solver: a few ulps of the anomaly.
 KEPLER_TOLERANCE = 4.0 * np.finfo(float).eps
@@ -75,14 +77,22 @@ def _sinh_minus_x(x):
     return total
 
 
+#: Newton correction below which one more step is replaced by first-order trigonometric updates:
+#: Newton converges quadratically, so the remaining error is ~ this², far below one ulp.
+KEPLER_FINAL_STEP = 1e-9
+
+
 @jit
-def solve_kepler_elliptic(mean_anomaly, e):
-    """Eccentric anomaly E with E − e sin E = M, 0 ≤ e < 1 (radians).
+def solve_kepler_elliptic_sincos(mean_anomaly, e):
+    """(E, sin E, cos E) with E − e sin E = M, 0 ≤ e < 1 (radians).
 
     M is reduced to [−π, π]; the root lies in [M − e, M + e] (since |E − M| = e|sin E| ≤ e) and
     f(E) = E − e sin E − M is monotone, so Newton steps are kept inside a shrinking bracket and
     replaced by bisection when they leave it: convergence for every e < 1, including e → 1, M → 0.
-    The returned E is continuous with the unreduced M (the reduction's multiple of 2π is added back).
+    f is evaluated as (1 − e)E + e(E − sin E) with a series for E − sin E near 0 (no cancellation).
+    Once the Newton correction δ is below KEPLER_FINAL_STEP the last update is applied to E, sin E and
+    cos E to first order (error ~δ² ≤ 1e-18), which saves one iteration and a sin/cos pair per call.
+    E is continuous with the unreduced M (the reduction's multiple of 2π is added back).
     """
     two_pi = 2.0 * math.pi
     turns = math.floor((mean_anomaly + math.pi) / two_pi)
@@ -93,22 +103,38 @@ def solve_kepler_elliptic(mean_anomaly, e):
     x = m + 0.85 * e * (1.0 if math.sin(m) >= 0.0 else -1.0)
     if x <= lo or x >= hi:
         x = 0.5 * (lo + hi)
+    sx = math.sin(x)
+    cx = math.cos(x)
     for _ in range(KEPLER_MAX_ITERATIONS):
-        # E − e sin E = (1 − e)E + e(E − sin E): no cancellation near e → 1, E → 0.
-        f = (1.0 - e) * x + e * _x_minus_sin(x) - m
+        if abs(x) < 0.5:
+            f = (1.0 - e) * x + e * _x_minus_sin(x) - m
+        else:
+            f = x - e * sx - m
         if f > 0.0:
             hi = x
         else:
             lo = x
-        fp = (1.0 - e) + e * 2.0 * math.sin(0.5 * x) ** 2  # 1 − e cos E, accurately
-        x_new = x - f / fp if fp > 0.0 else 0.5 * (lo + hi)
+        fp = 1.0 - e * cx  # only steers Newton; its rounding does not limit the root
+        dx = f / fp if fp > 0.0 else np.inf
+        if abs(dx) <= KEPLER_FINAL_STEP * max(1.0, abs(x)) and lo <= x - dx <= hi:
+            x_new = x - dx
+            return x_new + turns * two_pi, sx - cx * dx, cx + sx * dx
+        x_new = x - dx
         if not (lo <= x_new <= hi):
             x_new = 0.5 * (lo + hi)
-        if abs(x_new - x) <= KEPLER_TOLERANCE * max(1.0, abs(x_new)):
+        if hi - lo <= KEPLER_TOLERANCE * max(1.0, abs(x_new)):
             x = x_new
             break
         x = x_new
-    return x + turns * two_pi
+        sx = math.sin(x)
+        cx = math.cos(x)
+    return x + turns * two_pi, math.sin(x), math.cos(x)
+
+
+@jit
+def solve_kepler_elliptic(mean_anomaly, e):
+    """Eccentric anomaly E with E − e sin E = M, 0 ≤ e < 1 (see :func:`solve_kepler_elliptic_sincos`)."""
+    return solve_kepler_elliptic_sincos(mean_anomaly, e)[0]
 
 
 @jit
@@ -132,7 +158,7 @@ def solve_kepler_hyperbolic(mean_anomaly, e):
             hi = x
         else:
             lo = x
-        fp = (e - 1.0) + e * 2.0 * math.sinh(0.5 * x) ** 2  # e cosh H − 1, accurately
+        fp = e * math.cosh(x) - 1.0  # only steers Newton; its rounding does not limit the root
         x_new = x - f / fp
         if not (lo <= x_new <= hi):
             x_new = 0.5 * (lo + hi)
@@ -144,49 +170,84 @@ def solve_kepler_hyperbolic(mean_anomaly, e):
 
 
 @jit
-def kepler_state(t, params):
-    """Position and velocity (inertial) of a KIND_KEPLER source at time t → (6,) array."""
-    mu, a, e = params[0], params[1], params[2]
-    inc, node, argp, m0, t0, sign = params[3], params[4], params[5], params[6], params[7], params[8]
+def _kepler_perifocal(t, a, e, m0, t0, n, root):
+    """Perifocal position (px, py) and velocity (vx, vy) on a Kepler orbit at time t (floats only)."""
     if e < 1.0:
-        n = math.sqrt(mu / (a * a * a))
-        big_e = solve_kepler_elliptic(m0 + n * (t - t0), e)
-        ce, se = math.cos(big_e), math.sin(big_e)
-        root = math.sqrt((1.0 - e) * (1.0 + e))
+        _, se, ce = solve_kepler_elliptic_sincos(m0 + n * (t - t0), e)
         rate = n / (1.0 - e * ce)  # dE/dt
-        px = a * (ce - e)
-        py = a * root * se
-        vx = -a * se * rate
-        vy = a * root * ce * rate
-    else:
-        abs_a = -a
-        n = math.sqrt(mu / (abs_a * abs_a * abs_a))
-        big_h = solve_kepler_hyperbolic(m0 + n * (t - t0), e)
-        ch, sh = math.cosh(big_h), math.sinh(big_h)
-        root = math.sqrt((e - 1.0) * (e + 1.0))
-        rate = n / (e * ch - 1.0)  # dH/dt
-        px = abs_a * (e - ch)
-        py = abs_a * root * sh
-        vx = -abs_a * sh * rate
-        vy = abs_a * root * ch * rate
-    # Perifocal → inertial: R3(−Ω) R1(−i) R3(−ω) (active rotations).
-    cw, sw = math.cos(argp), math.sin(argp)
-    cn, sn = math.cos(node), math.sin(node)
-    ci, si = math.cos(inc), math.sin(inc)
-    p1 = cn * cw - sn * sw * ci
-    p2 = sn * cw + cn * sw * ci
-    p3 = sw * si
-    q1 = -cn * sw - sn * cw * ci
-    q2 = -sn * sw + cn * cw * ci
-    q3 = cw * si
+        return a * (ce - e), a * root * se, -a * se * rate, a * root * ce * rate
+    abs_a = -a
+    big_h = solve_kepler_hyperbolic(m0 + n * (t - t0), e)
+    ch, sh = math.cosh(big_h), math.sinh(big_h)
+    rate = n / (e * ch - 1.0)  # dH/dt
+    return abs_a * (e - ch), abs_a * root * sh, -abs_a * sh * rate, abs_a * root * ch * rate
+
+
+# inline="always": functions on the RHS hot path that receive arrays are inlined at numba-IR level,
+# so no array crosses a call boundary (each crossing costs reference-count updates, which measured
+# ~120 ns per RHS call, 30× the arithmetic of a torque-free RHS).
+# inline="always": functions on the RHS hot path are inlined at numba-IR level so that the model array
+# does not cross a call boundary per evaluation (each crossing costs atomic reference-count updates).
+@jit(inline="always")
+def kepler_position_xyz(t, arr, off):
+    """Inertial position (x, y, z) of the KIND_KEPLER parameter row ``arr[off:off+PARAM_SIZE]``.
+
+    Three floats, no allocation. Position = sign (P px + Q py) with the perifocal unit vectors P, Q
+    precomputed by :func:`kepler_source` (the orientation angles cost no trigonometry per call).
+    """
+    px, py, _, _ = _kepler_perifocal(t, arr[off + K_A], arr[off + K_E], arr[off + K_M0], arr[off + K_T0],
+                                     arr[off + K_MEAN_MOTION], arr[off + K_ROOT])
+    return (arr[off + K_P] * px + arr[off + K_Q] * py,
+            arr[off + K_P + 1] * px + arr[off + K_Q + 1] * py,
+            arr[off + K_P + 2] * px + arr[off + K_Q + 2] * py)
+
+
+@jit
+def kepler_state(t, params):
+    """Position and velocity (inertial) of a KIND_KEPLER parameter row at t → (6,) array."""
+    px, py, vx, vy = _kepler_perifocal(t, params[K_A], params[K_E], params[K_M0], params[K_T0],
+                                       params[K_MEAN_MOTION], params[K_ROOT])
     out = np.empty(6)
-    out[0] = sign * (p1 * px + q1 * py)
-    out[1] = sign * (p2 * px + q2 * py)
-    out[2] = sign * (p3 * px + q3 * py)
-    out[3] = sign * (p1 * vx + q1 * vy)
-    out[4] = sign * (p2 * vx + q2 * vy)
-    out[5] = sign * (p3 * vx + q3 * vy)
+    for k in range(3):
+        out[k] = params[K_P + k] * px + params[K_Q + k] * py
+        out[3 + k] = params[K_P + k] * vx + params[K_Q + k] * vy
     return out
+
+
+@jit
+def _find_interval(t, arr, first, count):
+    """Index lo (absolute) with arr[lo] ≤ t ≤ arr[lo+1] inside the sorted block [first, first+count)."""
+    lo = first
+    hi = first + count - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if arr[mid] <= t:
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+@jit(inline="always")
+def hermite_position_xyz(t, arr, first, count, xv_first):
+    """Cubic Hermite position (x, y, z) from a flat array: sample times at arr[first:first+count],
+    positions and velocities (6 per sample, row-major) from arr[xv_first]. NaN outside the span."""
+    if not (arr[first] <= t <= arr[first + count - 1]):
+        return np.nan, np.nan, np.nan
+    lo = _find_interval(t, arr, first, count)
+    h = arr[lo + 1] - arr[lo]
+    s = (t - arr[lo]) / h
+    s2 = s * s
+    s3 = s2 * s
+    h00 = 2.0 * s3 - 3.0 * s2 + 1.0
+    h10 = (s3 - 2.0 * s2 + s) * h
+    h01 = -2.0 * s3 + 3.0 * s2
+    h11 = (s3 - s2) * h
+    i0 = xv_first + 6 * (lo - first)
+    i1 = i0 + 6
+    return (h00 * arr[i0] + h10 * arr[i0 + 3] + h01 * arr[i1] + h11 * arr[i1 + 3],
+            h00 * arr[i0 + 1] + h10 * arr[i0 + 4] + h01 * arr[i1 + 1] + h11 * arr[i1 + 4],
+            h00 * arr[i0 + 2] + h10 * arr[i0 + 5] + h01 * arr[i1 + 2] + h11 * arr[i1 + 5])
 
 
 @jit
@@ -230,28 +291,38 @@ def hermite_state(t, times, xv):
     return out
 
 
-@jit
-def perturber_state(t, index, kinds, params, sample_t, sample_xv):
-    """Position and velocity (6,) of perturber ``index`` relative to the body, inertial frame."""
-    kind = kinds[index]
-    p = params[index]
+@jit(inline="always")
+def perturber_position_xyz(t, arr, row):
+    """Position (x, y, z) relative to the body (inertial) of the perturber whose row starts at arr[row].
+
+    A row is [kind, μ, params…] (PERTURBER_ROW floats); no allocation: the RHS hot path.
+    """
+    kind = int(arr[row])
+    off = row + 2
     if kind == KIND_KEPLER:
-        return kepler_state(t, p)
+        return kepler_position_xyz(t, arr, off)
     if kind == KIND_SAMPLED:
-        first = int(p[0])
-        count = int(p[1])
-        return hermite_state(t, sample_t[first:first + count], sample_xv[first:first + count])
-    out = np.zeros(6)
-    out[0] = p[0]
-    out[1] = p[1]
-    out[2] = p[2]
-    return out
+        return hermite_position_xyz(t, arr, int(arr[off]), int(arr[off + 1]), int(arr[off + 2]))
+    return arr[off], arr[off + 1], arr[off + 2]
 
 
 @jit
-def perturber_position(t, index, kinds, params, sample_t, sample_xv):
-    """Position (3,) of perturber ``index`` relative to the body (inertial frame)."""
-    return perturber_state(t, index, kinds, params, sample_t, sample_xv)[:3]
+def perturber_state(t, arr, row):
+    """Position and velocity (6,) of the perturber whose row starts at arr[row] (tests, diagnostics)."""
+    kind = int(arr[row])
+    off = row + 2
+    if kind == KIND_KEPLER:
+        return kepler_state(t, arr[off:off + PARAM_SIZE])
+    if kind == KIND_SAMPLED:
+        first, count, xv_first = int(arr[off]), int(arr[off + 1]), int(arr[off + 2])
+        times = arr[first:first + count].copy()
+        xv = arr[xv_first:xv_first + 6 * count].copy().reshape((count, 6))
+        return hermite_state(t, times, xv)
+    out = np.zeros(6)
+    out[0] = arr[off]
+    out[1] = arr[off + 1]
+    out[2] = arr[off + 2]
+    return out
 
 
 # ---------------------------------------------------------------------------------------------
@@ -315,8 +386,15 @@ def kepler_source(mu, a, e, inc, node, argp, mean_anomaly, epoch=0.0, mu_orbit=N
         raise ValueError(f"a: expected a > 0 for e < 1 and a < 0 for e > 1, got a={a!r}, e={e!r}.")
     if sign not in (1.0, -1.0):
         raise ValueError(f"sign: expected +1 or −1, got {sign!r}.")
-    params = np.zeros(9)
-    params[:] = [mu_orbit, a, e, inc, node, argp, mean_anomaly, epoch, sign]
+    params = np.zeros(PARAM_SIZE)
+    params[:9] = [mu_orbit, a, e, inc, node, argp, mean_anomaly, epoch, sign]
+    params[K_MEAN_MOTION] = math.sqrt(mu_orbit / abs(a) ** 3)
+    params[K_ROOT] = math.sqrt(abs((1.0 - e) * (1.0 + e)))
+    # Perifocal → inertial: R3(−Ω) R1(−i) R3(−ω) (active rotations); columns P and Q.
+    cw, sw, cn, sn, ci, si = (math.cos(argp), math.sin(argp), math.cos(node), math.sin(node),
+                              math.cos(inc), math.sin(inc))
+    params[K_P:K_P + 3] = sign * np.array([cn * cw - sn * sw * ci, sn * cw + cn * sw * ci, sw * si])
+    params[K_Q:K_Q + 3] = sign * np.array([-cn * sw - sn * cw * ci, -sn * sw + cn * cw * ci, cw * si])
     return _Source(KIND_KEPLER, float(mu), params)
 
 
@@ -326,7 +404,7 @@ def fixed_source(mu, position):
     position = np.asarray(position, dtype=float)
     if position.shape != (3,) or not np.all(np.isfinite(position)) or not np.any(position):
         raise ValueError(f"position: expected a finite non-zero 3-vector, got {position!r}.")
-    params = np.zeros(9)
+    params = np.zeros(PARAM_SIZE)
     params[:3] = position
     return _Source(KIND_FIXED, float(mu), params)
 
@@ -355,7 +433,7 @@ def sampled_source(mu, times, positions, velocities):
         if arr.shape != (times.size, 3) or not np.all(np.isfinite(arr)):
             raise ValueError(f"{name}: expected finite values of shape ({times.size}, 3), got {arr.shape}.")
     xv = np.hstack([positions, velocities])
-    return _Source(KIND_SAMPLED, float(mu), np.zeros(9), times.copy(), xv)
+    return _Source(KIND_SAMPLED, float(mu), np.zeros(PARAM_SIZE), times.copy(), xv)
 
 
 #: Step of the central difference used when a callable gives no velocity, as a fraction of the
@@ -395,41 +473,44 @@ def sampled_source_from_callable(mu, position_function, times, velocity_function
     return sampled_source(mu, times, positions, velocities)
 
 
-def pack_perturbers(sources):
-    """Pack a list of sources into (kinds, mus, params, sample_t, sample_xv) for the kernels."""
+def pack_perturbers(sources, base=0):
+    """Pack sources into one flat float array, to be placed at offset ``base`` of a model array.
+
+    Layout: [k, row₀, …, row_{k−1}, samples…] with rows of PERTURBER_ROW = 2 + PARAM_SIZE floats
+    [kind, μ, params]. A sampled source's params hold absolute indices (counting from the start of
+    the model array) of its times and of its (count, 6) position/velocity block.
+    """
     sources = list(sources)
     k = len(sources)
-    kinds = np.zeros(k, dtype=np.int64)
-    mus = np.zeros(k)
-    params = np.zeros((k, PARAM_SIZE))
-    times, xvs = [], []
-    offset = 0
+    rows = np.zeros((k, PERTURBER_ROW))
+    tail = []
+    offset = base + 1 + k * PERTURBER_ROW
     for i, src in enumerate(sources):
         if not isinstance(src, _Source):
             raise ValueError(
                 f"sources[{i}]: expected a source from kepler_source / sampled_source / fixed_source, "
                 f"got {type(src).__name__}."
             )
-        kinds[i] = src.kind
-        mus[i] = src.mu
-        params[i] = src.params
+        rows[i, 0] = src.kind
+        rows[i, 1] = src.mu
+        rows[i, 2:] = src.params
         if src.kind == KIND_SAMPLED:
-            params[i, 0] = offset
-            params[i, 1] = src.times.size
-            times.append(src.times)
-            xvs.append(src.xv)
-            offset += src.times.size
-    sample_t = np.concatenate(times) if times else np.zeros(1)
-    sample_xv = np.vstack(xvs) if xvs else np.zeros((1, 6))
-    return kinds, mus, params, sample_t, sample_xv
+            count = src.times.size
+            rows[i, 2] = offset
+            rows[i, 3] = count
+            rows[i, 4] = offset + count
+            tail.extend([src.times, src.xv.ravel()])
+            offset += 7 * count
+    return np.concatenate([[float(k)], rows.ravel()] + tail)
 
 
-def sampled_span(kinds, params, sample_t):
-    """(start, end) of the time span on which every sampled source is defined (±inf if none)."""
+def sampled_span(arr, base=0):
+    """(start, end) of the time span on which every sampled source in the block at ``base`` is defined."""
     start, end = -np.inf, np.inf
-    for kind, p in zip(kinds, params):
-        if kind == KIND_SAMPLED:
-            first, count = int(p[0]), int(p[1])
-            start = max(start, sample_t[first])
-            end = min(end, sample_t[first + count - 1])
+    for i in range(int(arr[base])):
+        row = base + 1 + i * PERTURBER_ROW
+        if int(arr[row]) == KIND_SAMPLED:
+            first, count = int(arr[row + 2]), int(arr[row + 3])
+            start = max(start, arr[first])
+            end = min(end, arr[first + count - 1])
     return start, end

@@ -273,7 +273,7 @@ def test_rhs_torque_enters_euler_equations():
 
 @pytest.mark.parametrize(
     "moments, match",
-    [((0.0, 1.0, 2.0), "positive"), ((2.0, 1.0, 1.5), "A ≤ B ≤ C"), ((1.0, 1.0, 3.0), "C ≤ A \\+ B"),
+    [((0.0, 1.0, 2.0), "positive"), ((2.0, 1.0, 1.5), "A ≤ B ≤ C"),
      ((np.nan, 1.0, 1.0), "finite")],
 )
 def test_bad_moments_raise(moments, match):

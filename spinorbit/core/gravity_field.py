@@ -138,7 +138,7 @@ def make_body(moments, mass=0.0, reference_radius=1.0, stokes_c=None, stokes_s=N
     Raises
     ------
     ValueError
-        Non-positive or unordered moments, moments violating the triangle inequality, negative mass,
+        Non-positive or unordered moments, negative mass,
         non-positive radius, Stokes terms without a positive mass, or arrays of the wrong shape.
     """
     moments = np.asarray(moments, dtype=float)
@@ -155,9 +155,9 @@ def make_body(moments, mass=0.0, reference_radius=1.0, stokes_c=None, stokes_s=N
             f"moments: expected A ≤ B ≤ C on the body x, y, z axes, got {tuple(moments)}; "
             "map your body axes onto the principal-axis convention first (docs/conventions.md)."
         )
-    # Triangle inequality of a physical mass distribution; a small relative slack for rounding.
-    if c_mom > (a_mom + b_mom) * (1.0 + 1e-12):
-        raise ValueError(f"moments: expected C ≤ A + B for a real body, got {tuple(moments)}.")
+    # The triangle inequality C ≤ A + B of a real mass distribution is deliberately *not* enforced:
+    # standard test bodies violate it (Hairer–Lubich–Wanner's I = (2, 1, 2/3)) and the equations of
+    # motion do not need it.
     if not (np.isfinite(mass) and mass >= 0):
         raise ValueError(f"mass: expected a finite mass ≥ 0, got {mass!r}.")
     if not (np.isfinite(reference_radius) and reference_radius > 0):

@@ -75,27 +75,36 @@ STAT_ACCEPTED, STAT_REJECTED, STAT_RHS_CALLS, STAT_STATUS = 0, 1, 2, 3
 
 
 @jit
-def _rk_step(t, y, f0, h, model, k, y_new):
+def _rk_step(t, y, f0, h, model, k, y_new, tmp):
     """Stages 1..12 of DOP853 from (t, y) with f0 = f(t, y); 8th-order result into y_new.
 
-    k has 16 rows: row 0 = f0, rows 1..11 the stages, row 12 f(t+h, y_new) (FSAL).
+    k has 16 rows: row 0 = f0, rows 1..11 the stages, row 12 f(t+h, y_new) (FSAL). tmp is scratch.
+    The stage sums run over j outside, components inside (contiguous rows of k) and skip the
+    tableau's zeros (a third of the entries below the diagonal).
     """
     n = y.shape[0]
-    tmp = np.empty(n)
     for i in range(n):
         k[0, i] = f0[i]
     for s in range(1, N_STAGES):
         for i in range(n):
-            acc = 0.0
-            for j in range(s):
-                acc += _A[s, j] * k[j, i]
-            tmp[i] = y[i] + h * acc
+            tmp[i] = 0.0
+        for j in range(s):
+            a = _A[s, j] * h
+            if a != 0.0:
+                for i in range(n):
+                    tmp[i] += a * k[j, i]
+        for i in range(n):
+            tmp[i] += y[i]
         rhs_into(t + _C[s] * h, tmp, model, k[s])
     for i in range(n):
-        acc = 0.0
-        for j in range(N_STAGES):
-            acc += _B[j] * k[j, i]
-        y_new[i] = y[i] + h * acc
+        y_new[i] = 0.0
+    for j in range(N_STAGES):
+        b = _B[j] * h
+        if b != 0.0:
+            for i in range(n):
+                y_new[i] += b * k[j, i]
+    for i in range(n):
+        y_new[i] += y[i]
     rhs_into(t + h, y_new, model, k[N_STAGES])
 
 
@@ -240,6 +249,7 @@ def integrate_dop853_kernel(y0, t0, t_out, model, rtol, atol, max_steps, hit_out
     coeffs = np.zeros((7, n))
     y = y0.copy()
     y_new = np.empty(n)
+    scratch = np.empty(n)
     f = np.empty(n)
     f_new = np.empty(n)
     t_end = t_out[n_out - 1]
@@ -284,7 +294,7 @@ def integrate_dop853_kernel(y0, t0, t_out, model, rtol, atol, max_steps, hit_out
                 t_new = target
             h = t_new - t
             h_abs = abs(h)
-            _rk_step(t, y, f, h, model, k, y_new)
+            _rk_step(t, y, f, h, model, k, y_new, scratch)
             stats[STAT_RHS_CALLS] += N_STAGES
             steps += 1
             err = _error_norm(k, h, y, y_new, rtol, atol)
@@ -350,8 +360,9 @@ def integrate_fixed_step_kernel(y0, t0, t1, n_steps, model):
     h = (t1 - t0) / n_steps
     t = t0
     rhs_into(t, y, model, f)
+    scratch = np.empty(n)
     for step in range(n_steps):
-        _rk_step(t, y, f, h, model, k, y_new)
+        _rk_step(t, y, f, h, model, k, y_new, scratch)
         norm = _normalize_quaternion_part(y_new)
         for i in range(n):
             y[i] = y_new[i]

@@ -77,9 +77,10 @@ def _sinh_minus_x(x):
     return total
 
 
-#: Newton correction below which one more step is replaced by first-order trigonometric updates:
-#: Newton converges quadratically, so the remaining error is ~ this², far below one ulp.
-KEPLER_FINAL_STEP = 1e-9
+#: Halley correction below which the iteration stops and sin E, cos E are updated by their Taylor
+#: series to second order instead of being recomputed: Halley converges cubically, so the root's
+#: remaining error is ~ this³ = 1e-18, and the neglected third-order trig term is ~ this³/6.
+KEPLER_FINAL_STEP = 1e-6
 
 
 @jit
@@ -114,11 +115,13 @@ def solve_kepler_elliptic_sincos(mean_anomaly, e):
             hi = x
         else:
             lo = x
-        fp = 1.0 - e * cx  # only steers Newton; its rounding does not limit the root
-        dx = f / fp if fp > 0.0 else np.inf
+        fp = 1.0 - e * cx  # only steers the iteration; its rounding does not limit the root
+        fpp = e * sx
+        dx = f / (fp - 0.5 * f * fpp / fp) if fp > 0.0 else np.inf  # Halley
         if abs(dx) <= KEPLER_FINAL_STEP * max(1.0, abs(x)) and lo <= x - dx <= hi:
             x_new = x - dx
-            return x_new + turns * two_pi, sx - cx * dx, cx + sx * dx
+            half_dx2 = 0.5 * dx * dx
+            return x_new + turns * two_pi, sx - cx * dx - sx * half_dx2, cx + sx * dx - cx * half_dx2
         x_new = x - dx
         if not (lo <= x_new <= hi):
             x_new = 0.5 * (lo + hi)

@@ -222,5 +222,5 @@ METHODS = [
     Method("spinorbit DOP853, tabulated perturbers", prepare_spinorbit_tabulated,
            (1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14), "tab:cyan", "D"),
     Method("heyoka Taylor", prepare_heyoka, (1e-8, 1e-10, 1e-12, 1e-14, 1e-15), "tab:red", "s"),
-    Method("scipy DOP853 (Python RHS)", prepare_scipy, (1e-8, 1e-10, 1e-12), "tab:gray", "^"),
+    Method("scipy DOP853 (Python RHS)", prepare_scipy, (1e-8, 1e-10, 1e-12, 1e-13), "tab:gray", "^"),
 ]

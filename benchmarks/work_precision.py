@@ -41,6 +41,9 @@ from spinorbit.core.rotations import rotation_angle_between_many  # noqa: E402
 
 #: Accuracy at which methods are compared (rad).
 TARGET_ERROR = 1e-10
+#: Scene (c) (10⁴ rotations) cannot reach 1e-10 rad in double precision with any method here (the
+#: phase error of ~2e5 steps accumulates), so it is also compared at this looser accuracy (rad).
+TARGET_ERROR_LONG = 1e-6
 #: Repeat a timing until this much CPU time is spent (s) or MAX_REPEATS runs are done; keep the best.
 TIMING_BUDGET_S = 1.0
 MAX_REPEATS = 7
@@ -205,7 +208,7 @@ def main(argv=None):
                       label=method.name)
             for tol, err, cpu in pts:
                 ax.annotate(f"{tol:.0e}", (cpu, err), fontsize=6, textcoords="offset points", xytext=(3, 3))
-        ax.axhline(TARGET_ERROR, color="0.7", lw=0.8, ls="--")
+        ax.axhline(TARGET_ERROR_LONG if scene.name == "c" else TARGET_ERROR, color="0.7", lw=0.8, ls="--")
         ax.set_xlabel("CPU time per integration (s)")
         ax.set_ylabel("max attitude error (rad)")
         ax.set_title(f"({scene.name}) {scene.title}", fontsize=9)
@@ -237,15 +240,16 @@ def main(argv=None):
         comp = ", ".join(f"{k}: {np.median(v):.2f} s" for k, v in compile_times.items())
         md.append(f"One-off preparation per tolerance (median; excluded from CPU): {comp}.")
         md.append("")
+        target = TARGET_ERROR_LONG if scene.name == "c" else TARGET_ERROR
         at = {}
         for method in METHODS:
-            at[method.name] = cpu_at_error([(e, c) for _, e, c in results[method.name]])
+            at[method.name] = cpu_at_error([(e, c) for _, e, c in results[method.name]], target)
         by_name = {m.name: at[m.name] for m in METHODS}
         so = by_name["spinorbit DOP853 (numba)"]
         so_tab = by_name["spinorbit DOP853, tabulated perturbers"]
         hy_ = by_name["heyoka Taylor"]
         sp = by_name["scipy DOP853 (Python RHS)"]
-        line = f"CPU at {TARGET_ERROR:.0e} rad (log-log interpolation): " + "; ".join(
+        line = f"CPU at {target:.0e} rad (log-log interpolation): " + "; ".join(
             f"{name}: {'%.2f ms' % (v[0] * 1e3) if v[0] else v[1]}" for name, v in at.items())
         md.append(line + ".")
         ratios = []
@@ -258,7 +262,13 @@ def main(argv=None):
         if so_tab[0] and sp[0]:
             ratios.append(f"scipy DOP853 / spinorbit tabulated = {sp[0] / so_tab[0]:.0f}")
         md.append("")
-        md.append("**Ratios at 1e-10 rad:** " + ("; ".join(ratios) if ratios else "not measurable (see above)") + ".")
+        md.append(f"**Ratios at {target:.0e} rad:** " + ("; ".join(ratios) if ratios else "not measurable (see above)") + ".")
+        same_tol = [(tol, c_sp / c_so) for (tol, _, c_sp) in results["scipy DOP853 (Python RHS)"]
+                    for (tol2, _, c_so) in results["spinorbit DOP853 (numba)"] if tol == tol2]
+        if same_tol:
+            md.append("")
+            md.append("scipy DOP853 / spinorbit DOP853 at the same rtol (same method, same steps, same error): "
+                      + ", ".join(f"{r:.0f}× at {t:.0e}" for t, r in same_tol) + ".")
         md.append("")
         breakdown = cost_breakdown(scene)
         print("   " + breakdown, flush=True)

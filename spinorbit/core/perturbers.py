@@ -141,35 +141,56 @@ def solve_kepler_elliptic(mean_anomaly, e):
 
 
 @jit
-def solve_kepler_hyperbolic(mean_anomaly, e):
-    """Hyperbolic anomaly H with e sinh H − H = M, e > 1.
+def solve_kepler_hyperbolic_sinhcosh(mean_anomaly, e):
+    """(H, sinh H, cosh H) with e sinh H − H = M, e > 1.
 
-    For M > 0 the root lies in [asinh(M/e), asinh(M/(e − 1))] (from sinh H ≥ H ≥ 0); the function
-    is monotone, so safeguarded Newton as in :func:`solve_kepler_elliptic` converges for all e > 1.
+    For M > 0 the root lies in [asinh(M/e), asinh(M/(e − 1))] (from sinh H ≥ H ≥ 0); the function is
+    monotone, so Halley steps kept inside the shrinking bracket (bisection when they leave it) converge
+    for all e > 1. f = (e − 1)H + e(sinh H − H) with a series near 0 (no cancellation as e → 1). As in
+    the elliptic solver, the last small correction δ < KEPLER_FINAL_STEP updates sinh and cosh by their
+    second-order Taylor series instead of recomputing them.
     """
     m = abs(mean_anomaly)
     sgn = 1.0 if mean_anomaly >= 0.0 else -1.0
     if m == 0.0:
-        return 0.0
+        return 0.0, 0.0, 1.0
     lo = math.asinh(m / e)
     hi = math.asinh(m / (e - 1.0))
     x = lo
+    sh = math.sinh(x)
+    ch = math.cosh(x)
     for _ in range(KEPLER_MAX_ITERATIONS):
-        # e sinh H − H = (e − 1)H + e(sinh H − H): no cancellation near e → 1, H → 0.
-        f = (e - 1.0) * x + e * _sinh_minus_x(x) - m
+        if x < 0.5:
+            f = (e - 1.0) * x + e * _sinh_minus_x(x) - m
+        else:
+            f = e * sh - x - m
         if f > 0.0:
             hi = x
         else:
             lo = x
-        fp = e * math.cosh(x) - 1.0  # only steers Newton; its rounding does not limit the root
-        x_new = x - f / fp
+        fp = e * ch - 1.0  # only steers the iteration; its rounding does not limit the root
+        fpp = e * sh
+        dx = f / (fp - 0.5 * f * fpp / fp) if fp > 0.0 else np.inf  # Halley
+        if abs(dx) <= KEPLER_FINAL_STEP * max(1.0, abs(x)) and lo <= x - dx <= hi:
+            x_new = x - dx
+            half_dx2 = 0.5 * dx * dx
+            return sgn * x_new, sgn * (sh - ch * dx + sh * half_dx2), ch - sh * dx + ch * half_dx2
+        x_new = x - dx
         if not (lo <= x_new <= hi):
             x_new = 0.5 * (lo + hi)
-        if abs(x_new - x) <= KEPLER_TOLERANCE * max(1.0, abs(x_new)):
+        if hi - lo <= KEPLER_TOLERANCE * max(1.0, abs(x_new)):
             x = x_new
             break
         x = x_new
-    return sgn * x
+        sh = math.sinh(x)
+        ch = math.cosh(x)
+    return sgn * x, sgn * math.sinh(x), math.cosh(x)
+
+
+@jit
+def solve_kepler_hyperbolic(mean_anomaly, e):
+    """Hyperbolic anomaly H with e sinh H − H = M, e > 1 (see :func:`solve_kepler_hyperbolic_sinhcosh`)."""
+    return solve_kepler_hyperbolic_sinhcosh(mean_anomaly, e)[0]
 
 
 @jit
@@ -180,8 +201,7 @@ def _kepler_perifocal(t, a, e, m0, t0, n, root):
         rate = n / (1.0 - e * ce)  # dE/dt
         return a * (ce - e), a * root * se, -a * se * rate, a * root * ce * rate
     abs_a = -a
-    big_h = solve_kepler_hyperbolic(m0 + n * (t - t0), e)
-    ch, sh = math.cosh(big_h), math.sinh(big_h)
+    _, sh, ch = solve_kepler_hyperbolic_sinhcosh(m0 + n * (t - t0), e)
     rate = n / (e * ch - 1.0)  # dH/dt
     return abs_a * (e - ch), abs_a * root * sh, -abs_a * sh * rate, abs_a * root * ch * rate
 

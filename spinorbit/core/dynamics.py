@@ -42,7 +42,7 @@ MODEL_PERTURBERS = FIGURE_SIZE
 
 def make_model(moments, sources=(), mass=0.0, reference_radius=1.0, stokes_c=None, stokes_s=None,
                normalized=False):
-    """Build the model tuple from a body description and a list of perturber sources.
+    """Build the model array from a body description and a list of perturber sources.
 
     Parameters
     ----------

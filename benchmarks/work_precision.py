@@ -16,8 +16,8 @@ Also: convergence orders of the fixed-step mode (scenes (a) and (c) over a short
 against the extended-precision reference as the step is halved).
 
 Writes ``docs/img/work_precision_<scene>.png`` and the ``work_precision`` section of
-``docs/performance.md``. ``--quick`` runs shortened scenes and fewer tolerances (a smoke test, not the
-published numbers).
+``docs/performance.md``. ``--quick`` runs shortened scenes and fewer tolerances and only prints (a
+smoke test, not the published numbers).
 """
 
 from __future__ import annotations
@@ -157,6 +157,9 @@ def main(argv=None):
     parser.add_argument("--scenes", default="abc", help="which scenes to run, e.g. 'a' or 'ac'")
     parser.add_argument("--no-write", action="store_true", help="print only; do not touch docs/")
     args = parser.parse_args(argv)
+    if args.quick:
+        # A smoke run must never overwrite the published plots and tables.
+        args.no_write = True
 
     import matplotlib
 
@@ -296,10 +299,8 @@ def main(argv=None):
     md.append("")
     text = "\n".join(md)
     print(text)
-    if not args.no_write and not args.quick:
+    if not args.no_write:
         write_section("work_precision", text)
-    elif args.quick and not args.no_write:
-        write_section("work_precision_quick", "*(quick smoke run; not the published numbers)*\n\n" + text)
 
 
 if __name__ == "__main__":

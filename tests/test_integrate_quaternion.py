@@ -16,6 +16,7 @@ from spinorbit.core.dynamics import (
 )
 from spinorbit.core.integrate_quaternion import integrate_fixed_step, integrate_quaternion
 from spinorbit.core.perturbers import (
+    PERTURBER_ROW,
     kepler_source,
     kepler_state,
     perturber_position_xyz,
@@ -184,3 +185,17 @@ def test_matches_heyoka_on_a_short_torqued_run():
     errors = [rotation_angle_between(a[:4], b[:4]) for a, b in zip(ours, theirs)]
     assert max(errors) < 1e-10
     np.testing.assert_allclose(ours[:, 4:], theirs[:, 4:], atol=1e-10 * np.abs(scene.y0[4:]).max())
+
+
+def test_hot_path_positions_match_diagnostic_states_for_every_kind():
+    """perturber_position_xyz (scalars, inlined in the RHS) and perturber_state (arrays) agree."""
+    from spinorbit.core.perturbers import fixed_source
+
+    sources = [kepler_source(1.0, 2.0, 0.4, 0.1, 0.2, 0.3, 0.4), kepler_source(1.0, -0.3, 5.0, 0.5, 0.6, 0.7, -2.0),
+               fixed_source(2.0, [1.0, -2.0, 0.5])]
+    model = make_model(TRIAXIAL, sources)
+    for k in range(perturber_count(model)):
+        row = MODEL_PERTURBERS + 1 + k * PERTURBER_ROW
+        for t in (-3.0, 0.0, 0.7, 11.0):
+            np.testing.assert_allclose(perturber_position_xyz(t, model, row), perturber_state(t, model, row)[:3],
+                                       rtol=1e-15, atol=1e-15)

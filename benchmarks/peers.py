@@ -1,0 +1,226 @@
+"""Peer integrators on the same quaternion equations, for benchmarks and validation tests only.
+
+Not runtime dependencies of spinorbit. Every method is a :class:`Method`: ``prepare(scene, tol)``
+does the one-off work (heyoka's LLVM compilation, numba's first call) and returns a callable that
+integrates the scene once and returns the states at ``scene.t_out``. The benchmark times only that
+callable. Adding a method (e.g. the canonical-element equations or a splitting scheme) is adding one
+entry to :data:`METHODS`.
+
+- ``spinorbit-dop853``: :func:`spinorbit.core.integrate_quaternion.integrate_quaternion`.
+- ``spinorbit DOP853, tabulated perturbers``: the same integrator with each Keplerian perturber
+  replaced by cubic Hermite samples of its orbit, dense enough for 1e-15 relative position error
+  (:func:`tabulated_model`): how an ephemeris-driven run looks, and it takes the Kepler solve (80 % of
+  the cost in scene (a)) out of the loop. Tabulation time counts as preparation.
+- ``scipy-DOP853``: ``scipy.integrate.solve_ivp(method="DOP853")`` with the Python RHS
+  :func:`spinorbit.core.dynamics.scipy_rhs` (which calls the same compiled RHS).
+- ``heyoka``: heyoka's Taylor integrator on the same equations, rebuilt as heyoka expressions:
+  degree-2 (MacCullagh) torque N = 3μ/R⁵ r × (I r) of point masses; an elliptic perturber's position
+  from ``hy.kepE`` of the time; a hyperbolic one (no hyperbolic Kepler solver in heyoka) from the
+  two-body ODE of its relative position appended to the system. q is not renormalised (heyoka has no
+  step hook for it); the body-frame position divides by |q|² as spinorbit's RHS does.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from spinorbit.core.dynamics import scipy_rhs
+from spinorbit.core.integrate_quaternion import default_atol, integrate_quaternion
+from spinorbit.core.perturbers import kepler_state
+
+
+@dataclass
+class Method:
+    name: str
+    prepare: Callable  # (scene, tol) -> (run: () -> ys (n, 7), info: dict)
+    tolerances: tuple
+    color: str = "k"
+    marker: str = "o"
+
+
+# --------------------------------------------------------------------------- spinorbit
+
+def prepare_spinorbit(scene, tol, hit_output_times=False):
+    atol = default_atol(np.asarray(scene.y0, float), tol)
+
+    def run():
+        return integrate_quaternion(scene.y0, scene.t0, scene.t_out, scene.model, rtol=tol, atol=atol,
+                                    hit_output_times=hit_output_times)
+
+    t = time.perf_counter()
+    _, stats = integrate_quaternion(scene.y0, scene.t0, scene.t_out[:1], scene.model, rtol=tol, atol=atol,
+                                    return_stats=True)  # numba compile / cache load, excluded
+    info = {"prepare_s": time.perf_counter() - t}
+    return run, info
+
+
+#: Relative position error allowed when a Kepler perturber is tabulated for Hermite interpolation:
+#: at 1e-15 the torque changes by ~1e-15 relative, far below every accuracy in the benchmark.
+TABULATION_RTOL = 1e-15
+
+
+def tabulated_model(scene, rtol=TABULATION_RTOL):
+    """The scene's model with every Kepler perturber replaced by cubic Hermite samples of its orbit.
+
+    Spacing from the Hermite bound |δx| ≤ h⁴/384 · max|x⁗| with |x⁗| ≤ r ω_max⁴ (ω_max the largest
+    angular rate on the orbit, at pericentre; the bound is rough, so a factor 2 of margin is kept):
+    h = 0.5 (384 rtol)^(1/4) / ω_max.
+    """
+    from spinorbit.core.dynamics import make_model
+    from spinorbit.core.perturbers import sampled_source
+
+    t_lo = min(scene.t0, float(np.min(scene.t_out)))
+    t_hi = max(scene.t0, float(np.max(scene.t_out)))
+    sources = []
+    for p in scene.perturbers:
+        src = p.source()
+        mu_o = p.mu_orbit or p.mu
+        q_peri = abs(p.a) * abs(1 - p.e)
+        v_peri = np.sqrt(mu_o * (2 / q_peri - 1 / p.a))
+        omega_max = v_peri / q_peri
+        h = 0.5 * (384 * rtol) ** 0.25 / omega_max
+        n = int(np.ceil((t_hi - t_lo) / h)) + 1
+        times = np.linspace(t_lo, t_hi, max(n, 2))
+        states = np.array([kepler_state(t, src.params) for t in times])
+        sources.append(sampled_source(p.mu, times, states[:, :3], states[:, 3:]))
+    return make_model(scene.moments, sources)
+
+
+def prepare_spinorbit_tabulated(scene, tol):
+    import dataclasses
+
+    t = time.perf_counter()
+    model = tabulated_model(scene)
+    tab = dataclasses.replace(scene)
+    tab.model = model
+    run, info = prepare_spinorbit(tab, tol)
+    info["prepare_s"] = time.perf_counter() - t
+    return run, info
+
+
+# --------------------------------------------------------------------------- scipy
+
+def prepare_scipy(scene, tol):
+    fun = scipy_rhs(scene.model)
+    atol = default_atol(np.asarray(scene.y0, float), tol)
+    fun(scene.t0, scene.y0)  # compile
+
+    def run():
+        sol = solve_ivp(fun, (scene.t0, scene.t_out[-1]), scene.y0, method="DOP853", rtol=tol, atol=atol,
+                        t_eval=scene.t_out)
+        if not sol.success:
+            raise RuntimeError(sol.message)
+        y = sol.y.T.copy()
+        y[:, :4] /= np.linalg.norm(y[:, :4], axis=1)[:, None]
+        return y
+
+    return run, {"prepare_s": 0.0}
+
+
+# --------------------------------------------------------------------------- heyoka
+
+def heyoka_system(scene, fp_type=float):
+    """heyoka (lhs, rhs) pairs and the initial state for the scene's quaternion equations."""
+    import heyoka as hy
+
+    q0, q1, q2, q3, wx, wy, wz = hy.make_vars("q0", "q1", "q2", "q3", "wx", "wy", "wz")
+    A, B, C = (float(m) for m in scene.moments)
+    nx = ny = nz = hy.expression(0.0)
+    extra_eqs = []
+    extra_state = []
+    inv = 1.0 / (q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
+    for k, p in enumerate(scene.perturbers):
+        params = p.source().params
+        if p.e < 1.0:
+            n = float(np.sqrt((p.mu_orbit or p.mu) / p.a**3))
+            E = hy.kepE(p.e, p.mean_anomaly + n * (hy.time - p.epoch))
+            px = p.a * (hy.cos(E) - p.e)
+            py = p.a * float(np.sqrt(1 - p.e**2)) * hy.sin(E)
+            P, Q = params[11:14], params[14:17]
+            rx, ry, rz = (float(P[i]) * px + float(Q[i]) * py for i in range(3))
+        else:
+            # Two-body ODE of the relative position, started from the exact Kepler state at t0.
+            x, y, z, vx, vy, vz = hy.make_vars(*(f"{s}{k}" for s in ("x", "y", "z", "vx", "vy", "vz")))
+            mu_o = p.mu_orbit or p.mu
+            r3 = (x * x + y * y + z * z) ** 1.5
+            extra_eqs += [(x, vx), (y, vy), (z, vz), (vx, -mu_o * x / r3), (vy, -mu_o * y / r3), (vz, -mu_o * z / r3)]
+            extra_state += list(kepler_state(scene.t0, params))
+            rx, ry, rz = x, y, z
+        # r_body = M(q)ᵀ r / |q|²
+        bx = inv * ((q0 * q0 + q1 * q1 - q2 * q2 - q3 * q3) * rx + 2 * (q1 * q2 + q0 * q3) * ry + 2 * (q1 * q3 - q0 * q2) * rz)
+        by = inv * (2 * (q1 * q2 - q0 * q3) * rx + (q0 * q0 - q1 * q1 + q2 * q2 - q3 * q3) * ry + 2 * (q2 * q3 + q0 * q1) * rz)
+        bz = inv * (2 * (q1 * q3 + q0 * q2) * rx + 2 * (q2 * q3 - q0 * q1) * ry + (q0 * q0 - q1 * q1 - q2 * q2 + q3 * q3) * rz)
+        rr = bx * bx + by * by + bz * bz
+        kfac = 3.0 * p.mu * rr ** (-2.5)
+        nx = nx + kfac * (by * (C * bz) - bz * (B * by))
+        ny = ny + kfac * (bz * (A * bx) - bx * (C * bz))
+        nz = nz + kfac * (bx * (B * by) - by * (A * bx))
+    eqs = [
+        (q0, 0.5 * (-q1 * wx - q2 * wy - q3 * wz)),
+        (q1, 0.5 * (q0 * wx + q2 * wz - q3 * wy)),
+        (q2, 0.5 * (q0 * wy - q1 * wz + q3 * wx)),
+        (q3, 0.5 * (q0 * wz + q1 * wy - q2 * wx)),
+        (wx, ((B - C) * wy * wz + nx) / A),
+        (wy, ((C - A) * wz * wx + ny) / B),
+        (wz, ((A - B) * wx * wy + nz) / C),
+    ] + extra_eqs
+    state = list(np.asarray(scene.y0, float)) + extra_state
+    return eqs, np.array(state, dtype=fp_type)
+
+
+def make_heyoka_integrator(scene, tol, fp_type=float, compact_mode=False):
+    import heyoka as hy
+
+    eqs, state = heyoka_system(scene, fp_type)
+    kwargs = dict(tol=fp_type(tol), compact_mode=compact_mode, time=fp_type(scene.t0))
+    if fp_type is not float:
+        kwargs["fp_type"] = fp_type
+    return hy.taylor_adaptive(eqs, state, **kwargs), state
+
+
+def prepare_heyoka(scene, tol):
+    t = time.perf_counter()
+    ta, state = make_heyoka_integrator(scene, tol)
+    compile_s = time.perf_counter() - t
+    # heyoka's grid must start at the current time: prepend t0 and drop that row.
+    grid = np.concatenate([[scene.t0], np.asarray(scene.t_out, float)])
+
+    def run():
+        ta.state[:] = state
+        ta.time = scene.t0
+        out = ta.propagate_grid(grid)
+        res = out[-1][1:, :7].copy()
+        res[:, :4] /= np.linalg.norm(res[:, :4], axis=1)[:, None]
+        return res
+
+    return run, {"prepare_s": compile_s}
+
+
+def reference_solution(scene):
+    """heyoka in extended precision (x86 80-bit long double, ε ≈ 1.1e-19) at tol = ε: the reference.
+
+    Returns states (n, 7) as float64 and the wall-clock seconds it took.
+    """
+    t = time.perf_counter()
+    ta, _ = make_heyoka_integrator(scene, float(np.finfo(np.longdouble).eps), fp_type=np.longdouble,
+                                   compact_mode=True)
+    grid = np.concatenate([[scene.t0], np.asarray(scene.t_out, float)]).astype(np.longdouble)
+    out = ta.propagate_grid(grid)
+    res = np.asarray(out[-1][1:, :7], dtype=np.longdouble)
+    res[:, :4] /= np.sqrt((res[:, :4] ** 2).sum(axis=1))[:, None]
+    return res.astype(float), time.perf_counter() - t
+
+
+METHODS = [
+    Method("spinorbit DOP853 (numba)", prepare_spinorbit, (1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14),
+           "tab:blue", "o"),
+    Method("spinorbit DOP853, tabulated perturbers", prepare_spinorbit_tabulated,
+           (1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14), "tab:cyan", "D"),
+    Method("heyoka Taylor", prepare_heyoka, (1e-8, 1e-10, 1e-12, 1e-14, 1e-15), "tab:red", "s"),
+    Method("scipy DOP853 (Python RHS)", prepare_scipy, (1e-8, 1e-10, 1e-12, 1e-13), "tab:gray", "^"),
+]

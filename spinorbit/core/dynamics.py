@@ -1,0 +1,222 @@
+"""THE equations of motion of a perturbed rigid body in Euler parameters + body angular velocity.
+
+State y = (q0, q1, q2, q3, ωx, ωy, ωz): q the scalar-first unit quaternion (body → inertial,
+``docs/conventions.md``), ω the body-frame angular velocity (rad/time) on the principal axes with
+moments A ≤ B ≤ C::
+
+    q̇ = ½ q ⊗ (0, ω)
+    I ω̇ = Iω × ω + N,   N = Σ_perturbers (∂U/∂r) × r     (gravity_field.py for U and the sign)
+
+r is the perturber's position in the body frame, r = R r_inertial with R = M(q)ᵀ. Every back end
+(the numba integrator, scipy's ``solve_ivp`` through :func:`scipy_rhs`, the benchmark peers) calls
+:func:`rhs`; nothing else defines the dynamics.
+
+**The model** is ONE flat float64 array (jitclasses cannot be cached; a tuple of arrays costs two
+atomic reference-count updates per array at every numba call boundary, measured ~130 ns per RHS call
+with eight arrays, more than the whole torque-free RHS)::
+
+    model = concatenate([figure (FIGURE_SIZE floats, gravity_field.make_body),
+                         perturber block (perturbers.pack_perturbers, at offset MODEL_PERTURBERS)])
+
+Build it with :func:`make_model`. Any other integrator (the canonical-element equations, a splitting
+scheme) takes the same array and calls :func:`force_function_and_torque_xyz` (scalars, no allocation)
+or :func:`total_torque` / :func:`force_function`.
+
+Energy: with time-independent perturbers, E = T − U (T = ½ ωᵀ I ω) is conserved, because
+dT/dt = ω·N and dU/dt = (∂U/∂r)·(−ω × r) = ω·N (tested).
+"""
+
+import math
+
+import numpy as np
+
+from ._jit import jit
+from .gravity_field import BODY_A, BODY_B, BODY_C, FIGURE_SIZE, figure_force_function_and_gradient_xyz, make_body
+from .perturbers import PERTURBER_ROW, pack_perturbers, perturber_position_xyz
+
+STATE_SIZE = 7
+
+#: Offset of the perturber block in the model array (the figure comes first).
+MODEL_PERTURBERS = FIGURE_SIZE
+
+
+def make_model(moments, sources=(), mass=0.0, reference_radius=1.0, stokes_c=None, stokes_s=None,
+               normalized=False):
+    """Build the model array from a body description and a list of perturber sources.
+
+    Parameters
+    ----------
+    moments, mass, reference_radius, stokes_c, stokes_s, normalized
+        As in :func:`spinorbit.core.gravity_field.make_body`.
+    sources : sequence
+        Perturber sources from :mod:`spinorbit.core.perturbers` (may be empty: torque-free).
+
+    Returns
+    -------
+    model : ndarray (float64, 1-d)
+        [figure, number of perturbers, perturber rows, samples] (see the module docstring).
+    """
+    figure = make_body(moments, mass, reference_radius, stokes_c, stokes_s, normalized)
+    return np.ascontiguousarray(np.concatenate([figure, pack_perturbers(sources, base=MODEL_PERTURBERS)]))
+
+
+def perturber_count(model):
+    """Number of perturbers in a model array."""
+    return int(model[MODEL_PERTURBERS])
+
+
+@jit
+def body_frame_xyz(q0, q1, q2, q3, rx, ry, rz):
+    """r_body = M(q)ᵀ r_inertial for a quaternion of any non-zero norm (divides by |q|²), as 3 floats.
+
+    Dividing by |q|² makes the right-hand side well defined at the RK stages, where q is off the unit
+    sphere by the local error; the integrator renormalises after each step. The result depends on q
+    only through q/|q|.
+    """
+    w, x, y, z = q0, q1, q2, q3
+    inv = 1.0 / (w * w + x * x + y * y + z * z)
+    return (inv * ((w * w + x * x - y * y - z * z) * rx + 2.0 * (x * y + w * z) * ry + 2.0 * (x * z - w * y) * rz),
+            inv * (2.0 * (x * y - w * z) * rx + (w * w - x * x + y * y - z * z) * ry + 2.0 * (y * z + w * x) * rz),
+            inv * (2.0 * (x * z + w * y) * rx + 2.0 * (y * z - w * x) * ry + (w * w - x * x - y * y + z * z) * rz))
+
+
+@jit
+def body_frame_position(q, r_inertial):
+    """Array form of :func:`body_frame_xyz`."""
+    x, y, z = body_frame_xyz(q[0], q[1], q[2], q[3], r_inertial[0], r_inertial[1], r_inertial[2])
+    return np.array([x, y, z])
+
+
+@jit(inline="always")  # RHS hot path: no array crosses a call boundary (see perturbers.py)
+def force_function_and_torque_xyz(t, q0, q1, q2, q3, model):
+    """(U, Nx, Ny, Nz) summed over all perturbers: the one torque definition, allocation-free.
+
+    U in energy units (force function, −potential energy); N = Σ (∂U/∂r) × r in the body frame.
+    """
+    u = 0.0
+    nx = 0.0
+    ny = 0.0
+    nz = 0.0
+    for k in range(int(model[MODEL_PERTURBERS])):
+        row = MODEL_PERTURBERS + 1 + k * PERTURBER_ROW
+        ix, iy, iz = perturber_position_xyz(t, model, row)
+        x, y, z = body_frame_xyz(q0, q1, q2, q3, ix, iy, iz)
+        u_k, gx, gy, gz = figure_force_function_and_gradient_xyz(x, y, z, model[row + 1], model)
+        u += u_k
+        # N = (∂U/∂r) × r
+        nx += gy * z - gz * y
+        ny += gz * x - gx * z
+        nz += gx * y - gy * x
+    return u, nx, ny, nz
+
+
+@jit
+def total_force_function_and_torque(t, q, model):
+    """U (energy) and body-frame torque N (energy, (3,) array) of all perturbers at time t, attitude q."""
+    u, nx, ny, nz = force_function_and_torque_xyz(t, q[0], q[1], q[2], q[3], model)
+    return u, np.array([nx, ny, nz])
+
+
+@jit
+def total_torque(t, q, model):
+    """Body-frame torque N(t, q) of all perturbers (energy units)."""
+    return total_force_function_and_torque(t, q, model)[1]
+
+
+@jit
+def force_function(t, q, model):
+    """Force function U(t, q) of all perturbers (energy units; U = −potential energy)."""
+    return force_function_and_torque_xyz(t, q[0], q[1], q[2], q[3], model)[0]
+
+
+@jit(inline="always")
+def rhs_into(t, y, model, dy):
+    """Write dy/dt into ``dy`` (no allocation; the integrators' inner call)."""
+    a_mom, b_mom, c_mom = model[BODY_A], model[BODY_B], model[BODY_C]
+    q0, q1, q2, q3 = y[0], y[1], y[2], y[3]
+    wx, wy, wz = y[4], y[5], y[6]
+    if model[MODEL_PERTURBERS] > 0.0:
+        _, nx, ny, nz = force_function_and_torque_xyz(t, q0, q1, q2, q3, model)
+    else:
+        nx = ny = nz = 0.0
+    # q̇ = ½ q ⊗ (0, ω)
+    dy[0] = 0.5 * (-q1 * wx - q2 * wy - q3 * wz)
+    dy[1] = 0.5 * (q0 * wx + q2 * wz - q3 * wy)
+    dy[2] = 0.5 * (q0 * wy - q1 * wz + q3 * wx)
+    dy[3] = 0.5 * (q0 * wz + q1 * wy - q2 * wx)
+    # Euler: A ω̇x = (B − C) ωy ωz + Nx, cyclic.
+    dy[4] = ((b_mom - c_mom) * wy * wz + nx) / a_mom
+    dy[5] = ((c_mom - a_mom) * wz * wx + ny) / b_mom
+    dy[6] = ((a_mom - b_mom) * wx * wy + nz) / c_mom
+
+
+@jit
+def rhs(t, y, model):
+    """dy/dt of the state y = (q, ω) at time t: the one definition of the dynamics."""
+    dy = np.empty(STATE_SIZE)
+    rhs_into(t, y, model, dy)
+    return dy
+
+
+@jit
+def kinetic_energy(y, model):
+    """T = ½ ωᵀ I ω (energy)."""
+    return 0.5 * (model[BODY_A] * y[4] ** 2 + model[BODY_B] * y[5] ** 2 + model[BODY_C] * y[6] ** 2)
+
+
+@jit
+def total_energy(t, y, model):
+    """E = T − U (energy), conserved when the perturbers are at rest."""
+    return kinetic_energy(y, model) - force_function(t, y[0:4], model)
+
+
+@jit
+def inertial_angular_momentum(y, model):
+    """Angular momentum M(q) I ω in the inertial frame (mass·length²/time)."""
+    w, x, yy, z = y[0], y[1], y[2], y[3]
+    inv = 1.0 / (w * w + x * x + yy * yy + z * z)
+    lx, ly, lz = model[BODY_A] * y[4], model[BODY_B] * y[5], model[BODY_C] * y[6]
+    out = np.empty(3)
+    out[0] = inv * ((w * w + x * x - yy * yy - z * z) * lx + 2.0 * (x * yy - w * z) * ly + 2.0 * (x * z + w * yy) * lz)
+    out[1] = inv * (2.0 * (x * yy + w * z) * lx + (w * w - x * x + yy * yy - z * z) * ly + 2.0 * (yy * z - w * x) * lz)
+    out[2] = inv * (2.0 * (x * z - w * yy) * lx + 2.0 * (yy * z + w * x) * ly + (w * w - x * x - yy * yy + z * z) * lz)
+    return out
+
+
+def scipy_rhs(model):
+    """A ``fun(t, y)`` for ``scipy.integrate.solve_ivp`` that calls the compiled :func:`rhs`.
+
+    The Python-level call per evaluation is what scipy's solvers cost anyway; the dynamics are the
+    same compiled definition the numba integrator uses.
+    """
+
+    def fun(t, y):
+        return rhs(float(t), np.ascontiguousarray(y, dtype=float), model)
+
+    return fun
+
+
+def validate_state(y0):
+    """Check an initial state (q, ω) and return it as a float array with q normalised.
+
+    Raises
+    ------
+    ValueError
+        Wrong shape, NaN/inf, or a zero quaternion.
+    """
+    y0 = np.asarray(y0, dtype=float)
+    if y0.shape != (STATE_SIZE,):
+        raise ValueError(
+            f"y0: expected 7 numbers (q0, q1, q2, q3, ωx, ωy, ωz), got shape {y0.shape}."
+        )
+    if not np.all(np.isfinite(y0)):
+        raise ValueError(f"y0: expected finite numbers, got {y0.tolist()}; check the initial state for NaN/inf.")
+    norm = math.sqrt(float(np.dot(y0[:4], y0[:4])))
+    if norm < 1e-150:
+        raise ValueError(
+            f"y0: expected a non-zero quaternion in y0[0:4], got {y0[:4].tolist()}; "
+            "use (1, 0, 0, 0) for the identity attitude."
+        )
+    y0 = y0.copy()
+    y0[:4] /= norm
+    return y0

@@ -75,12 +75,16 @@ class RigidBody:
     radius : Quantity, optional
         Reference radius (km) of the body's gravity field.
     name : str, optional
+    physical : bool, optional
+        Require A + B ≥ C (default True). Set False for mathematical test problems such as the
+        Hairer–Lubich–Wanner free rigid body I = (2, 1, 2/3), which no mass distribution has but
+        whose dynamics are well defined.
 
     Raises
     ------
     InvalidBodyError
-        Non-finite or non-positive moments, or moments violating A + B ≥ C (no mass distribution
-        has them).
+        Non-finite or non-positive moments, or (with ``physical=True``) moments violating
+        A + B ≥ C (no mass distribution has them).
 
     Notes
     -----
@@ -98,6 +102,7 @@ class RigidBody:
     mass: u.Quantity | None = None
     radius: u.Quantity | None = None
     name: str | None = None
+    physical: bool = True
     _values: np.ndarray = field(init=False, repr=False, compare=False)
     _unit: u.Unit = field(init=False, repr=False, compare=False)
     _to_principal: np.ndarray = field(init=False, repr=False, compare=False)
@@ -105,10 +110,11 @@ class RigidBody:
     def __post_init__(self):
         values, unit = _as_moments(self.moments)
         big_a, big_b, big_c = np.sort(values)
-        if big_a + big_b < big_c * (1.0 - TRIANGLE_SLACK):
+        if self.physical and big_a + big_b < big_c * (1.0 - TRIANGLE_SLACK):
             raise InvalidBodyError(
                 f"moments {values.tolist()} violate the triangle inequality A + B ≥ C "
-                f"({float(big_a)!r} + {float(big_b)!r} < {float(big_c)!r}); no mass distribution has them. Check the values and their axes."
+                f"({float(big_a)!r} + {float(big_b)!r} < {float(big_c)!r}); no mass distribution has them. Check the "
+                "values and their axes, or pass physical=False for a mathematical test problem."
             )
         if self.mass is not None and (not isinstance(self.mass, u.Quantity) or self.mass.unit.physical_type != "mass"):
             raise u.UnitTypeError(f"mass must be a Quantity in a mass unit (e.g. 6e10 * u.kg); got {self.mass!r}.")

@@ -123,3 +123,15 @@ def test_rotation_matrix_must_be_a_rotation():
         RotationState.from_matrix(RigidBody([1.0, 2.0, 2.5]), np.diag([1.0, 1.0, -1.0]), [1.0, 0, 0])
     with pytest.raises(u.UnitTypeError, match="angle per time"):
         RotationState(RigidBody([1.0, 2.0, 2.5]), [1, 0, 0, 0], [1.0, 0, 0] * u.m / u.s)
+
+
+def test_hairer_lubich_wanner_body_needs_physical_false_and_is_lam():
+    # I = (2, 1, 2/3): A + B = 5/3 < C = 2, a mathematical test problem (GNI §IV.1).
+    with pytest.raises(InvalidBodyError, match="physical=False"):
+        RigidBody([2.0, 1.0, 2 / 3])
+    body = RigidBody([2.0, 1.0, 2 / 3], physical=False)
+    state = RotationState.from_angular_momentum(body, [1, 0, 0, 0], [math.cos(1.1), 0.0, math.sin(1.1)])
+    assert state.mode == "LAM"
+    quaternions, omega = state.propagate_torque_free(np.linspace(0, 1e4, 5))
+    momentum = omega.value * np.array([2.0, 1.0, 2 / 3])
+    assert np.abs(np.linalg.norm(momentum, axis=1) - 1.0).max() < 1e-14  # |M| is exact

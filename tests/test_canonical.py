@@ -246,7 +246,7 @@ def test_round_trip_all_modes_within_the_elements_own_conditioning(body, q, size
     error, elements, flip = round_trip_error(attitude, momentum, body)
     if not np.all(np.isfinite(elements)):
         return  # permanent rotation: covered by test_permanent_rotations_are_refused_by_the_paper_maps
-    assert error <= 16 * conditioning_error(elements, flip, body, attitude, momentum) + ROUND_TRIP_TOLERANCE
+    assert error <= 4 * conditioning_error(elements, flip, body, attitude, momentum) + ROUND_TRIP_TOLERANCE
     if min(distances_to_singular_sets(momentum, attitude, body)) >= FAR:
         assert error <= ROUND_TRIP_TOLERANCE
 
@@ -342,3 +342,32 @@ def test_bad_elements_input_is_named():
         canonical_to_andoyer(1.5, 1.0, 0.2, 0.1, 0.2, 0.3, 1.0, 2.0, 2.5)
     with pytest.raises(ValueError, match=r"\|S\| must lie"):
         canonical_to_andoyer(0.1, 1.0, 0.2, 0.1, 0.2, 0.3, 1.0, 2.0, 2.5)  # below √(A/C) Z: no such energy
+
+
+def nearly_symmetric_body(log10_f):
+    """Moments with f = C(B − A)/(A(C − B)) ≈ 10^log10_f: B → A for f → 0, C → B for f → ∞."""
+    f = 10.0**log10_f
+    if f <= 1.0:
+        big_a, big_c = 1.0, 2.0
+        big_b = big_a * (big_c + f * big_c) / (big_c + f * big_a)  # solves f = C(B−A)/(A(C−B))
+    else:
+        big_a, big_b = 1.0, 2.0
+        big_c = big_b * (1.0 + (big_b - big_a) / (f * big_a - (big_b - big_a)))
+    return big_a, big_b, big_c
+
+
+@given(
+    st.floats(-12, 12),
+    unit_quaternions,
+    st.lists(st.floats(-1, 1), min_size=3, max_size=3).filter(lambda v: np.linalg.norm(v) > 0.05),
+)
+def test_round_trip_nearly_symmetric_bodies_f_from_1e_minus_12_to_1e12(log10_f, q, momentum):
+    body = nearly_symmetric_body(log10_f)
+    if not (body[0] < body[1] < body[2]):
+        return  # rounding made the body exactly symmetric: a permanent-rotation case, tested elsewhere
+    momentum = np.array(momentum)
+    attitude = rot.quat_to_attitude(q)
+    error, elements, flip = round_trip_error(attitude, momentum, body)
+    if not np.all(np.isfinite(elements)):
+        return
+    assert error <= 4 * conditioning_error(elements, flip, body, attitude, momentum) + ROUND_TRIP_TOLERANCE

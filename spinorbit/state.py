@@ -14,6 +14,7 @@ import numpy as np
 from astropy import units as u
 
 from .body import RigidBody
+from .core import andoyer as _andoyer
 from .core import canonical as _canonical
 from .core import elliptic as _elliptic
 from .core import rotations as _rotations
@@ -262,6 +263,45 @@ class RotationState:
             mean_g_rate -= 2 * math.pi / rotation_period
         return rotation_period * u.day, (2 * math.pi / mean_g_rate) * u.day
 
+    def _reference_frame(self, reference) -> np.ndarray:
+        """Passive rotation inertial → frame of the Andoyer angles h, I (see :meth:`canonical_elements`)."""
+        if isinstance(reference, str):
+            if reference not in ("auto", "inertial"):
+                raise ValueError(f"reference must be 'auto', 'inertial' or a 3×3 rotation; got {reference!r}.")
+            direction = self.angular_momentum_direction
+            if reference == "auto" and math.hypot(direction[0], direction[1]) < AUTO_REFERENCE_MIN_SIN_I:
+                return _rotations.rot1(math.pi / 2)
+            return np.eye(3)
+        return _as_rotation_matrix(reference)
+
+    def andoyer_variables(self, reference="auto") -> tuple[float, float, float, float, float, float]:
+        """Andoyer variables (L, G, H, l, g, h) in principal axes (A ≤ B ≤ C), paper section 3.
+
+        Momenta in the body's moment unit × rad/day, angles in radians. ``reference`` as in
+        :meth:`canonical_elements`. At J = 0 (spin exactly about C) only l + g is defined; the split
+        follows ``spinorbit.core.andoyer.andoyer_from_attitude``.
+        """
+        frame = self._reference_frame(reference)
+        attitude, momentum = self._principal()
+        return tuple(float(x) for x in _andoyer.andoyer_from_attitude(attitude @ frame.T, momentum))
+
+    @classmethod
+    def from_andoyer(cls, body: RigidBody, big_l, big_g, big_h, l, g, h, reference=None) -> "RotationState":
+        """The state of Andoyer variables in principal axes (inverse of :meth:`andoyer_variables`).
+
+        ``reference`` is the passive rotation inertial → frame of h and I (identity by default).
+        """
+        values = np.array([big_l, big_g, big_h, l, g, h], dtype=float)
+        if not np.all(np.isfinite(values)) or big_g <= 0 or abs(big_l) > big_g or abs(big_h) > big_g:
+            raise InvalidStateError(
+                f"Andoyer variables need finite values with G > 0 and |L|, |H| ≤ G; got L={big_l!r}, G={big_g!r}, "
+                f"H={big_h!r}."
+            )
+        frame = np.eye(3) if reference is None else _as_rotation_matrix(reference)
+        attitude_ref, momentum = _andoyer.attitude_from_andoyer(*values)
+        p = body._to_principal
+        return cls.from_matrix(body, p.T @ attitude_ref @ frame, (p.T @ momentum) / body._values)
+
     def canonical_elements(self, reference="auto") -> CanonicalElements:
         """Fukushima's canonical elements (paper eq. 4) of this state.
 
@@ -285,15 +325,7 @@ class RotationState:
                 "finite canonical elements. propagate_torque_free still works (uniform rotation)."
             )
         attitude, momentum = self._principal()
-        if isinstance(reference, str):
-            if reference not in ("auto", "inertial"):
-                raise ValueError(f"reference must be 'auto', 'inertial' or a 3×3 rotation; got {reference!r}.")
-            frame = np.eye(3)
-            direction = self.angular_momentum_direction
-            if reference == "auto" and math.hypot(direction[0], direction[1]) < AUTO_REFERENCE_MIN_SIN_I:
-                frame = _rotations.rot1(math.pi / 2)
-        else:
-            frame = _as_rotation_matrix(reference)
+        frame = self._reference_frame(reference)
         ic = _canonical.inertia_constants(*moments)
         elements, flip, mode = _canonical.elements_from_state(attitude @ frame.T, momentum, ic)
         return CanonicalElements(*(float(x) for x in elements), flip=int(flip), mode=MODE_NAMES[mode], reference=frame)

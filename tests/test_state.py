@@ -135,3 +135,18 @@ def test_hairer_lubich_wanner_body_needs_physical_false_and_is_lam():
     quaternions, omega = state.propagate_torque_free(np.linspace(0, 1e4, 5))
     momentum = omega.value * np.array([2.0, 1.0, 2 / 3])
     assert np.abs(np.linalg.norm(momentum, axis=1) - 1.0).max() < 1e-14  # |M| is exact
+
+
+def test_andoyer_variables_round_trip_and_meaning():
+    body = RigidBody([2.5, 1.0, 2.0])
+    q = np.array([0.2, 0.5, -0.4, 0.7])
+    state = RotationState(body, q / np.linalg.norm(q), [0.3, 1.2, -0.4])
+    big_l, big_g, big_h, l, g, h = state.andoyer_variables(reference="inertial")
+    momentum = body.to_principal @ state.angular_momentum.value
+    assert big_g == pytest.approx(np.linalg.norm(momentum), rel=1e-15)
+    assert big_l == pytest.approx(momentum[2], rel=1e-14)  # L is the C-axis component
+    back = RotationState.from_andoyer(body, big_l, big_g, big_h, l, g, h)
+    assert np.abs(back.attitude_matrix - state.attitude_matrix).max() < 1e-14
+    assert np.abs((back.angular_velocity - state.angular_velocity).value).max() < 1e-14
+    with pytest.raises(InvalidStateError, match="G > 0"):
+        RotationState.from_andoyer(body, 2.0, 1.0, 0.0, 0.0, 0.0, 0.0)

@@ -360,13 +360,15 @@ class RotationState:
         if times.ndim != 1 or not np.all(np.isfinite(times)):
             raise ValueError("dt must be a finite scalar or 1-D array of time offsets.")
         attitude, momentum = self._principal()
-        moments = self._body.principal_moments
-        attitudes = _torque_free.torque_free_attitudes(attitude, momentum, *moments, times)
         p = self._body._to_principal
-        user_attitudes = np.einsum("ji,njk->nik", p, attitudes)
-        quaternions = _rotations.attitude_to_quat_many(user_attitudes)
-        inertial_momentum = attitude.T @ momentum
-        body_momentum = np.einsum("nij,j->ni", user_attitudes, inertial_momentum)
+        principal_q, principal_m = _torque_free.torque_free_states(
+            _rotations.attitude_to_quat(attitude), momentum, *self._body.principal_moments, times
+        )
+        # v_inertial = M(q_p) v_principal = M(q_p) P v_user, so q_user = q_p ⊗ q(P).
+        p0, p1, p2, p3 = _rotations.matrix_to_quat(np.ascontiguousarray(p))
+        right_product = np.array([[p0, -p1, -p2, -p3], [p1, p0, p3, -p2], [p2, -p3, p0, p1], [p3, p2, -p1, p0]])
+        quaternions = principal_q @ right_product.T  # row-wise q ⊗ q(P), no Python loop over times
+        body_momentum = principal_m @ p  # Pᵀ M_p for every row
         return quaternions, (body_momentum / self._body._values) * RAD_PER_DAY
 
     def __repr__(self):

@@ -103,6 +103,7 @@ from .torque_free import (
     FL_QN_Z,
     FL_RATE_HI,
     FLOW_SIZE,
+    _qmul,
     evaluate_flow,
     flow_constants,
 )
@@ -211,9 +212,12 @@ def short_flow_constants(quaternion, momentum, big_a, big_b, big_c):
 def drift(tau, q, m, big_a, big_b, big_c, short_setup=True):
     """Exact torque-free flow over τ, in place: q (unit quaternion, body → inertial), m (body momentum).
 
-    M = 0 is no rotation at all (the torque-free setup has no elements for it). q is renormalised:
-    the closed form keeps |q| = 1 to rounding, and without the projection that rounding would random-
-    walk over 1e6 steps (renormalising does not change the attitude).
+    The flow is applied as a *relative* rotation: q ← q ⊗ (q_f(0)⁻¹ ⊗ q_f(τ)), M ← M + (M_f(τ) − M_f(0)),
+    where q_f, M_f are the closed form from the elements of (q, M). The round trip (q, M) → elements →
+    (q_f(0), M_f(0)) is off by a few ε in a direction that repeats from drift to drift (measured
+    ≈ 5e-15 rad per drift, growing linearly over 1e5 drifts); the relative form cancels that common
+    error at the cost of one more evaluation (≈ 0.3 µs). M = 0 is no rotation at all. q is
+    renormalised (the projection does not change the attitude).
     """
     if m[0] == 0.0 and m[1] == 0.0 and m[2] == 0.0:
         return
@@ -221,10 +225,19 @@ def drift(tau, q, m, big_a, big_b, big_c, short_setup=True):
         flow, mo, mk, pk = short_flow_constants(q, m, big_a, big_b, big_c)
     else:
         flow, mo, mk, pk = flow_constants(q, m, big_a, big_b, big_c)
-    evaluate_flow(tau, flow, mo, mk, pk, q, m)  # flow holds all it needs: q, m may be overwritten
-    norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
-    for i in range(4):
-        q[i] /= norm
+    q_start = np.empty(4)
+    m_start = np.empty(3)
+    q_end = np.empty(4)
+    m_end = np.empty(3)
+    evaluate_flow(0.0, flow, mo, mk, pk, q_start, m_start)
+    evaluate_flow(tau, flow, mo, mk, pk, q_end, m_end)
+    # relative body-frame rotation r = q_f(0)⁻¹ ⊗ q_f(τ)
+    r = _qmul(q_start[0], -q_start[1], -q_start[2], -q_start[3], q_end[0], q_end[1], q_end[2], q_end[3])
+    q0, q1, q2, q3 = _qmul(q[0], q[1], q[2], q[3], r[0], r[1], r[2], r[3])
+    norm = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
+    q[0], q[1], q[2], q[3] = q0 / norm, q1 / norm, q2 / norm, q3 / norm
+    for i in range(3):
+        m[i] += m_end[i] - m_start[i]
 
 
 @jit

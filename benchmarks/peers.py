@@ -256,5 +256,6 @@ METHODS = [
     splitting_method("strang", "Strang", "tab:olive", "v"),
     splitting_method("saba2", "SABA2", "tab:green", "P"),
     splitting_method("saba3", "SABA3", "tab:purple", "X"),
+    splitting_method("saba4", "SABA4", "tab:pink", "p"),
     splitting_method("yoshida4", "Yoshida4", "tab:brown", "*"),
 ]

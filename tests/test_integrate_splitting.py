@@ -161,8 +161,8 @@ def test_fixed_perturber_conserves_the_momentum_along_its_direction_only():
 
 
 #: Energy test: μ = 1e-3, τ = 0.1 (≈ 46 steps per rotation), SABA2. The splitting conserves a modified
-#: energy within O(ε τ⁴ + ε² τ²) of E; measured max |ΔE|/|E| = 2.5e-10 over 1e5 steps and 2.6e-10
-#: over 1e6 steps (docs/splitting.md). Bound with a factor 4.
+#: energy within O(ε τ⁴ + ε² τ²) of E; measured max |ΔE|/|E| = 2.56e-10 over 1e5 steps and 2.71e-10
+#: over 1e6 steps (docs/splitting.md). Bound with a factor ~4.
 ENERGY_MU = 1e-3
 ENERGY_STEP = 0.1
 ENERGY_BOUND = 1e-9

@@ -46,7 +46,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import rebound
 from astropy import units as u
-from astropy.table import Table
+from astropy.table import QTable
 from astropy.time import Time
 
 from ..core import rotations as _rotations
@@ -347,7 +347,9 @@ class _Snapshot:
         xyz, vel, mass = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n)
         sim.serialize_particle_data(xyz=xyz, vxvyvz=vel, m=mass)
         handle = getattr(sim, "_afp", None)
-        return cls(sim.t, sim.G, sim.integrator, tuple(p.name for p in sim.particles), mass, xyz, vel,
+        name = sim.integrator.name
+        name = name.decode() if isinstance(name, bytes) else str(name)  # REBOUND 5 gives bytes
+        return cls(sim.t, sim.G, name, tuple(p.name for p in sim.particles), mass, xyz, vel,
                    handle if isinstance(handle, ExtraForces) else None)
 
     def build(self):
@@ -468,7 +470,7 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
 
     Returns
     -------
-    astropy.table.Table
+    astropy.table.QTable
         Columns ``time`` (Time), ``quaternion`` (n, 4; scalar first, user body axes → ICRF),
         ``omega`` (n, 3; rad/day, user body axes), ``momentum_direction`` (n, 3; unit, ICRF); with
         ``periods``: ``mode``, ``energy_ratio`` (E/E0), ``P_psi``, ``P_phi`` (day).
@@ -490,7 +492,7 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
     model = make_model(body.principal_moments, samples.sources())
     ys, stats = integrate_quaternion(_to_core(state), t0, t_out, model, rtol=rtol, return_stats=True)
     rotation_states = [_from_core(body, y) for y in ys]
-    table = Table()
+    table = QTable()
     table["time"] = time_from_tdb_days(t_out)
     table["quaternion"] = np.array([s.quaternion for s in rotation_states])
     table["omega"] = np.array([s.angular_velocity.to_value(u.rad / u.day) for s in rotation_states]) * (u.rad / u.day)

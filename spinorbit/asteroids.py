@@ -152,7 +152,9 @@ def encounter_state(geometry, return_details=False):
 
     Construction (module docstring): v̂∞ from the element ellipse point nearest Earth; impact-parameter
     direction b̂ = the part of (ellipse point − Earth) perpendicular to v̂∞; perigee speed v_p as
-    published (or from the elements' |v∞| when ``geometry.speed_km_s`` is None); then, with
+    published; when ``geometry.speed_km_s`` is None, v∞ is the ellipse's heliocentric velocity
+    direction with the vis-viva speed of its semi-major axis at the perigee point, minus Earth's
+    velocity (so the asteroid keeps the elements' orbital period); then, with
     e = 1 + r_p v∞²/μ and the turning angle δ (sin δ/2 = 1/e), the perigee velocity is
     v̂∞ rotated by δ/2 towards −b̂ (gravity bends the path towards Earth) and the perigee position
     r_p (sin δ/2 v̂∞ + cos δ/2 b̂), perpendicular to it.
@@ -173,26 +175,40 @@ def encounter_state(geometry, return_details=False):
     nu0 = coarse[int(np.argmin([distance(x) for x in coarse]))]
     nu = minimize_scalar(distance, bracket=(nu0 - 0.01, nu0, nu0 + 0.01), tol=1e-12).x
     point, velocity = _kepler_state_from_true_anomaly(el, nu, gm_sun)
-    v_inf_vec = velocity - earth_helio_v
-    v_inf_hat = v_inf_vec / np.linalg.norm(v_inf_vec)
+    v_inf_elements = float(np.linalg.norm(velocity - earth_helio_v))
     offset = point - earth_helio
-    b = offset - (offset @ v_inf_hat) * v_inf_hat
-    if np.linalg.norm(b) < 1e-9:  # ellipse through Earth: any perpendicular; take ecliptic north's
-        b = ecliptic_direction(0.0, 90.0) - (ecliptic_direction(0.0, 90.0) @ v_inf_hat) * v_inf_hat
-    b_hat = b / np.linalg.norm(b)
     r_p = geometry.distance_km / au_km
-    v_inf_elements = float(np.linalg.norm(v_inf_vec))
-    if geometry.speed_km_s is None:
-        v_inf = v_inf_elements
-        v_p = math.sqrt(v_inf**2 + 2 * mu_earth / r_p)
-    else:
-        v_p = geometry.speed_km_s * 86400.0 / au_km
-        v_inf = math.sqrt(v_p**2 - 2 * mu_earth / r_p)
-    ecc = 1 + r_p * v_inf**2 / mu_earth
-    half_turn = math.asin(1 / ecc)
-    velocity_hat = math.cos(half_turn) * v_inf_hat - math.sin(half_turn) * b_hat
-    position_hat = math.sin(half_turn) * v_inf_hat + math.cos(half_turn) * b_hat
-    position, velocity = r_p * position_hat, v_p * velocity_hat
+    position = np.zeros(3)
+    # Three passes: without a published speed, the vis-viva speed is taken at the asteroid's own
+    # perigee position, which depends (weakly) on the v∞ direction it produces.
+    for _ in range(3 if geometry.speed_km_s is None else 1):
+        v_inf_vec = velocity - earth_helio_v
+        if geometry.speed_km_s is None:
+            # No published speed: keep the ellipse's heliocentric velocity direction but give it the
+            # vis-viva speed of the elements' a at the asteroid's position, so that the semi-major axis
+            # — hence the period and the near-commensurability with Earth that brings the asteroid
+            # back every few years — is the elements' a (Earth's potential at perigee changes it by
+            # < 1e-3 relative).
+            r_here = float(np.linalg.norm(earth_helio + position))
+            speed = math.sqrt(gm_sun * (2 / r_here - 1 / el.a))
+            v_inf_vec = speed * velocity / np.linalg.norm(velocity) - earth_helio_v
+        v_inf_hat = v_inf_vec / np.linalg.norm(v_inf_vec)
+        b = offset - (offset @ v_inf_hat) * v_inf_hat
+        if np.linalg.norm(b) < 1e-9:  # ellipse through Earth: any perpendicular; take ecliptic north's
+            b = ecliptic_direction(0.0, 90.0) - (ecliptic_direction(0.0, 90.0) @ v_inf_hat) * v_inf_hat
+        b_hat = b / np.linalg.norm(b)
+        if geometry.speed_km_s is None:
+            v_inf = float(np.linalg.norm(v_inf_vec))
+            v_p = math.sqrt(v_inf**2 + 2 * mu_earth / r_p)
+        else:
+            v_p = geometry.speed_km_s * 86400.0 / au_km
+            v_inf = math.sqrt(v_p**2 - 2 * mu_earth / r_p)
+        ecc = 1 + r_p * v_inf**2 / mu_earth
+        half_turn = math.asin(1 / ecc)
+        velocity_hat = math.cos(half_turn) * v_inf_hat - math.sin(half_turn) * b_hat
+        position_hat = math.sin(half_turn) * v_inf_hat + math.cos(half_turn) * b_hat
+        position, perigee_velocity = r_p * position_hat, v_p * velocity_hat
+    velocity = perigee_velocity
     if not return_details:
         return position, velocity
     kms = au_km / 86400.0

@@ -96,6 +96,12 @@ class EncounterGeometry:
     elements: HeliocentricDirections
     source: str
 
+    @property
+    def time_tdb(self):
+        """The encounter time on the TDB scale, converted through :mod:`spinorbit.time` (astropy's own
+        ``.tdb`` warns "dubious year" for 2029 through an irrelevant UTC leg)."""
+        return _tdb(self.time)
+
 
 APOPHIS_ELEMENTS = HeliocentricDirections(
     0.9224, 0.1914, 3.339, 204.43, 126.39,

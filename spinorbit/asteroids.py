@@ -65,6 +65,7 @@ __all__ = [
     "toutatis_rotation_state",
     "sam_state_from_periods",
     "ecliptic_direction",
+    "aligning_quaternion",
 ]
 
 DEG = math.pi / 180.0
@@ -251,7 +252,7 @@ def _tdb(time):
 # Spin states.
 
 
-def _aligning_quaternion(v_body, v_inertial):
+def aligning_quaternion(v_body, v_inertial):
     """Unit quaternion q (body → inertial) with M(q) v̂_body = v̂_inertial (the smallest rotation)."""
     a = np.asarray(v_body, float) / np.linalg.norm(v_body)
     b = np.asarray(v_inertial, float) / np.linalg.norm(v_inertial)
@@ -266,7 +267,7 @@ def _sam_state(body, d, momentum, direction):
     principal_momentum = np.array([0.0, math.sqrt(momentum**2 - along_c**2), along_c])
     p = body._to_principal
     user_momentum = p.T @ principal_momentum
-    q = _aligning_quaternion(user_momentum, direction)
+    q = aligning_quaternion(user_momentum, direction)
     return RotationState(body, q, user_momentum / body._values)
 
 

@@ -67,6 +67,7 @@ __all__ = [
     "sample_from_rebound",
     "propagate_one_way",
     "de421_orbit",
+    "rebound_orbit",
 ]
 
 #: Perturbers by default: the Sun (the secular torque), Earth and Moon (close encounters of NEAs).
@@ -146,6 +147,21 @@ def _hermite_positions(grid, states, days):
     s2, s3 = s * s, s * s * s
     return ((2 * s3 - 3 * s2 + 1) * p0 + (s3 - 2 * s2 + s) * h * v0 + (-2 * s3 + 3 * s2) * p1
             + (s3 - s2) * h * v1)
+
+
+def _hermite_states(grid, states, days):
+    """Hermite-interpolated positions and velocities (n, k, 6) at ``days`` (velocity: the derivative)."""
+    index = np.clip(np.searchsorted(grid, days, side="right") - 1, 0, grid.size - 2)
+    h = (grid[index + 1] - grid[index])[:, None, None]
+    s = (days - grid[index])[:, None, None] / h
+    p0, v0 = states[index, :, :3], states[index, :, 3:]
+    p1, v1 = states[index + 1, :, :3], states[index + 1, :, 3:]
+    s2, s3 = s * s, s * s * s
+    position = ((2 * s3 - 3 * s2 + 1) * p0 + (s3 - 2 * s2 + s) * h * v0 + (-2 * s3 + 3 * s2) * p1
+                + (s3 - s2) * h * v1)
+    velocity = ((6 * s2 - 6 * s) * p0 / h + (3 * s2 - 4 * s + 1) * v0 + (-6 * s2 + 6 * s) * p1 / h
+                + (3 * s2 - 2 * s) * v1)
+    return np.concatenate([position, velocity], axis=2)
 
 
 def _midpoint_errors(grid, states, mid_states):
@@ -276,7 +292,7 @@ def sample_from_ephemeris(body_orbit, start, end, perturbers=DEFAULT_PERTURBERS,
     body_orbit : callable
         ``body_orbit(days) -> (positions (n, 3), velocities (n, 3))``: barycentric ICRF state of the
         rotating body in au_DE421 and au/day at TDB days since J2000 (vectorised over ``days``).
-        E.g. :func:`de421_orbit`, or the asteroid orbit of :func:`spinorbit.asteroids.asteroid_orbit`.
+        E.g. :func:`de421_orbit`, or a REBOUND particle's through :func:`rebound_orbit`.
     start, end : astropy.time.Time
         Span to cover (end > start).
     perturbers : sequence of str
@@ -314,6 +330,42 @@ def sample_from_ephemeris(body_orbit, start, end, perturbers=DEFAULT_PERTURBERS,
     grid, states, error, passes, closest = _adaptive_samples(provider, start_day, end_day, tolerance)
     return SampledPerturbers(names, gm, grid, states, tolerance, error, passes,
                              {names[i]: c for i, c in closest.items()})
+
+
+def rebound_orbit(sim, body):
+    """The barycentric orbit of a REBOUND particle as a callable for :func:`sample_from_ephemeris`.
+
+    Route (a) with a REBOUND-integrated body and the perturbers straight from DE421. Each call
+    rebuilds the simulation from a copy of its present state (``sim`` is not modified) and integrates
+    it through the requested times (``exact_finish_time``), so the sampler gets the smooth
+    trajectory, not an interpolant of it. The frame is REBOUND's: a simulation from
+    :func:`~spinorbit.coupling.rebound_adapter.simulation_from_de421` is barycentric ICRF to the
+    centre-of-mass shift of the bodies left out (metres); but the perturber vectors then mix DE421
+    planets with a body integrated among REBOUND's planets, whose drift from DE421 (metres to
+    kilometres over decades: ``docs/ephemeris.md``) enters them. Route (b),
+    :func:`sample_from_rebound`, takes both from the same run and has no such mixing.
+
+    Returns
+    -------
+    callable
+        ``days -> (positions (n, 3), velocities (n, 3))``, au and au/day.
+    """
+    centre = body_index(sim, body)
+    snapshot = _Snapshot.of(sim)
+
+    def orbit(days):
+        days = np.atleast_1d(np.asarray(days, dtype=float))
+        order = np.argsort(days, kind="stable")
+        run = snapshot.build()
+        out = np.empty((days.size, 6))
+        xyz, vel = np.zeros((run.N, 3)), np.zeros((run.N, 3))
+        for j in order:
+            run.integrate(days[j])
+            run.serialize_particle_data(xyz=xyz, vxvyvz=vel)
+            out[j, :3], out[j, 3:] = xyz[centre], vel[centre]
+        return out[:, :3], out[:, 3:]
+
+    return orbit
 
 
 @dataclass

@@ -21,11 +21,12 @@ kernel is largest at the midpoint: ≤ h⁴/384 · max|x⁗|. Two steps choose t
    automatically around close encounters (≈ 4 min for Apophis in 2029 at ε = 1e-10, which the
    check below refines to 1.2 min: near perigee x⁗ exceeds r/τ⁴).
 2. **A posteriori** (check and refine): the true states at every interval's midpoint are computed
-   (from the ephemeris, or by re-running REBOUND to them) and compared with the interpolant there.
+   together with the grid, in one provider call (the ephemeris, or one REBOUND run through grid and
+   midpoints), and compared with the interpolant there.
    The midpoint error is the error estimate of the interval (the kernel's maximum, exact when x⁗ is
    nearly constant over the interval, which it is once h ≪ τ). Intervals whose relative midpoint
    error exceeds ε for any perturber are bisected — the midpoint, whose true state is known, becomes
-   a sample — and the new halves are checked in the next pass.
+   a sample — and the next pass re-evaluates the refined grid and all its midpoints.
 
 The relative error ε is on |r| because the degree-2 torque is ∝ μ/|r|³: a relative position error ε
 gives a relative torque error ≲ 3ε. ``SampledPerturbers.midpoint_error`` reports the measured

@@ -20,11 +20,16 @@ Usage::
 from __future__ import annotations
 
 import argparse
+import sys
 import math
 import time
+from pathlib import Path
 
 import numpy as np
 from astropy import units as u
+
+# Run from a checkout without installing (the project does not use editable installs).
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from spinorbit import RotationState
 from spinorbit.asteroids import APOPHIS_2029, apophis_rotation_state, encounter_simulation, encounter_state

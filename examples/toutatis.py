@@ -23,11 +23,16 @@ Usage::
 from __future__ import annotations
 
 import argparse
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 from astropy import units as u
 from astropy.time import Time
+
+# Run from a checkout without installing (the project does not use editable installs).
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from spinorbit.asteroids import TOUTATIS_2004, TOUTATIS_EPOCH, encounter_simulation, toutatis_rotation_state
 from spinorbit.coupling.one_way import propagate_one_way, sample_from_rebound

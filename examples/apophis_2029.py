@@ -20,8 +20,8 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import sys
 import math
+import sys
 import time
 from pathlib import Path
 

@@ -20,6 +20,7 @@ from scipy.integrate import quad, solve_ivp
 from scipy.optimize import brentq
 from scipy.special import ellipk
 
+from spinorbit.asteroids import aligning_quaternion as _quat_aligning  # one implementation, in the library
 from spinorbit.core.dynamics import make_model
 from spinorbit.core.perturbers import kepler_source
 from spinorbit.core.rotations import matrix_to_quat
@@ -65,14 +66,6 @@ class Scene:
 
     def __post_init__(self):
         self.model = make_model(self.moments, [p.source() for p in self.perturbers])
-
-
-def _quat_aligning(v_body, v_inertial):
-    """A unit quaternion q (body → inertial) with M(q) v̂_body = v̂_inertial (smallest rotation)."""
-    a = np.asarray(v_body, float) / np.linalg.norm(v_body)
-    b = np.asarray(v_inertial, float) / np.linalg.norm(v_inertial)
-    q = np.concatenate([[1.0 + a @ b], np.cross(a, b)])
-    return q / np.linalg.norm(q)
 
 
 def sam_periods(moments, G, d):

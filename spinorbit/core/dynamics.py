@@ -132,13 +132,26 @@ def force_function(t, q, model):
 @jit(inline="always")
 def rhs_into(t, y, model, dy):
     """Write dy/dt into ``dy`` (no allocation; the integrators' inner call)."""
-    a_mom, b_mom, c_mom = model[BODY_A], model[BODY_B], model[BODY_C]
     q0, q1, q2, q3 = y[0], y[1], y[2], y[3]
-    wx, wy, wz = y[4], y[5], y[6]
     if model[MODEL_PERTURBERS] > 0.0:
         _, nx, ny, nz = force_function_and_torque_xyz(t, q0, q1, q2, q3, model)
     else:
         nx = ny = nz = 0.0
+    kinematics_and_euler_into(y, nx, ny, nz, model, dy)
+
+
+@jit(inline="always")
+def kinematics_and_euler_into(y, nx, ny, nz, model, dy):
+    """dy/dt for a given body-frame torque N: q̇ = ½ q ⊗ (0, ω) and Euler's equations.
+
+    The one place where the equations of motion are written; :func:`rhs_into` (torque from the
+    perturber table) and the REBOUND coupling (torque from the simulation's particles, see
+    ``spinorbit/coupling/rebound_adapter.py``) both end here. ``model`` needs only the figure head
+    (A, B, C at BODY_A..BODY_C).
+    """
+    a_mom, b_mom, c_mom = model[BODY_A], model[BODY_B], model[BODY_C]
+    q0, q1, q2, q3 = y[0], y[1], y[2], y[3]
+    wx, wy, wz = y[4], y[5], y[6]
     # q̇ = ½ q ⊗ (0, ω)
     dy[0] = 0.5 * (-q1 * wx - q2 * wy - q3 * wz)
     dy[1] = 0.5 * (q0 * wx + q2 * wz - q3 * wy)

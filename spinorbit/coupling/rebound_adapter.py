@@ -31,6 +31,7 @@ import rebound
 from numba import carray, cfunc, types
 from numba.extending import intrinsic
 
+from ..core._jit import jit
 from ..ephemeris import barycentric_state_au, de421_constants
 from ..time import tdb_day_and_fraction
 
@@ -121,17 +122,16 @@ def _word_as_float64(typingctx, word):
     return signature, codegen
 
 
-@cfunc(types.void(types.CPointer(types.uint64)), cache=True)
-def _extra_forces_cfunc(simulation):
-    """Earth J2 on all bodies (+ reaction on Earth) and the EIH 1PN accelerations, in place.
+@jit
+def _apply_extra_forces(words, p):
+    """The body of :func:`_extra_forces_cfunc`, callable from any cfunc that owns ``additional_forces``.
 
-    ``simulation`` is REBOUND's ``struct reb_simulation*``, viewed as 64-bit words. Accelerations
-    are *added* to ``ax, ay, az``, which REBOUND has filled with Newtonian gravity already.
+    ``words``: the simulation struct as 64-bit words; ``p``: the extra-force parameter block
+    (``_N_PARAMETERS`` floats). Shared so that the rigid-body coupling's combined force
+    (``rotation_coupling``) runs exactly the same EIH + J2 code.
     """
-    words = carray(simulation, _SIM_WORDS)
     n = np.int64(words[_SIM_N_WORD])
     particles = carray(_as_float64_pointer(words[_SIM_PARTICLES_WORD]), n * _PARTICLE_WORDS)
-    p = carray(_as_float64_pointer(words[_SIM_EXTRAS_WORD]), _N_PARAMETERS)
     earth = np.int64(p[_P_EARTH]) * _PARTICLE_WORDS
     correction = np.zeros((n, 3))  # 1PN accelerations × c², added after J2 (see below)
 
@@ -219,6 +219,18 @@ def _extra_forces_cfunc(simulation):
             particles[bi + _AX] += correction[i, 0] / c2
             particles[bi + _AX + 1] += correction[i, 1] / c2
             particles[bi + _AX + 2] += correction[i, 2] / c2
+
+
+@cfunc(types.void(types.CPointer(types.uint64)), cache=True)
+def _extra_forces_cfunc(simulation):
+    """Earth J2 on all bodies (+ reaction on Earth) and the EIH 1PN accelerations, in place.
+
+    ``simulation`` is REBOUND's ``struct reb_simulation*``, viewed as 64-bit words. Accelerations
+    are *added* to ``ax, ay, az``, which REBOUND has filled with Newtonian gravity already.
+    """
+    words = carray(simulation, _SIM_WORDS)
+    p = carray(_as_float64_pointer(words[_SIM_EXTRAS_WORD]), _N_PARAMETERS)
+    _apply_extra_forces(words, p)
 
 
 # The ctypes type of the struct field itself: assigning an instance of it stores the raw address.

@@ -31,7 +31,8 @@ import math
 import numpy as np
 
 from ._jit import jit
-from .gravity_field import BODY_A, BODY_B, BODY_C, FIGURE_SIZE, figure_force_function_and_gradient_xyz, make_body
+from .gravity_field import (BODY_A, BODY_B, BODY_C, BODY_MASS, FIGURE_SIZE, figure_field_without_monopole_xyz,
+                            make_body)
 from .perturbers import PERTURBER_ROW, pack_perturbers, perturber_position_xyz
 
 STATE_SIZE = 7
@@ -101,8 +102,11 @@ def force_function_and_torque_xyz(t, q0, q1, q2, q3, model):
         row = MODEL_PERTURBERS + 1 + k * PERTURBER_ROW
         ix, iy, iz = perturber_position_xyz(t, model, row)
         x, y, z = body_frame_xyz(q0, q1, q2, q3, ix, iy, iz)
-        u_k, gx, gy, gz = figure_force_function_and_gradient_xyz(x, y, z, model[row + 1], model)
-        u += u_k
+        # Torque from the field without the monopole: its radial gradient has no torque but would
+        # add rounding noise (see gravity_field.figure_field_without_monopole_xyz).
+        mu = model[row + 1]
+        u_k, gx, gy, gz = figure_field_without_monopole_xyz(x, y, z, mu, model)
+        u += u_k + mu * model[BODY_MASS] / math.sqrt(x * x + y * y + z * z)
         # N = (∂U/∂r) × r
         nx += gy * z - gz * y
         ny += gz * x - gx * z

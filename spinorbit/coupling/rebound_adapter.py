@@ -455,7 +455,7 @@ def perturber_positions(sim, body: str, perturbers=None):
 from rebound.ode import ODE as _ODE  # noqa: E402  (kept next to the code that reads its layout)
 
 from ..core.dynamics import body_frame_xyz, kinematics_and_euler_into  # noqa: E402
-from ..core.gravity_field import FIGURE_SIZE, figure_force_function_and_gradient_xyz  # noqa: E402
+from ..core.gravity_field import FIGURE_SIZE, figure_field_without_monopole_xyz  # noqa: E402
 
 _ODE_WORDS = ctypes.sizeof(_ODE) // _WORD
 _ODE_REF_WORD = _ODE.ref.offset // _WORD
@@ -553,8 +553,9 @@ def _figure_torque_and_reaction(words, sim_address, p, y, apply_reaction):
     F_p = ∂U/∂r (``gravity_field``); the kernel is called with μ = G, i.e. per unit perturber mass,
     so a massless perturber also feels the figure. Torque N = m_p (∂U₁/∂r) × r. The reaction
     (``apply_reaction``) adds ∂U₁/∂r, rotated to ICRF, to the perturber's acceleration and
-    −(m_p/m_b) times it to the body's, without the monopole (REBOUND already has the point-mass
-    part). Sets an error code and stops the run if the particle count changed or y is not finite.
+    −(m_p/m_b) times it to the body's; the field excludes the monopole (REBOUND already has the
+    point-mass part, and the monopole only adds rounding noise to the torque). Sets an error code
+    and stops the run if the particle count changed or y is not finite.
     """
     n = np.int64(words[_SIM_N_WORD])
     if n != np.int64(p[_R_N_EXPECTED]):
@@ -579,18 +580,13 @@ def _figure_torque_and_reaction(words, sim_address, p, y, apply_reaction):
         ry = particles[b + _X + 1] - particles[body + _X + 1]
         rz = particles[b + _X + 2] - particles[body + _X + 2]
         x, yy, z = body_frame_xyz(q0, q1, q2, q3, rx, ry, rz)
-        _, gx, gy, gz = figure_force_function_and_gradient_xyz(x, yy, z, g, model)
+        # Degrees ≥ 2 only: the monopole has no torque and REBOUND's point-mass gravity has it.
+        _, gx, gy, gz = figure_field_without_monopole_xyz(x, yy, z, g, model)
         m_p = particles[b + _M]
         nx += m_p * (gy * z - gz * yy)
         ny += m_p * (gz * x - gx * z)
         nz += m_p * (gx * yy - gy * x)
         if apply_reaction:
-            # Remove the monopole −G m_b r/R³ (REBOUND's point-mass gravity has it already).
-            rr = x * x + yy * yy + z * z
-            mono = g * m_body / (rr * np.sqrt(rr))
-            gx += mono * x
-            gy += mono * yy
-            gz += mono * z
             # Body → ICRF: M(q) v = body_frame_xyz with the conjugate quaternion.
             ax, ay, az = body_frame_xyz(q0, -q1, -q2, -q3, gx, gy, gz)
             particles[b + _AX] += ax
@@ -762,9 +758,6 @@ def attach_rotation_hooks(sim, body: str, perturbers, figure, state, coupled: bo
         earth_j2, gr = previous.earth_j2, previous.gr
         earth_pole = previous.parameters[_P_POLE:_P_POLE + 3]
     if earth_j2 or gr:
-        sim.extras = None
-        sim._afp = None
-        sim.additional_forces = None
         probe = rebound.Simulation()  # fill the EIH/J2 block with install_extra_forces' own code
         probe.add(m=1.0, name="Earth")
         extra = install_extra_forces(probe, earth_j2=earth_j2, gr=gr, earth_pole=earth_pole)

@@ -1,0 +1,46 @@
+"""The lunar physical libration from DE421 at J2000 against DE421's own librations (validation).
+
+Measured on this code (BS 1e-13, 11 bodies, EIH + Earth J2 on the orbits, degree 2–4 lunar field,
+Sun, planets and Earth torquing the figure, daily comparison) over one year from J2000:
+rigid 1.52″, core-corrected 0.207″ maximum attitude difference. The residual is physics DE421 has
+and this model lacks (tidal and rotational distortion k2/τ, the core's oblateness and friction,
+Earth's J2 acting on the lunar figure), not integration error: BS tolerances 1e-12 … 1e-15 give
+1.5157″ / 0.2072″ alike (spread < 1e-4″).
+"""
+
+import numpy as np
+import pytest
+
+from spinorbit.coupling.moon import compare_with_de421, moon_at_de421
+
+pytestmark = pytest.mark.validation
+
+ONE_YEAR_DAYS = 365.25
+#: Rigid Moon with DE421's published (total) moments: measured 1.52″; the design target was ≈ 2″.
+#: The bound is the target: a regression past it means the coupling or the field changed.
+RIGID_ONE_YEAR_ARCSEC = 2.0
+#: Mantle moments (fluid core's share IFAC·C removed): measured 0.207″; 0.3″ leaves ~50 % margin
+#: for step-sequence differences between platforms while still failing if the core correction is lost
+#: (that alone gives 1.5″).
+CORE_CORRECTED_ONE_YEAR_ARCSEC = 0.3
+#: Without degrees 3–4 the Moon drifts ~100″ a year (shared note): the comparison must see it.
+DEGREE2_ONLY_AT_LEAST_ARCSEC = 20.0
+
+
+@pytest.mark.parametrize(
+    ("model", "bound"),
+    [("rigid", RIGID_ONE_YEAR_ARCSEC), ("core-corrected", CORE_CORRECTED_ONE_YEAR_ARCSEC)],
+)
+def test_one_year_attitude_against_de421(model, bound):
+    comparison = compare_with_de421(moon_at_de421(model=model), ONE_YEAR_DAYS, step_days=1.0)
+    assert comparison.attitude_difference_arcsec[0] < 1e-6  # same initial attitude
+    assert comparison.max_difference_arcsec < bound
+    # The libration itself is followed: φ and θ differ from DE421 by ≤ the attitude bound (+ margin
+    # for the 3-1-3 angles' amplification near θ ≈ 24°).
+    difference = comparison.angles_model[:, :2] - comparison.angles_de421[:, :2]
+    assert np.max(np.abs(difference)) * 206264.806 < 2.0 * bound
+
+
+def test_comparison_detects_a_missing_degree_three_field():
+    comparison = compare_with_de421(moon_at_de421(model="core-corrected", degree=2), ONE_YEAR_DAYS, 5.0)
+    assert comparison.max_difference_arcsec > DEGREE2_ONLY_AT_LEAST_ARCSEC

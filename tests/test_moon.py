@@ -44,3 +44,26 @@ def test_one_year_attitude_against_de421(model, bound):
 def test_comparison_detects_a_missing_degree_three_field():
     comparison = compare_with_de421(moon_at_de421(model="core-corrected", degree=2), ONE_YEAR_DAYS, 5.0)
     assert comparison.max_difference_arcsec > DEGREE2_ONLY_AT_LEAST_ARCSEC
+
+
+def test_cli_moon_last_line_and_files(tmp_path, capsys):
+    from astropy.table import Table
+
+    from spinorbit import cli
+
+    table_path, plot_path = tmp_path / "moon.ecsv", tmp_path / "moon.png"
+    status = cli.main(["moon", "--span", "30", "d", "--model", "rigid", "--output", str(table_path),
+                       "--plot", str(plot_path)])
+    assert status == 0
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert last.startswith("max attitude difference vs DE421: ") and last.endswith(" arcsec over 30 d")
+    table = Table.read(table_path, format="ascii.ecsv")
+    assert len(table) == 31 and table["attitude_difference"].unit == "arcsec"
+    assert plot_path.stat().st_size > 0
+
+
+def test_cli_moon_refuses_a_span_past_the_model_range(capsys):
+    from spinorbit import cli
+
+    assert cli.main(["moon", "--span", "200", "yr"]) == cli.EXIT_USAGE
+    assert "up to 50 yr" in capsys.readouterr().err

@@ -67,3 +67,19 @@ def test_cli_moon_refuses_a_span_past_the_model_range(capsys):
 
     assert cli.main(["moon", "--span", "200", "yr"]) == cli.EXIT_USAGE
     assert "up to 50 yr" in capsys.readouterr().err
+
+
+#: Longer spans (slow): bounds ≈ 15 % above the measured maxima (rigid 6.92″ / 11.3″,
+#: core-corrected 0.857″ / 1.38″), so that a regression shows while step-sequence noise does not.
+LONG_SPAN_BOUNDS_ARCSEC = {
+    ("rigid", 5): 8.0, ("core-corrected", 5): 1.0,
+    ("rigid", 20): 13.0, ("core-corrected", 20): 1.6,
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("model", "years"), sorted(LONG_SPAN_BOUNDS_ARCSEC))
+def test_long_span_attitude_against_de421(model, years):
+    step = 5.0 if years == 5 else 10.0
+    comparison = compare_with_de421(moon_at_de421(model=model), years * ONE_YEAR_DAYS, step)
+    assert comparison.max_difference_arcsec < LONG_SPAN_BOUNDS_ARCSEC[(model, years)]

@@ -318,6 +318,16 @@ def figure_field_without_monopole_xyz(x, y, z, mu, body):
     the Sun acting on the Moon is ~1e-3 of the true solar torque and made an adaptive integrator
     shrink its steps 100-fold. It is also the back-reaction an N-body code adds to its point masses.
     """
+    return figure_field_to_degree_xyz(x, y, z, mu, body, int(body[BODY_NMAX]))
+
+
+@jit(inline="always")
+def figure_field_to_degree_xyz(x, y, z, mu, body, n_max):
+    """:func:`figure_field_without_monopole_xyz` truncated at degree ``min(n_max, figure's n_max)``.
+
+    For distant perturbers whose degree ≥ 3 torque is negligible (the Sun on the Moon: (R/r) ~ 1e-5
+    of its own degree-2 torque), so that the allocating Stokes recursion is skipped for them.
+    """
     a_mom, b_mom, c_mom = body[BODY_A], body[BODY_B], body[BODY_C]
     rr = x * x + y * y + z * z
     dist = math.sqrt(rr)
@@ -334,7 +344,7 @@ def figure_field_without_monopole_xyz(x, y, z, mu, body):
     gx = radial * x + k * ix
     gy = radial * y + k * iy
     gz = radial * z + k * iz
-    n_max = int(body[BODY_NMAX])
+    n_max = min(n_max, int(body[BODY_NMAX]))
     if n_max >= 3:
         r = np.array([x, y, z])
         u_s, g_s = stokes_force_function_and_gradient(r, mu, body, 3, n_max)

@@ -40,6 +40,10 @@ ARCSEC_PER_RAD = 180.0 * 3600.0 / np.pi
 #: BS tolerance (eps_abs = eps_rel) for the lunar runs: the shared note measured 1e-13 for
 #: ephemeris-grade orbits; the state is O(1) (q, ω ≈ 0.23 rad/day, positions ≲ 40 au).
 DEFAULT_TOLERANCE = 1e-13
+#: Perturbers that see the lunar field's degrees 3–4 by default. For the Sun the degree-3 torque is
+#: (R_Moon/1 au) ~ 1e-5 of its degree-2 torque; for the planets less. Measured: limiting degrees 3–4
+#: to Earth changes the 1-year comparison by < 0.001″ and halves the wall time (docs/coupling.md).
+FULL_FIELD_PERTURBERS = ("Earth",)
 
 
 def moon_figure(moon_mass: float, model: str = "rigid", degree: int = 4) -> np.ndarray:
@@ -84,7 +88,8 @@ def moon_figure(moon_mass: float, model: str = "rigid", degree: int = 4) -> np.n
 
 
 def moon_at_de421(epoch=None, model: str = "rigid", degree: int = 4, coupled: bool = True,
-                  bodies=DEFAULT_BODIES, perturbers=None, tolerance: float = DEFAULT_TOLERANCE):
+                  bodies=DEFAULT_BODIES, perturbers=None, tolerance: float = DEFAULT_TOLERANCE,
+                  full_field_perturbers=FULL_FIELD_PERTURBERS):
     """A DE421 simulation with the Moon's rotation attached (BS, EIH + Earth J2 on the orbits).
 
     Parameters
@@ -101,6 +106,9 @@ def moon_at_de421(epoch=None, model: str = "rigid", degree: int = 4, coupled: bo
         Particles torquing the lunar figure; default all others (Sun, planets, Earth).
     tolerance : float
         BS eps_abs = eps_rel.
+    full_field_perturbers : sequence of str or None
+        Perturbers that see degrees 3..``degree``; the others see degree 2 only. None: all see the
+        full field.
 
     Returns
     -------
@@ -115,8 +123,14 @@ def moon_at_de421(epoch=None, model: str = "rigid", degree: int = 4, coupled: bo
     moon = sim.particles["Moon"]
     figure = moon_figure(moon.m, model, degree)
     state = np.concatenate([quaternion, omega])
+    if perturbers is None:
+        perturbers = [p.name for p in sim.particles if p.name != "Moon"]
+    degrees = None
+    if full_field_perturbers is not None:
+        wanted = {name.capitalize() for name in full_field_perturbers}
+        degrees = [degree if name.capitalize() in wanted else 2 for name in perturbers]
     return CoupledRigidBody(sim, "Moon", figure, state, perturbers=perturbers, coupled=coupled,
-                            earth_j2=True, gr=True)
+                            earth_j2=True, gr=True, perturber_degrees=degrees)
 
 
 @dataclass

@@ -455,7 +455,7 @@ def perturber_positions(sim, body: str, perturbers=None):
 from rebound.ode import ODE as _ODE  # noqa: E402  (kept next to the code that reads its layout)
 
 from ..core.dynamics import body_frame_xyz, kinematics_and_euler_into  # noqa: E402
-from ..core.gravity_field import FIGURE_SIZE, figure_field_without_monopole_xyz  # noqa: E402
+from ..core.gravity_field import BODY_NMAX, FIGURE_SIZE, figure_field_to_degree_xyz  # noqa: E402
 
 _ODE_WORDS = ctypes.sizeof(_ODE) // _WORD
 _ODE_REF_WORD = _ODE.ref.offset // _WORD
@@ -477,7 +477,8 @@ ROTATION_STATE_SIZE = 7
 _R_BODY, _R_COUPLED, _R_N_PERTURBERS, _R_ERROR, _R_N_EXPECTED, _R_USE_EXTRA, _R_ODE, _R_ERROR_T = range(8)
 _R_EXTRA = 8  # the install_extra_forces parameter block (_N_PARAMETERS floats)
 _R_PERTURBERS = _R_EXTRA + _N_PARAMETERS
-_R_MODEL = _R_PERTURBERS + MAX_PERTURBERS  # the figure array (gravity_field.make_body)
+_R_DEGREES = _R_PERTURBERS + MAX_PERTURBERS  # highest field degree each perturber sees
+_R_MODEL = _R_DEGREES + MAX_PERTURBERS  # the figure array (gravity_field.make_body)
 _R_SIZE = _R_MODEL + FIGURE_SIZE
 
 #: Error codes the cfuncs write into the parameter block (0: no error).
@@ -581,7 +582,8 @@ def _figure_torque_and_reaction(words, sim_address, p, y, apply_reaction):
         rz = particles[b + _X + 2] - particles[body + _X + 2]
         x, yy, z = body_frame_xyz(q0, q1, q2, q3, rx, ry, rz)
         # Degrees ≥ 2 only: the monopole has no torque and REBOUND's point-mass gravity has it.
-        _, gx, gy, gz = figure_field_without_monopole_xyz(x, yy, z, g, model)
+        degree = np.int64(p[_R_DEGREES + k])
+        _, gx, gy, gz = figure_field_to_degree_xyz(x, yy, z, g, model, degree)
         m_p = particles[b + _M]
         nx += m_p * (gy * z - gz * yy)
         ny += m_p * (gz * x - gx * z)
@@ -670,6 +672,12 @@ class RotationHooks:
         y[:] = np.asarray(value, dtype=float)
 
     @property
+    def perturber_degrees(self) -> tuple:
+        """Highest degree of the figure's field each perturber sees (in perturber order)."""
+        count = int(self.parameters[_R_N_PERTURBERS])
+        return tuple(int(d) for d in self.parameters[_R_DEGREES:_R_DEGREES + count])
+
+    @property
     def figure(self) -> np.ndarray:
         """The figure array (``gravity_field.make_body`` layout) in simulation units (view)."""
         return self.parameters[_R_MODEL:_R_MODEL + FIGURE_SIZE]
@@ -687,7 +695,8 @@ class RotationHooks:
 
 
 def attach_rotation_hooks(sim, body: str, perturbers, figure, state, coupled: bool = True,
-                          earth_j2: bool = False, gr: bool = False, earth_pole=(0.0, 0.0, 1.0)):
+                          earth_j2: bool = False, gr: bool = False, earth_pole=(0.0, 0.0, 1.0),
+                          degrees=None):
     """Integrate the rotation of ``body`` together with the orbits of ``sim`` (BS + one user ODE).
 
     Parameters
@@ -708,6 +717,9 @@ def attach_rotation_hooks(sim, body: str, perturbers, figure, state, coupled: bo
         Add the figure's back-reaction to the orbits (energy and total angular momentum conserved).
     earth_j2, gr, earth_pole
         As in :func:`install_extra_forces`; they run in the same compiled force, before the reaction.
+    degrees : sequence of int, optional
+        Highest degree of the figure's field each perturber sees (torque and reaction alike, so
+        conservation holds); default: the figure's own n_max for all.
 
     Returns
     -------
@@ -753,6 +765,11 @@ def attach_rotation_hooks(sim, body: str, perturbers, figure, state, coupled: bo
     parameters[_R_N_EXPECTED] = sim.N
     parameters[_R_PERTURBERS:_R_PERTURBERS + len(indices)] = indices
     parameters[_R_MODEL:] = figure
+    n_max = int(figure[BODY_NMAX])
+    degrees = [n_max] * len(indices) if degrees is None else [int(d) for d in degrees]
+    if len(degrees) != len(indices) or any(d < 2 for d in degrees):
+        raise ValueError(f"degrees: expected one degree ≥ 2 per perturber, got {degrees!r}.")
+    parameters[_R_DEGREES:_R_DEGREES + len(indices)] = [min(d, n_max) for d in degrees]
     extra = None
     if isinstance(previous, ExtraForces):  # fold forces installed earlier into the combined cfunc
         earth_j2, gr = previous.earth_j2, previous.gr

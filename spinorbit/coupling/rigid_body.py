@@ -53,6 +53,10 @@ class CoupledRigidBody:
         (energy and total angular momentum conserved). False: one-way (orbits ignore the figure).
     earth_j2, gr : bool, optional
         EIH 1PN and Earth J2 on the orbits, in the same compiled force (see ``install_extra_forces``).
+    earth_pole : array_like, shape (3,), optional
+        Earth's figure axis for J2 (inertial unit vector).
+    perturber_degrees : sequence of int, optional
+        Highest degree of the figure's field each perturber sees (default: all of it).
 
     Raises
     ------
@@ -63,7 +67,7 @@ class CoupledRigidBody:
     """
 
     def __init__(self, sim, body, figure, state, perturbers=None, coupled=True, earth_j2=False, gr=False,
-                 earth_pole=(0.0, 0.0, 1.0)):
+                 earth_pole=(0.0, 0.0, 1.0), perturber_degrees=None):
         centre = body_index(sim, body)
         if perturbers is None:
             perturbers = [p.name for i, p in enumerate(sim.particles) if i != centre and p.name]
@@ -74,8 +78,9 @@ class CoupledRigidBody:
         self.earth_pole = tuple(float(v) for v in earth_pole)
         self.hooks: RotationHooks = attach_rotation_hooks(
             sim, body, self.perturbers, figure, state, coupled=coupled, earth_j2=earth_j2, gr=gr,
-            earth_pole=earth_pole,
+            earth_pole=earth_pole, degrees=perturber_degrees,
         )
+        self.perturber_degrees = self.hooks.perturber_degrees
 
     # ---------------------------------------------------------------------------------------
     @property
@@ -171,6 +176,7 @@ class CoupledRigidBody:
                     body=np.str_(self.body),
                     perturbers=np.array(self.perturbers, dtype=str),
                     flags=np.array([self.coupled, self.earth_j2, self.gr]),
+                    perturber_degrees=np.array(self.perturber_degrees, dtype=np.int64),
                     earth_pole=np.array(self.earth_pole),
                 )
             os.replace(temporary, path)
@@ -203,4 +209,5 @@ class CoupledRigidBody:
         coupled, earth_j2, gr = (bool(v) for v in contents["flags"])
         return cls(sim, str(contents["body"]), contents["figure"], contents["rotation_state"],
                    perturbers=[str(n) for n in contents["perturbers"]], coupled=coupled,
-                   earth_j2=earth_j2, gr=gr, earth_pole=contents["earth_pole"])
+                   earth_j2=earth_j2, gr=gr, earth_pole=contents["earth_pole"],
+                   perturber_degrees=[int(d) for d in contents["perturber_degrees"]])

@@ -72,7 +72,8 @@ def test_one_way_equals_coupled_when_the_reaction_is_negligible():
     coupled, one_way = _system(True, **small), _system(False, **small)
     for body in (coupled, one_way):
         body.integrate(3 * ORBIT_PERIOD)
-    # Difference set by the figure/monopole force ratio (~1e-9) times the orbit's phase sensitivity.
+    # Difference set by the figure/monopole force ratio (~1e-9) times the orbit's phase sensitivity;
+    # measured 1.4e-10 (rotation state) and 2.4e-9 (position): bounds 40× above the larger.
     assert np.max(np.abs(coupled.state - one_way.state)) < 1e-7
     position = [np.array(b.sim.particles["Body"].xyz) for b in (coupled, one_way)]
     assert np.linalg.norm(position[0] - position[1]) < 1e-7

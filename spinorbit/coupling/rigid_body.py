@@ -106,6 +106,7 @@ class CoupledRigidBody:
 
     @property
     def figure(self) -> np.ndarray:
+        """The figure array (``gravity_field.make_body`` layout, simulation units), a copy."""
         return self.hooks.figure.copy()
 
     def integrate(self, t) -> None:

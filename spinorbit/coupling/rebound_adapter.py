@@ -479,7 +479,8 @@ _R_EXTRA = 8  # the install_extra_forces parameter block (_N_PARAMETERS floats)
 _R_PERTURBERS = _R_EXTRA + _N_PARAMETERS
 _R_DEGREES = _R_PERTURBERS + MAX_PERTURBERS  # highest field degree each perturber sees
 _R_MODEL = _R_DEGREES + MAX_PERTURBERS  # the figure array (gravity_field.make_body)
-_R_SIZE = _R_MODEL + FIGURE_SIZE
+_R_PSEUDO = _R_MODEL + FIGURE_SIZE  # IAS15 route only: index of the first pseudo-particle
+_R_SIZE = _R_PSEUDO + 1
 
 #: Error codes the cfuncs write into the parameter block (0: no error).
 ERROR_PARTICLE_COUNT = 1.0
@@ -764,7 +765,7 @@ def attach_rotation_hooks(sim, body: str, perturbers, figure, state, coupled: bo
     parameters[_R_N_PERTURBERS] = len(indices)
     parameters[_R_N_EXPECTED] = sim.N
     parameters[_R_PERTURBERS:_R_PERTURBERS + len(indices)] = indices
-    parameters[_R_MODEL:] = figure
+    parameters[_R_MODEL:_R_MODEL + FIGURE_SIZE] = figure
     n_max = int(figure[BODY_NMAX])
     degrees = [n_max] * len(indices) if degrees is None else [int(d) for d in degrees]
     if len(degrees) != len(indices) or any(d < 2 for d in degrees):
@@ -801,4 +802,130 @@ def attach_rotation_hooks(sim, body: str, perturbers, figure, state, coupled: bo
         # EIH depends on velocities; the back-reaction depends on the ODE stage, which BS evaluates
         # with the N-body state anyway. The flag is harmless for BS and needed if IAS15 is ever used.
         sim.force_is_velocity_dependent = 1
+    return hooks
+
+
+# ============================================================================================
+# The IAS15 route, kept for measurement against BS (docs/coupling.md): the quaternion and its rate
+# ride in two massless pseudo-particles after the real bodies (N_active = real bodies):
+# a: (x, y, z) = (q0, q1, q2), b: x = q3 (y = z = 0); velocities are q̇. A last-running force
+# overwrites their accelerations with q̈ from the same torque kernel and Euler equations.
+# --------------------------------------------------------------------------------------------
+PSEUDO_PARTICLE_NAMES = ("_spinorbit_q012", "_spinorbit_q3")
+
+
+@intrinsic
+def _pointer_address(typingctx, pointer):
+    """The integer address of a pointer (to hand the simulation's address to the error path)."""
+    if not isinstance(pointer, types.CPointer):
+        return None
+    signature = types.uint64(pointer)
+
+    def codegen(context, builder, sig, args):
+        return builder.ptrtoint(args[0], context.get_value_type(types.uint64))
+
+    return signature, codegen
+
+
+@cfunc(types.void(types.CPointer(types.uint64)), cache=True)
+def _pseudo_particle_forces_cfunc(simulation):
+    """``additional_forces`` of the IAS15 route: EIH + J2, back-reaction, then q̈ on the pseudo-particles."""
+    words = carray(simulation, _SIM_WORDS)
+    p = carray(_as_float64_pointer(words[_SIM_EXTRAS_WORD]), _R_SIZE)
+    if p[_R_USE_EXTRA] != 0.0:
+        _apply_extra_forces(words, p[_R_EXTRA:_R_EXTRA + _N_PARAMETERS])
+    n = np.int64(words[_SIM_N_WORD])
+    if n != np.int64(p[_R_N_EXPECTED]):
+        _stop_with_error(words, _pointer_address(simulation), p, ERROR_PARTICLE_COUNT)
+        return
+    particles = carray(_as_float64_pointer(words[_SIM_PARTICLES_WORD]), n * _PARTICLE_WORDS)
+    a = np.int64(p[_R_PSEUDO]) * _PARTICLE_WORDS
+    b = a + _PARTICLE_WORDS
+    q0, q1, q2, q3 = particles[a + _X], particles[a + _X + 1], particles[a + _X + 2], particles[b + _X]
+    d0, d1, d2, d3 = particles[a + _VX], particles[a + _VX + 1], particles[a + _VX + 2], particles[b + _VX]
+    norm2 = q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3
+    # ω = 2 vec(conj(q) ⊗ q̇) / |q|²
+    y = np.empty(ROTATION_STATE_SIZE)
+    y[0], y[1], y[2], y[3] = q0, q1, q2, q3
+    y[4] = 2.0 * (q0 * d1 - d0 * q1 - (q2 * d3 - q3 * d2)) / norm2
+    y[5] = 2.0 * (q0 * d2 - d0 * q2 - (q3 * d1 - q1 * d3)) / norm2
+    y[6] = 2.0 * (q0 * d3 - d0 * q3 - (q1 * d2 - q2 * d1)) / norm2
+    nx, ny, nz = _figure_torque_and_reaction(words, _pointer_address(simulation), p, y, p[_R_COUPLED] != 0.0)
+    dy = np.empty(ROTATION_STATE_SIZE)
+    kinematics_and_euler_into(y, nx, ny, nz, p[_R_MODEL:_R_MODEL + FIGURE_SIZE], dy)
+    wx, wy, wz, ex, ey, ez = y[4], y[5], y[6], dy[4], dy[5], dy[6]
+    # q̈ = ½ q̇ ⊗ (0, ω) + ½ q ⊗ (0, ω̇);  (s, v) ⊗ (0, w) = (−v·w, s w + v × w)
+    particles[a + _AX] = 0.5 * (-(d1 * wx + d2 * wy + d3 * wz) - (q1 * ex + q2 * ey + q3 * ez))
+    particles[a + _AX + 1] = 0.5 * (d0 * wx + d2 * wz - d3 * wy + q0 * ex + q2 * ez - q3 * ey)
+    particles[a + _AX + 2] = 0.5 * (d0 * wy + d3 * wx - d1 * wz + q0 * ey + q3 * ex - q1 * ez)
+    particles[b + _AX] = 0.5 * (d0 * wz + d1 * wy - d2 * wx + q0 * ez + q1 * ey - q2 * ex)
+    particles[b + _AX + 1] = 0.0
+    particles[b + _AX + 2] = 0.0
+
+
+class PseudoParticleHooks(RotationHooks):
+    """What :func:`attach_rotation_ias15` installed (IAS15 route); ``state`` is read from the particles."""
+
+    sim: object = None
+
+    @property
+    def state(self) -> np.ndarray:
+        pa, pb = (self.sim.particles[name] for name in PSEUDO_PARTICLE_NAMES)
+        q = np.array([pa.x, pa.y, pa.z, pb.x])
+        d = np.array([pa.vx, pa.vy, pa.vz, pb.vx])
+        omega = 2.0 * (q[0] * d[1:] - d[0] * q[1:] - np.cross(q[1:], d[1:])) / np.dot(q, q)
+        return np.concatenate([q, omega])
+
+
+def attach_rotation_ias15(sim, body: str, perturbers, figure, state, coupled: bool = True,
+                          earth_j2: bool = False, gr: bool = False, earth_pole=(0.0, 0.0, 1.0)):
+    """The IAS15 route (for measurements): rotation in two massless pseudo-particles.
+
+    Same parameters as :func:`attach_rotation_hooks` (integrator must be 'ias15'; two particles are
+    appended and ``N_active`` set to the real bodies; adaptive mode GLOBAL). Returns
+    :class:`PseudoParticleHooks`. Not part of the public workflow: ``CoupledRigidBody`` uses BS.
+    """
+    if str(sim.integrator) != "ias15":
+        raise ForceInstallError(f"attach_rotation_ias15 needs sim.integrator = 'ias15', got {sim.integrator!r}.")
+    if getattr(sim, "_afp", None) is not None or sim.extras:
+        raise ForceInstallError("additional forces are already installed on this simulation.")
+    y0 = np.asarray(state, dtype=float)
+    q, omega = y0[:4], y0[4:]
+    # q̇ = ½ q ⊗ (0, ω)
+    q_dot = 0.5 * np.array([-np.dot(q[1:], omega), *(q[0] * omega + np.cross(q[1:], omega))])
+    n_real = sim.N
+    sim.add(m=0.0, x=q[0], y=q[1], z=q[2], vx=q_dot[0], vy=q_dot[1], vz=q_dot[2], name=PSEUDO_PARTICLE_NAMES[0])
+    sim.add(m=0.0, x=q[3], vx=q_dot[3], name=PSEUDO_PARTICLE_NAMES[1])
+    sim.N_active = n_real
+    sim.testparticle_type = 0
+    sim.integrator.adaptive_mode = "global"
+    parameters = np.zeros(_R_SIZE)
+    centre = body_index(sim, body)
+    indices = [body_index(sim, name) for name in perturbers]
+    parameters[_R_BODY] = centre
+    parameters[_R_COUPLED] = float(coupled)
+    parameters[_R_N_PERTURBERS] = len(indices)
+    parameters[_R_N_EXPECTED] = sim.N
+    parameters[_R_PERTURBERS:_R_PERTURBERS + len(indices)] = indices
+    parameters[_R_MODEL:_R_MODEL + FIGURE_SIZE] = figure
+    n_max = int(figure[BODY_NMAX])
+    parameters[_R_DEGREES:_R_DEGREES + len(indices)] = n_max
+    parameters[_R_PSEUDO] = n_real
+    extra = None
+    if earth_j2 or gr:
+        probe = rebound.Simulation()
+        probe.add(m=1.0, name="Earth")
+        extra = install_extra_forces(probe, earth_j2=earth_j2, gr=gr, earth_pole=earth_pole)
+        if earth_j2:
+            extra.parameters[_P_EARTH] = body_index(sim, "earth")
+        parameters[_R_EXTRA:_R_EXTRA + _N_PARAMETERS] = extra.parameters
+        parameters[_R_USE_EXTRA] = 1.0
+    forces = _ADDITIONAL_FORCES_TYPE(_pseudo_particle_forces_cfunc.address)
+    hooks = PseudoParticleHooks(parameters, None, bool(coupled), extra, (forces, _pseudo_particle_forces_cfunc))
+    hooks.sim = sim
+    sim._afp = hooks
+    sim._extras_ref = parameters
+    sim.extras = parameters.ctypes.data
+    sim._additional_forces = forces
+    sim.force_is_velocity_dependent = 1
     return hooks

@@ -1,6 +1,7 @@
 """REBOUND behind one adapter: offline DE421 simulations, compiled extra forces, perturber reads.
 
-This module owns every raw pointer the package hands to REBOUND (``docs/ephemeris.md``):
+This module owns every raw pointer the package hands to REBOUND (``docs/ephemeris.md``,
+``docs/coupling.md``):
 
 - :func:`simulation_from_de421` builds a ``rebound.Simulation`` from DE421 at an astropy ``Time``,
   offline: units ("AU", "day", "Msun") so that G = k² = DE421's GM_Sun; masses GM/G; ``sim.t`` in
@@ -13,6 +14,10 @@ This module owns every raw pointer the package hands to REBOUND (``docs/ephemeri
   of all bodies on each other.
   The cfunc reads its parameters through ``sim.extras``; every object C can reach (cfunc, pointer,
   parameter array) is kept alive on the simulation object for its whole life.
+- :func:`attach_rotation_hooks` integrates a rigid body's rotation (q, ω) with the orbits: a BS user
+  ODE whose ``derivatives`` and a combined ``additional_forces`` (EIH + J2 + the figure's
+  back-reaction) are raw cfuncs sharing one parameter block; :func:`attach_rotation_ias15` is the
+  measured alternative (rotation in two pseudo-particles under IAS15).
 - :func:`perturber_positions` reads positions relative to a named body straight out of REBOUND's
   particle array into numpy (body-centric, au, at ``sim.t`` in TDB days since J2000): the input the
   rotation integrators consume for their torques.
@@ -44,6 +49,13 @@ __all__ = [
     "install_extra_forces",
     "body_index",
     "perturber_positions",
+    "RotationCallbackError",
+    "RotationHooks",
+    "attach_rotation_hooks",
+    "PseudoParticleHooks",
+    "attach_rotation_ias15",
+    "MAX_PERTURBERS",
+    "ROTATION_STATE_SIZE",
 ]
 
 #: Bodies of :func:`simulation_from_de421` by default: Sun, the planets (system barycentres as DE421
@@ -870,6 +882,7 @@ class PseudoParticleHooks(RotationHooks):
 
     @property
     def state(self) -> np.ndarray:
+        """(q0..q3, ωx, ωy, ωz) from the pseudo-particles: ω = 2 vec(conj(q) ⊗ q̇)/|q|² (rad/time)."""
         pa, pb = (self.sim.particles[name] for name in PSEUDO_PARTICLE_NAMES)
         q = np.array([pa.x, pa.y, pa.z, pb.x])
         d = np.array([pa.vx, pa.vy, pa.vz, pb.vx])

@@ -31,7 +31,8 @@ import math
 import numpy as np
 
 from ._jit import jit
-from .gravity_field import BODY_A, BODY_B, BODY_C, FIGURE_SIZE, figure_force_function_and_gradient_xyz, make_body
+from .gravity_field import (BODY_A, BODY_B, BODY_C, BODY_MASS, FIGURE_SIZE, figure_field_without_monopole_xyz,
+                            make_body)
 from .perturbers import PERTURBER_ROW, pack_perturbers, perturber_position_xyz
 
 STATE_SIZE = 7
@@ -101,8 +102,11 @@ def force_function_and_torque_xyz(t, q0, q1, q2, q3, model):
         row = MODEL_PERTURBERS + 1 + k * PERTURBER_ROW
         ix, iy, iz = perturber_position_xyz(t, model, row)
         x, y, z = body_frame_xyz(q0, q1, q2, q3, ix, iy, iz)
-        u_k, gx, gy, gz = figure_force_function_and_gradient_xyz(x, y, z, model[row + 1], model)
-        u += u_k
+        # Torque from the field without the monopole: its radial gradient has no torque but would
+        # add rounding noise (see gravity_field.figure_field_without_monopole_xyz).
+        mu = model[row + 1]
+        u_k, gx, gy, gz = figure_field_without_monopole_xyz(x, y, z, mu, model)
+        u += u_k + mu * model[BODY_MASS] / math.sqrt(x * x + y * y + z * z)
         # N = (∂U/∂r) × r
         nx += gy * z - gz * y
         ny += gz * x - gx * z
@@ -132,13 +136,26 @@ def force_function(t, q, model):
 @jit(inline="always")
 def rhs_into(t, y, model, dy):
     """Write dy/dt into ``dy`` (no allocation; the integrators' inner call)."""
-    a_mom, b_mom, c_mom = model[BODY_A], model[BODY_B], model[BODY_C]
     q0, q1, q2, q3 = y[0], y[1], y[2], y[3]
-    wx, wy, wz = y[4], y[5], y[6]
     if model[MODEL_PERTURBERS] > 0.0:
         _, nx, ny, nz = force_function_and_torque_xyz(t, q0, q1, q2, q3, model)
     else:
         nx = ny = nz = 0.0
+    kinematics_and_euler_into(y, nx, ny, nz, model, dy)
+
+
+@jit(inline="always")
+def kinematics_and_euler_into(y, nx, ny, nz, model, dy):
+    """dy/dt for a given body-frame torque N: q̇ = ½ q ⊗ (0, ω) and Euler's equations.
+
+    The one place where the equations of motion are written; :func:`rhs_into` (torque from the
+    perturber table) and the REBOUND coupling (torque from the simulation's particles, see
+    ``spinorbit/coupling/rebound_adapter.py``) both end here. ``model`` needs only the figure head
+    (A, B, C at BODY_A..BODY_C).
+    """
+    a_mom, b_mom, c_mom = model[BODY_A], model[BODY_B], model[BODY_C]
+    q0, q1, q2, q3 = y[0], y[1], y[2], y[3]
+    wx, wy, wz = y[4], y[5], y[6]
     # q̇ = ½ q ⊗ (0, ω)
     dy[0] = 0.5 * (-q1 * wx - q2 * wy - q3 * wz)
     dy[1] = 0.5 * (q0 * wx + q2 * wz - q3 * wy)

@@ -300,28 +300,51 @@ def figure_force_function_and_gradient_xyz(x, y, z, mu, body):
     """Scalar form of :func:`figure_force_function_and_gradient`: returns (U, ∂U/∂x, ∂U/∂y, ∂U/∂z).
 
     The hot path of the right-hand side; allocates nothing unless Stokes terms (degree ≥ 3) are on.
+    Degree 0 (μ m_b / R) plus :func:`figure_field_without_monopole_xyz`.
+    """
+    u, gx, gy, gz = figure_field_without_monopole_xyz(x, y, z, mu, body)
+    rr = x * x + y * y + z * z
+    dist = math.sqrt(rr)
+    radial = -mu * body[BODY_MASS] / (rr * dist)
+    return u + mu * body[BODY_MASS] / dist, gx + radial * x, gy + radial * y, gz + radial * z
+
+
+@jit(inline="always")
+def figure_field_without_monopole_xyz(x, y, z, mu, body):
+    """(U, ∂U/∂x, ∂U/∂y, ∂U/∂z) of degrees 2..n_max only, i.e. without μ m_b / R.
+
+    What the torque must be computed from: the monopole gradient is radial, so its torque is zero
+    analytically, but in floating point (∂U₀/∂r) × r leaves rounding noise of ε·μ m_b / R, which for
+    the Sun acting on the Moon is ~1e-3 of the true solar torque and made an adaptive integrator
+    shrink its steps 100-fold. It is also the back-reaction an N-body code adds to its point masses.
+    """
+    return figure_field_to_degree_xyz(x, y, z, mu, body, int(body[BODY_NMAX]))
+
+
+@jit(inline="always")
+def figure_field_to_degree_xyz(x, y, z, mu, body, n_max):
+    """:func:`figure_field_without_monopole_xyz` truncated at degree ``min(n_max, figure's n_max)``.
+
+    For distant perturbers whose degree ≥ 3 torque is negligible (the Sun on the Moon: (R/r) ~ 1e-5
+    of its own degree-2 torque), so that the allocating Stokes recursion is skipped for them.
     """
     a_mom, b_mom, c_mom = body[BODY_A], body[BODY_B], body[BODY_C]
-    mass = body[BODY_MASS]
     rr = x * x + y * y + z * z
     dist = math.sqrt(rr)
     inv_r3 = 1.0 / (rr * dist)
     inv_r5 = inv_r3 / rr
-    # Degree 0: U0 = μ m_b / R.
-    u = mu * mass / dist
-    radial = -mu * mass * inv_r3
     # Degree 2 (MacCullagh): U2 = μ/(2R³) tr I − (3μ/2R⁵) rᵀ I r;
     # ∂U2/∂r = [−(3μ/2R⁵) tr I + (15μ/2R⁷) rᵀIr] r − (3μ/R⁵) I r.
     ix, iy, iz = a_mom * x, b_mom * y, c_mom * z
     r_i_r = x * ix + y * iy + z * iz
     trace = a_mom + b_mom + c_mom
-    u += 0.5 * mu * trace * inv_r3 - 1.5 * mu * r_i_r * inv_r5
-    radial += -1.5 * mu * trace * inv_r5 + 7.5 * mu * r_i_r * inv_r5 / rr
+    u = 0.5 * mu * trace * inv_r3 - 1.5 * mu * r_i_r * inv_r5
+    radial = -1.5 * mu * trace * inv_r5 + 7.5 * mu * r_i_r * inv_r5 / rr
     k = -3.0 * mu * inv_r5
     gx = radial * x + k * ix
     gy = radial * y + k * iy
     gz = radial * z + k * iz
-    n_max = int(body[BODY_NMAX])
+    n_max = min(n_max, int(body[BODY_NMAX]))
     if n_max >= 3:
         r = np.array([x, y, z])
         u_s, g_s = stokes_force_function_and_gradient(r, mu, body, 3, n_max)

@@ -1,6 +1,7 @@
 """REBOUND behind one adapter: offline DE421 simulations, compiled extra forces, perturber reads.
 
-This module owns every raw pointer the package hands to REBOUND (``docs/ephemeris.md``):
+This module owns every raw pointer the package hands to REBOUND (``docs/ephemeris.md``,
+``docs/coupling.md``):
 
 - :func:`simulation_from_de421` builds a ``rebound.Simulation`` from DE421 at an astropy ``Time``,
   offline: units ("AU", "day", "Msun") so that G = k² = DE421's GM_Sun; masses GM/G; ``sim.t`` in
@@ -13,6 +14,10 @@ This module owns every raw pointer the package hands to REBOUND (``docs/ephemeri
   of all bodies on each other.
   The cfunc reads its parameters through ``sim.extras``; every object C can reach (cfunc, pointer,
   parameter array) is kept alive on the simulation object for its whole life.
+- :func:`attach_rotation_hooks` integrates a rigid body's rotation (q, ω) with the orbits: a BS user
+  ODE whose ``derivatives`` and a combined ``additional_forces`` (EIH + J2 + the figure's
+  back-reaction) are raw cfuncs sharing one parameter block; :func:`attach_rotation_ias15` is the
+  measured alternative (rotation in two pseudo-particles under IAS15).
 - :func:`perturber_positions` reads positions relative to a named body straight out of REBOUND's
   particle array into numpy (body-centric, au, at ``sim.t`` in TDB days since J2000): the input the
   rotation integrators consume for their torques.
@@ -31,6 +36,7 @@ import rebound
 from numba import carray, cfunc, types
 from numba.extending import intrinsic
 
+from ..core._jit import jit
 from ..ephemeris import barycentric_state_au, de421_constants
 from ..time import tdb_day_and_fraction
 
@@ -43,6 +49,13 @@ __all__ = [
     "install_extra_forces",
     "body_index",
     "perturber_positions",
+    "RotationCallbackError",
+    "RotationHooks",
+    "attach_rotation_hooks",
+    "PseudoParticleHooks",
+    "attach_rotation_ias15",
+    "MAX_PERTURBERS",
+    "ROTATION_STATE_SIZE",
 ]
 
 #: Bodies of :func:`simulation_from_de421` by default: Sun, the planets (system barycentres as DE421
@@ -121,17 +134,16 @@ def _word_as_float64(typingctx, word):
     return signature, codegen
 
 
-@cfunc(types.void(types.CPointer(types.uint64)), cache=True)
-def _extra_forces_cfunc(simulation):
-    """Earth J2 on all bodies (+ reaction on Earth) and the EIH 1PN accelerations, in place.
+@jit
+def _apply_extra_forces(words, p):
+    """The body of :func:`_extra_forces_cfunc`, callable from any cfunc that owns ``additional_forces``.
 
-    ``simulation`` is REBOUND's ``struct reb_simulation*``, viewed as 64-bit words. Accelerations
-    are *added* to ``ax, ay, az``, which REBOUND has filled with Newtonian gravity already.
+    ``words``: the simulation struct as 64-bit words; ``p``: the extra-force parameter block
+    (``_N_PARAMETERS`` floats). Shared so that the rigid-body coupling's combined force
+    (``rotation_coupling``) runs exactly the same EIH + J2 code.
     """
-    words = carray(simulation, _SIM_WORDS)
     n = np.int64(words[_SIM_N_WORD])
     particles = carray(_as_float64_pointer(words[_SIM_PARTICLES_WORD]), n * _PARTICLE_WORDS)
-    p = carray(_as_float64_pointer(words[_SIM_EXTRAS_WORD]), _N_PARAMETERS)
     earth = np.int64(p[_P_EARTH]) * _PARTICLE_WORDS
     correction = np.zeros((n, 3))  # 1PN accelerations × c², added after J2 (see below)
 
@@ -219,6 +231,18 @@ def _extra_forces_cfunc(simulation):
             particles[bi + _AX] += correction[i, 0] / c2
             particles[bi + _AX + 1] += correction[i, 1] / c2
             particles[bi + _AX + 2] += correction[i, 2] / c2
+
+
+@cfunc(types.void(types.CPointer(types.uint64)), cache=True)
+def _extra_forces_cfunc(simulation):
+    """Earth J2 on all bodies (+ reaction on Earth) and the EIH 1PN accelerations, in place.
+
+    ``simulation`` is REBOUND's ``struct reb_simulation*``, viewed as 64-bit words. Accelerations
+    are *added* to ``ax, ay, az``, which REBOUND has filled with Newtonian gravity already.
+    """
+    words = carray(simulation, _SIM_WORDS)
+    p = carray(_as_float64_pointer(words[_SIM_EXTRAS_WORD]), _N_PARAMETERS)
+    _apply_extra_forces(words, p)
 
 
 # The ctypes type of the struct field itself: assigning an instance of it stores the raw address.
@@ -425,3 +449,496 @@ def perturber_positions(sim, body: str, perturbers=None):
     gm = table[index, _M] * sim.G
     names = tuple(sim.particles[i].name for i in indices)
     return positions, gm, names
+
+
+# ============================================================================================
+# Rigid-body rotation coupled to the orbits (BS integrator + one user ODE, docs/coupling.md).
+#
+# Two raw cfuncs share one float64 parameter block (``RotationHooks.parameters``):
+# - ``_rotation_derivatives_cfunc`` is the user ODE's ``derivatives``: (q̇, ω̇) of the body from the
+#   particles' positions at the current BS stage (REBOUND updates the particle array before calling
+#   it when ``needs_nbody`` is set);
+# - ``_coupled_forces_cfunc`` is ``additional_forces``: the EIH + Earth-J2 forces of
+#   :func:`install_extra_forces` (if asked for), then the figure's back-reaction on the orbits, read
+#   from the ODE's *current stage* ``y1`` (not ``y``, which is the state at the start of the step).
+# Both call :func:`_figure_torque_and_reaction`, so torque and back-reaction come from the same
+# gravity-field kernel (``gravity_field.figure_force_function_and_gradient_xyz``).
+# --------------------------------------------------------------------------------------------
+from rebound.ode import ODE as _ODE  # noqa: E402  (kept next to the code that reads its layout)
+
+from ..core.dynamics import body_frame_xyz, kinematics_and_euler_into  # noqa: E402
+from ..core.gravity_field import BODY_NMAX, FIGURE_SIZE, figure_field_to_degree_xyz  # noqa: E402
+
+_ODE_WORDS = ctypes.sizeof(_ODE) // _WORD
+_ODE_REF_WORD = _ODE.ref.offset // _WORD
+_ODE_Y_WORD = _ODE.y.offset // _WORD
+_ODE_Y1_WORD = _ODE._y1.offset // _WORD
+_ODE_SIM_WORD = _ODE.r.offset // _WORD
+_SIM_STATUS_BYTE = rebound.Simulation._status.offset
+_SIM_T_BYTE = rebound.Simulation.t.offset
+assert ctypes.sizeof(dict(rebound.Simulation._fields_)["_status"]) == 4, "sim.status is not a C int"
+#: REBOUND's REB_STATUS_USER: ``integrate`` returns quietly; the Python side then raises our error.
+_REB_STATUS_USER = 5
+
+#: Most perturbers acting on one figure (the parameter block has a fixed size).
+MAX_PERTURBERS = 64
+#: Length of the rotation state (q0..q3, ωx, ωy, ωz).
+ROTATION_STATE_SIZE = 7
+
+# Parameter block (float64) shared by both cfunc: named offsets.
+_R_BODY, _R_COUPLED, _R_N_PERTURBERS, _R_ERROR, _R_N_EXPECTED, _R_USE_EXTRA, _R_ODE, _R_ERROR_T = range(8)
+_R_EXTRA = 8  # the install_extra_forces parameter block (_N_PARAMETERS floats)
+_R_PERTURBERS = _R_EXTRA + _N_PARAMETERS
+_R_DEGREES = _R_PERTURBERS + MAX_PERTURBERS  # highest field degree each perturber sees
+_R_MODEL = _R_DEGREES + MAX_PERTURBERS  # the figure array (gravity_field.make_body)
+_R_PSEUDO = _R_MODEL + FIGURE_SIZE  # IAS15 route only: index of the first pseudo-particle
+_R_SIZE = _R_PSEUDO + 1
+
+#: Error codes the cfuncs write into the parameter block (0: no error).
+ERROR_PARTICLE_COUNT = 1.0
+ERROR_NONFINITE_STATE = 2.0
+ERROR_MESSAGES = {
+    ERROR_PARTICLE_COUNT: "the number of particles changed after the rigid body was attached "
+    "(particle indices in the coupling are stale); attach the body after adding or removing particles",
+    ERROR_NONFINITE_STATE: "the rotation state became NaN or infinite (check the initial state, the "
+    "moments and the step-size tolerances)",
+}
+
+
+class RotationCallbackError(RuntimeError):
+    """A compiled rotation callback found a problem during ``sim.integrate``; the run was stopped."""
+
+
+@intrinsic
+def _as_uint64_pointer(typingctx, address):
+    """Reinterpret an integer address as ``uint64*`` (a struct viewed as 64-bit words)."""
+    if not isinstance(address, types.Integer):
+        return None
+    signature = types.CPointer(types.uint64)(address)
+
+    def codegen(context, builder, sig, args):
+        return builder.inttoptr(args[0], context.get_value_type(types.CPointer(types.uint64)))
+
+    return signature, codegen
+
+
+@intrinsic
+def _as_int32_pointer(typingctx, address):
+    """Reinterpret an integer address as ``int32*`` (to write REBOUND's C-int ``status``)."""
+    if not isinstance(address, types.Integer):
+        return None
+    signature = types.CPointer(types.int32)(address)
+
+    def codegen(context, builder, sig, args):
+        return builder.inttoptr(args[0], context.get_value_type(types.CPointer(types.int32)))
+
+    return signature, codegen
+
+
+@intrinsic
+def _float64_bits(typingctx, value):
+    """The bits of a double as a uint64 (the ODE address is stored bit-exactly in the float block)."""
+    if not isinstance(value, types.Float):
+        return None
+    signature = types.uint64(value)
+
+    def codegen(context, builder, sig, args):
+        return builder.bitcast(args[0], context.get_value_type(types.uint64))
+
+    return signature, codegen
+
+
+@jit
+def _stop_with_error(words, sim_address, p, code):
+    """Record ``code`` (first error wins) and ask REBOUND to stop the run (status = REB_STATUS_USER)."""
+    if p[_R_ERROR] == 0.0:
+        p[_R_ERROR] = code
+        p[_R_ERROR_T] = carray(_as_float64_pointer(sim_address + _SIM_T_BYTE), 1)[0]
+    status = carray(_as_int32_pointer(sim_address + _SIM_STATUS_BYTE), 1)
+    status[0] = _REB_STATUS_USER
+
+
+@jit
+def _figure_torque_and_reaction(words, sim_address, p, y, apply_reaction):
+    """Body-frame torque (Nx, Ny, Nz) on the figure from the chosen particles; optionally the reaction.
+
+    Units: positions au, G·m au³/day², moments Msun·au², so the torque is Msun·au²/day².
+    For each perturber with mass m_p at body-frame r, U = G m_p ∫dm/|r − ρ| and
+    F_p = ∂U/∂r (``gravity_field``); the kernel is called with μ = G, i.e. per unit perturber mass,
+    so a massless perturber also feels the figure. Torque N = m_p (∂U₁/∂r) × r. The reaction
+    (``apply_reaction``) adds ∂U₁/∂r, rotated to ICRF, to the perturber's acceleration and
+    −(m_p/m_b) times it to the body's; the field excludes the monopole (REBOUND already has the
+    point-mass part, and the monopole only adds rounding noise to the torque). Sets an error code
+    and stops the run if the particle count changed or y is not finite.
+    """
+    n = np.int64(words[_SIM_N_WORD])
+    if n != np.int64(p[_R_N_EXPECTED]):
+        _stop_with_error(words, sim_address, p, ERROR_PARTICLE_COUNT)
+        return 0.0, 0.0, 0.0
+    for i in range(ROTATION_STATE_SIZE):
+        if not np.isfinite(y[i]):
+            _stop_with_error(words, sim_address, p, ERROR_NONFINITE_STATE)
+            return 0.0, 0.0, 0.0
+    particles = carray(_as_float64_pointer(words[_SIM_PARTICLES_WORD]), n * _PARTICLE_WORDS)
+    model = p[_R_MODEL:_R_MODEL + FIGURE_SIZE]
+    g = _word_as_float64(words[_SIM_G_WORD])
+    body = np.int64(p[_R_BODY]) * _PARTICLE_WORDS
+    m_body = particles[body + _M]
+    q0, q1, q2, q3 = y[0], y[1], y[2], y[3]
+    nx = 0.0
+    ny = 0.0
+    nz = 0.0
+    for k in range(np.int64(p[_R_N_PERTURBERS])):
+        b = np.int64(p[_R_PERTURBERS + k]) * _PARTICLE_WORDS
+        rx = particles[b + _X] - particles[body + _X]
+        ry = particles[b + _X + 1] - particles[body + _X + 1]
+        rz = particles[b + _X + 2] - particles[body + _X + 2]
+        x, yy, z = body_frame_xyz(q0, q1, q2, q3, rx, ry, rz)
+        # Degrees ≥ 2 only: the monopole has no torque and REBOUND's point-mass gravity has it.
+        degree = np.int64(p[_R_DEGREES + k])
+        _, gx, gy, gz = figure_field_to_degree_xyz(x, yy, z, g, model, degree)
+        m_p = particles[b + _M]
+        nx += m_p * (gy * z - gz * yy)
+        ny += m_p * (gz * x - gx * z)
+        nz += m_p * (gx * yy - gy * x)
+        if apply_reaction:
+            # Body → ICRF: M(q) v = body_frame_xyz with the conjugate quaternion.
+            ax, ay, az = body_frame_xyz(q0, -q1, -q2, -q3, gx, gy, gz)
+            particles[b + _AX] += ax
+            particles[b + _AX + 1] += ay
+            particles[b + _AX + 2] += az
+            ratio = m_p / m_body
+            particles[body + _AX] -= ratio * ax
+            particles[body + _AX + 1] -= ratio * ay
+            particles[body + _AX + 2] -= ratio * az
+    return nx, ny, nz
+
+
+_DERIVATIVES_SIGNATURE = types.void(
+    types.CPointer(types.uint64), types.CPointer(types.float64), types.CPointer(types.float64), types.float64
+)
+
+
+@cfunc(_DERIVATIVES_SIGNATURE, cache=True)
+def _rotation_derivatives_cfunc(ode, y_dot, y, t):
+    """User-ODE ``derivatives``: (q̇, ω̇) with the torque from the particles at this BS stage."""
+    ode_words = carray(ode, _ODE_WORDS)
+    p = carray(_as_float64_pointer(ode_words[_ODE_REF_WORD]), _R_SIZE)
+    sim_address = ode_words[_ODE_SIM_WORD]
+    words = carray(_as_uint64_pointer(sim_address), _SIM_WORDS)
+    state = carray(y, ROTATION_STATE_SIZE)
+    out = carray(y_dot, ROTATION_STATE_SIZE)
+    nx, ny, nz = _figure_torque_and_reaction(words, sim_address, p, state, False)
+    kinematics_and_euler_into(state, nx, ny, nz, p[_R_MODEL:_R_MODEL + FIGURE_SIZE], out)
+
+
+@cfunc(types.void(types.CPointer(types.uint64)), cache=True)
+def _coupled_forces_cfunc(simulation):
+    """``additional_forces``: EIH + Earth J2 (if on), then the figure's back-reaction (if coupled)."""
+    words = carray(simulation, _SIM_WORDS)
+    p = carray(_as_float64_pointer(words[_SIM_EXTRAS_WORD]), _R_SIZE)
+    if p[_R_USE_EXTRA] != 0.0:
+        _apply_extra_forces(words, p[_R_EXTRA:_R_EXTRA + _N_PARAMETERS])
+    if p[_R_COUPLED] != 0.0:
+        ode_words = carray(_as_uint64_pointer(_float64_bits(p[_R_ODE])), _ODE_WORDS)
+        # The ODE's current BS stage lives in y1; before the first step y1 is not allocated yet.
+        address = ode_words[_ODE_Y1_WORD]
+        if address == 0:
+            address = ode_words[_ODE_Y_WORD]
+        state = carray(_as_float64_pointer(address), ROTATION_STATE_SIZE)
+        _figure_torque_and_reaction(words, ode_words[_ODE_SIM_WORD], p, state, True)
+
+
+_ODE_DERIVATIVES_TYPE = dict(_ODE._fields_)["_derivatives"]
+
+
+@dataclass
+class RotationHooks:
+    """What :func:`attach_rotation_hooks` installed; kept on the simulation for its whole life.
+
+    Attributes
+    ----------
+    parameters : ndarray
+        The float64 block both cfuncs read (``sim.extras`` and the ODE's ``ref`` point to it).
+    ode : rebound.ODE
+        The user ODE holding (q0, q1, q2, q3, ωx, ωy, ωz); ω in rad/day, q body → ICRF.
+    coupled : bool
+        True: the figure's back-reaction acts on the orbits; False: one-way (orbits do not feel it).
+    extra : ExtraForces or None
+        The EIH + Earth-J2 parameters folded into the combined force, if any.
+    """
+
+    parameters: np.ndarray
+    ode: object
+    coupled: bool
+    extra: ExtraForces | None
+    _keep_alive: tuple = ()
+
+    @property
+    def state(self) -> np.ndarray:
+        """A copy of the rotation state y = (q, ω) at ``sim.t`` (q body → ICRF, ω body axes rad/day)."""
+        return np.ctypeslib.as_array(self.ode.y, shape=(ROTATION_STATE_SIZE,)).copy()
+
+    @state.setter
+    def state(self, value) -> None:
+        y = np.ctypeslib.as_array(self.ode.y, shape=(ROTATION_STATE_SIZE,))
+        y[:] = np.asarray(value, dtype=float)
+
+    @property
+    def perturber_degrees(self) -> tuple:
+        """Highest degree of the figure's field each perturber sees (in perturber order)."""
+        count = int(self.parameters[_R_N_PERTURBERS])
+        return tuple(int(d) for d in self.parameters[_R_DEGREES:_R_DEGREES + count])
+
+    @property
+    def figure(self) -> np.ndarray:
+        """The figure array (``gravity_field.make_body`` layout) in simulation units (view)."""
+        return self.parameters[_R_MODEL:_R_MODEL + FIGURE_SIZE]
+
+    def raise_if_failed(self) -> None:
+        """Raise :class:`RotationCallbackError` if a cfunc recorded an error during the last run."""
+        code = float(self.parameters[_R_ERROR])
+        if code != 0.0:
+            when = float(self.parameters[_R_ERROR_T])
+            self.parameters[_R_ERROR] = 0.0
+            raise RotationCallbackError(
+                f"rotation callback stopped the run at t = {when!r} (TDB days since J2000 for DE421 "
+                f"simulations): {ERROR_MESSAGES.get(code, f'unknown error code {code}')}."
+            )
+
+
+def attach_rotation_hooks(sim, body: str, perturbers, figure, state, coupled: bool = True,
+                          earth_j2: bool = False, gr: bool = False, earth_pole=(0.0, 0.0, 1.0),
+                          degrees=None):
+    """Integrate the rotation of ``body`` together with the orbits of ``sim`` (BS + one user ODE).
+
+    Parameters
+    ----------
+    sim : rebound.Simulation
+        Integrator must be 'bs' (the only one in which a user ODE and the N-body equations are one
+        system; see ``docs/coupling.md``). Any units; the figure must be in the same units.
+    body : str
+        Name of the particle carrying the figure.
+    perturbers : sequence of str
+        Particles whose gravity torques the figure (and, if ``coupled``, feels it).
+    figure : ndarray
+        ``gravity_field.make_body`` array: moments in (sim mass)·(sim length)², mass = the particle's
+        mass, reference radius in sim length.
+    state : array_like, shape (7,)
+        (q0, q1, q2, q3, ωx, ωy, ωz): q body → inertial (scalar first), ω body axes, rad/(sim time).
+    coupled : bool
+        Add the figure's back-reaction to the orbits (energy and total angular momentum conserved).
+    earth_j2, gr, earth_pole
+        As in :func:`install_extra_forces`; they run in the same compiled force, before the reaction.
+    degrees : sequence of int, optional
+        Highest degree of the figure's field each perturber sees (torque and reaction alike, so
+        conservation holds); default: the figure's own n_max for all.
+
+    Returns
+    -------
+    RotationHooks
+
+    Raises
+    ------
+    ForceInstallError
+        Integrator is not BS, hooks already attached, REBOUNDx present, or too many perturbers.
+    MissingBodyError
+        ``body`` or a perturber is not in ``sim``.
+    """
+    if str(sim.integrator) != "bs":
+        raise ForceInstallError(
+            f"the rotation can only be coupled with the 'bs' integrator, got {sim.integrator!r}: other "
+            "integrators advance user ODEs after the N-body step with the particles frozen (a 13 degree "
+            "attitude error in a year for the Moon). Set sim.integrator = 'bs' first."
+        )
+    if isinstance(getattr(sim, "_afp", None), RotationHooks):
+        raise ForceInstallError("a rigid body is already attached to this simulation (one per simulation).")
+    previous = getattr(sim, "_afp", None)
+    if sim.extras and not isinstance(previous, ExtraForces):
+        raise ForceInstallError(
+            "sim.extras is already set (is REBOUNDx attached?); the coupling needs additional_forces itself."
+        )
+    centre = body_index(sim, body)
+    indices = [body_index(sim, name) for name in perturbers]
+    if centre in indices:
+        raise ValueError(f"the body {body!r} cannot perturb itself; remove it from perturbers.")
+    if len(indices) > MAX_PERTURBERS:
+        raise ForceInstallError(f"at most {MAX_PERTURBERS} perturbers, got {len(indices)}.")
+    figure = np.asarray(figure, dtype=float)
+    if figure.shape != (FIGURE_SIZE,):
+        raise ValueError(f"figure: expected a gravity_field.make_body array of {FIGURE_SIZE} floats.")
+    y0 = np.asarray(state, dtype=float)
+    if y0.shape != (ROTATION_STATE_SIZE,) or not np.all(np.isfinite(y0)):
+        raise ValueError(f"state: expected 7 finite numbers (q0..q3, wx, wy, wz), got {state!r}.")
+
+    parameters = np.zeros(_R_SIZE)
+    parameters[_R_BODY] = centre
+    parameters[_R_COUPLED] = float(coupled)
+    parameters[_R_N_PERTURBERS] = len(indices)
+    parameters[_R_N_EXPECTED] = sim.N
+    parameters[_R_PERTURBERS:_R_PERTURBERS + len(indices)] = indices
+    parameters[_R_MODEL:_R_MODEL + FIGURE_SIZE] = figure
+    n_max = int(figure[BODY_NMAX])
+    degrees = [n_max] * len(indices) if degrees is None else [int(d) for d in degrees]
+    if len(degrees) != len(indices) or any(d < 2 for d in degrees):
+        raise ValueError(f"degrees: expected one degree ≥ 2 per perturber, got {degrees!r}.")
+    parameters[_R_DEGREES:_R_DEGREES + len(indices)] = [min(d, n_max) for d in degrees]
+    extra = None
+    if isinstance(previous, ExtraForces):  # fold forces installed earlier into the combined cfunc
+        earth_j2, gr = previous.earth_j2, previous.gr
+        earth_pole = previous.parameters[_P_POLE:_P_POLE + 3]
+    if earth_j2 or gr:
+        probe = rebound.Simulation()  # fill the EIH/J2 block with install_extra_forces' own code
+        probe.add(m=1.0, name="Earth")
+        extra = install_extra_forces(probe, earth_j2=earth_j2, gr=gr, earth_pole=earth_pole)
+        if earth_j2:
+            extra.parameters[_P_EARTH] = body_index(sim, "earth")
+        parameters[_R_EXTRA:_R_EXTRA + _N_PARAMETERS] = extra.parameters
+        parameters[_R_USE_EXTRA] = 1.0
+
+    ode = sim.create_ode(length=ROTATION_STATE_SIZE, needs_nbody=True)
+    y = np.ctypeslib.as_array(ode.y, shape=(ROTATION_STATE_SIZE,))
+    y[:] = y0
+    parameters[_R_ODE:_R_ODE + 1] = np.array([ctypes.addressof(ode)], dtype=np.uint64).view(np.float64)
+    derivatives = _ODE_DERIVATIVES_TYPE(_rotation_derivatives_cfunc.address)
+    forces = _ADDITIONAL_FORCES_TYPE(_coupled_forces_cfunc.address)
+    hooks = RotationHooks(parameters, ode, bool(coupled), extra,
+                          (derivatives, forces, _rotation_derivatives_cfunc, _coupled_forces_cfunc))
+    ode.ref = parameters.ctypes.data
+    ode._derivatives = derivatives
+    sim._afp = hooks  # keep-alive in REBOUND's own slots (see install_extra_forces)
+    sim._extras_ref = parameters
+    sim.extras = parameters.ctypes.data
+    sim._additional_forces = forces
+    if gr or coupled:
+        # EIH depends on velocities; the back-reaction depends on the ODE stage, which BS evaluates
+        # with the N-body state anyway. The flag is harmless for BS and needed if IAS15 is ever used.
+        sim.force_is_velocity_dependent = 1
+    return hooks
+
+
+# ============================================================================================
+# The IAS15 route, kept for measurement against BS (docs/coupling.md): the quaternion and its rate
+# ride in two massless pseudo-particles after the real bodies (N_active = real bodies):
+# a: (x, y, z) = (q0, q1, q2), b: x = q3 (y = z = 0); velocities are q̇. A last-running force
+# overwrites their accelerations with q̈ from the same torque kernel and Euler equations.
+# --------------------------------------------------------------------------------------------
+PSEUDO_PARTICLE_NAMES = ("_spinorbit_q012", "_spinorbit_q3")
+
+
+@intrinsic
+def _pointer_address(typingctx, pointer):
+    """The integer address of a pointer (to hand the simulation's address to the error path)."""
+    if not isinstance(pointer, types.CPointer):
+        return None
+    signature = types.uint64(pointer)
+
+    def codegen(context, builder, sig, args):
+        return builder.ptrtoint(args[0], context.get_value_type(types.uint64))
+
+    return signature, codegen
+
+
+@cfunc(types.void(types.CPointer(types.uint64)), cache=True)
+def _pseudo_particle_forces_cfunc(simulation):
+    """``additional_forces`` of the IAS15 route: EIH + J2, back-reaction, then q̈ on the pseudo-particles."""
+    words = carray(simulation, _SIM_WORDS)
+    p = carray(_as_float64_pointer(words[_SIM_EXTRAS_WORD]), _R_SIZE)
+    if p[_R_USE_EXTRA] != 0.0:
+        _apply_extra_forces(words, p[_R_EXTRA:_R_EXTRA + _N_PARAMETERS])
+    n = np.int64(words[_SIM_N_WORD])
+    if n != np.int64(p[_R_N_EXPECTED]):
+        _stop_with_error(words, _pointer_address(simulation), p, ERROR_PARTICLE_COUNT)
+        return
+    particles = carray(_as_float64_pointer(words[_SIM_PARTICLES_WORD]), n * _PARTICLE_WORDS)
+    a = np.int64(p[_R_PSEUDO]) * _PARTICLE_WORDS
+    b = a + _PARTICLE_WORDS
+    q0, q1, q2, q3 = particles[a + _X], particles[a + _X + 1], particles[a + _X + 2], particles[b + _X]
+    d0, d1, d2, d3 = particles[a + _VX], particles[a + _VX + 1], particles[a + _VX + 2], particles[b + _VX]
+    norm2 = q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3
+    # ω = 2 vec(conj(q) ⊗ q̇) / |q|²
+    y = np.empty(ROTATION_STATE_SIZE)
+    y[0], y[1], y[2], y[3] = q0, q1, q2, q3
+    y[4] = 2.0 * (q0 * d1 - d0 * q1 - (q2 * d3 - q3 * d2)) / norm2
+    y[5] = 2.0 * (q0 * d2 - d0 * q2 - (q3 * d1 - q1 * d3)) / norm2
+    y[6] = 2.0 * (q0 * d3 - d0 * q3 - (q1 * d2 - q2 * d1)) / norm2
+    nx, ny, nz = _figure_torque_and_reaction(words, _pointer_address(simulation), p, y, p[_R_COUPLED] != 0.0)
+    dy = np.empty(ROTATION_STATE_SIZE)
+    kinematics_and_euler_into(y, nx, ny, nz, p[_R_MODEL:_R_MODEL + FIGURE_SIZE], dy)
+    wx, wy, wz, ex, ey, ez = y[4], y[5], y[6], dy[4], dy[5], dy[6]
+    # q̈ = ½ q̇ ⊗ (0, ω) + ½ q ⊗ (0, ω̇);  (s, v) ⊗ (0, w) = (−v·w, s w + v × w)
+    particles[a + _AX] = 0.5 * (-(d1 * wx + d2 * wy + d3 * wz) - (q1 * ex + q2 * ey + q3 * ez))
+    particles[a + _AX + 1] = 0.5 * (d0 * wx + d2 * wz - d3 * wy + q0 * ex + q2 * ez - q3 * ey)
+    particles[a + _AX + 2] = 0.5 * (d0 * wy + d3 * wx - d1 * wz + q0 * ey + q3 * ex - q1 * ez)
+    particles[b + _AX] = 0.5 * (d0 * wz + d1 * wy - d2 * wx + q0 * ez + q1 * ey - q2 * ex)
+    particles[b + _AX + 1] = 0.0
+    particles[b + _AX + 2] = 0.0
+
+
+class PseudoParticleHooks(RotationHooks):
+    """What :func:`attach_rotation_ias15` installed (IAS15 route); ``state`` is read from the particles."""
+
+    sim: object = None
+
+    @property
+    def state(self) -> np.ndarray:
+        """(q0..q3, ωx, ωy, ωz) from the pseudo-particles: ω = 2 vec(conj(q) ⊗ q̇)/|q|² (rad/time)."""
+        pa, pb = (self.sim.particles[name] for name in PSEUDO_PARTICLE_NAMES)
+        q = np.array([pa.x, pa.y, pa.z, pb.x])
+        d = np.array([pa.vx, pa.vy, pa.vz, pb.vx])
+        omega = 2.0 * (q[0] * d[1:] - d[0] * q[1:] - np.cross(q[1:], d[1:])) / np.dot(q, q)
+        return np.concatenate([q, omega])
+
+
+def attach_rotation_ias15(sim, body: str, perturbers, figure, state, coupled: bool = True,
+                          earth_j2: bool = False, gr: bool = False, earth_pole=(0.0, 0.0, 1.0)):
+    """The IAS15 route (for measurements): rotation in two massless pseudo-particles.
+
+    Same parameters as :func:`attach_rotation_hooks` (integrator must be 'ias15'; two particles are
+    appended and ``N_active`` set to the real bodies; adaptive mode GLOBAL). Returns
+    :class:`PseudoParticleHooks`. Not part of the public workflow: ``CoupledRigidBody`` uses BS.
+    """
+    if str(sim.integrator) != "ias15":
+        raise ForceInstallError(f"attach_rotation_ias15 needs sim.integrator = 'ias15', got {sim.integrator!r}.")
+    if getattr(sim, "_afp", None) is not None or sim.extras:
+        raise ForceInstallError("additional forces are already installed on this simulation.")
+    y0 = np.asarray(state, dtype=float)
+    q, omega = y0[:4], y0[4:]
+    # q̇ = ½ q ⊗ (0, ω)
+    q_dot = 0.5 * np.array([-np.dot(q[1:], omega), *(q[0] * omega + np.cross(q[1:], omega))])
+    n_real = sim.N
+    sim.add(m=0.0, x=q[0], y=q[1], z=q[2], vx=q_dot[0], vy=q_dot[1], vz=q_dot[2], name=PSEUDO_PARTICLE_NAMES[0])
+    sim.add(m=0.0, x=q[3], vx=q_dot[3], name=PSEUDO_PARTICLE_NAMES[1])
+    sim.N_active = n_real
+    sim.testparticle_type = 0
+    sim.integrator.adaptive_mode = "global"
+    parameters = np.zeros(_R_SIZE)
+    centre = body_index(sim, body)
+    indices = [body_index(sim, name) for name in perturbers]
+    parameters[_R_BODY] = centre
+    parameters[_R_COUPLED] = float(coupled)
+    parameters[_R_N_PERTURBERS] = len(indices)
+    parameters[_R_N_EXPECTED] = sim.N
+    parameters[_R_PERTURBERS:_R_PERTURBERS + len(indices)] = indices
+    parameters[_R_MODEL:_R_MODEL + FIGURE_SIZE] = figure
+    n_max = int(figure[BODY_NMAX])
+    parameters[_R_DEGREES:_R_DEGREES + len(indices)] = n_max
+    parameters[_R_PSEUDO] = n_real
+    extra = None
+    if earth_j2 or gr:
+        probe = rebound.Simulation()
+        probe.add(m=1.0, name="Earth")
+        extra = install_extra_forces(probe, earth_j2=earth_j2, gr=gr, earth_pole=earth_pole)
+        if earth_j2:
+            extra.parameters[_P_EARTH] = body_index(sim, "earth")
+        parameters[_R_EXTRA:_R_EXTRA + _N_PARAMETERS] = extra.parameters
+        parameters[_R_USE_EXTRA] = 1.0
+    forces = _ADDITIONAL_FORCES_TYPE(_pseudo_particle_forces_cfunc.address)
+    hooks = PseudoParticleHooks(parameters, None, bool(coupled), extra, (forces, _pseudo_particle_forces_cfunc))
+    hooks.sim = sim
+    sim._afp = hooks
+    sim._extras_ref = parameters
+    sim.extras = parameters.ctypes.data
+    sim._additional_forces = forces
+    sim.force_is_velocity_dependent = 1
+    return hooks

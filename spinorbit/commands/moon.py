@@ -1,0 +1,154 @@
+"""``spinorbit moon``: the lunar physical libration from DE421 at J2000, integrated with the orbits."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..cli import CommandError
+from ._common import Progress, atomic_output, check_output_path, quantity
+
+NAME = "moon"
+SUMMARY = "lunar physical libration from DE421 at J2000, coupled to the orbits, compared with DE421"
+DESCRIPTION = """\
+Integrate the Moon's rotation (quaternion + angular velocity, degree 2-4 lunar gravity field from the
+DE421 constants, torques from the Sun, planets and Earth) together with the orbits (REBOUND's BS,
+point masses + EIH 1PN + Earth J2 + the lunar figure's back-reaction), starting from DE421 at J2000,
+and compare the attitude with DE421's librations at every output time.
+
+Models: 'rigid' uses DE421's total moments; 'core-corrected' removes the fluid core's share of the
+polar moment (IFAC) from the moments the mantle's Euler equations see (docs/coupling.md).
+
+The last line printed is 'max attitude difference vs DE421: <x> arcsec over <span>'."""
+EXAMPLES = """\
+examples:
+  spinorbit moon                                   # 1 year, core-corrected model
+  spinorbit moon --span 20 yr --model rigid --step 5 d --output moon.ecsv --plot moon.png
+
+exit status: 0 on success; 2 with a one-line message if the input is wrong or an output file
+cannot be written (nothing is left half-written)."""
+
+#: DE421's librations end in 2050 and (from J2000) the lunar model is meant for decades, not more.
+MAX_SPAN_DAYS = 50 * 365.25
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the options of ``spinorbit moon``."""
+    run = parser.add_argument_group("model and span")
+    run.add_argument("--span", nargs="+", default=["1", "yr"], metavar="SPAN",
+                     help="how long to integrate from J2000, e.g. '1 yr' (default), '20 yr', '200 d'")
+    run.add_argument("--step", nargs="+", default=["1", "d"], metavar="STEP",
+                     help="spacing of the comparison times (default 1 d)")
+    run.add_argument("--model", choices=("rigid", "core-corrected"), default="core-corrected",
+                     help="moments of the whole Moon (rigid) or of the mantle (core-corrected, default)")
+    run.add_argument("--one-way", action="store_true",
+                     help="do not let the lunar figure act back on the orbits (default: fully coupled)")
+    files = parser.add_argument_group("output files")
+    files.add_argument("--output", metavar="FILE.ecsv", help="write time, attitude difference and angles as ECSV")
+    files.add_argument("--plot", metavar="FILE.png", help="plot the difference and the libration (needs matplotlib)")
+
+
+def libration_table(comparison, model: str, coupled: bool):
+    """An astropy Table of a :class:`spinorbit.coupling.moon.LibrationComparison` (units attached)."""
+    import astropy.units as u
+    import numpy as np
+    from astropy.table import Table
+
+    from .. import __version__
+
+    table = Table(meta={
+        "software": f"spinorbit {__version__} moon",
+        "model": model,
+        "coupled": coupled,
+        "reference": "DE421 lunar librations (de421 package via jplephem)",
+        "conventions": "angles passive 3-1-3 ICRF -> mantle, R = R3(psi) R1(theta) R3(phi); "
+                       "difference = rotation from the DE421 frame to the model frame, on DE421 mantle axes",
+    })
+    table["time"] = comparison.times * u.day
+    table["time"].description = "TDB days since J2000"
+    table["attitude_difference"] = comparison.attitude_difference_arcsec * u.arcsec
+    for i, axis in enumerate("xyz"):
+        table[f"difference_{axis}"] = comparison.body_difference_arcsec[:, i] * u.arcsec
+    for i, name in enumerate(("phi", "theta", "psi")):
+        table[f"{name}_model"] = comparison.angles_model[:, i] * u.rad
+        table[f"{name}_de421"] = np.asarray(comparison.angles_de421[:, i]) * u.rad
+    return table
+
+
+def plot_comparison(comparison, path: str, title: str) -> None:
+    """PNG: attitude difference (top) and libration in longitude and inclination (bottom), arcsec."""
+    import numpy as np
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from ..coupling.moon import ARCSEC_PER_RAD
+
+    years = (comparison.times - comparison.times[0]) / 365.25
+    figure = Figure(figsize=(9, 7), layout="constrained")
+    FigureCanvasAgg(figure)
+    top, bottom = figure.subplots(2, 1, sharex=True)
+    top.plot(years, comparison.attitude_difference_arcsec, "k", label="total angle")
+    for i, axis in enumerate("xyz"):
+        top.plot(years, comparison.body_difference_arcsec[:, i], lw=0.8, label=f"about mantle {axis}")
+    top.set_ylabel("model - DE421 [arcsec]")
+    top.set_title(title)
+    top.legend(fontsize="small")
+    for label, angles, style in (("DE421", comparison.angles_de421, "-"), ("model", comparison.angles_model, "--")):
+        longitude = np.unwrap(angles[:, 0]) + np.unwrap(angles[:, 2])
+        trend = np.polyval(np.polyfit(years, longitude, 1), years)
+        bottom.plot(years, (longitude - trend) * ARCSEC_PER_RAD, style, label=f"phi+psi - linear fit ({label})")
+        bottom.plot(years, (angles[:, 1] - np.mean(angles[:, 1])) * ARCSEC_PER_RAD, style,
+                    label=f"theta - mean ({label})")
+    bottom.set_ylabel("libration [arcsec]")
+    bottom.set_xlabel("years since J2000 (TDB)")
+    bottom.legend(fontsize="small")
+    figure.savefig(path, format="png", dpi=120)
+
+
+def run(args) -> int:
+    """Run ``spinorbit moon``; return the exit status."""
+    from ..coupling.moon import compare_with_de421, moon_at_de421
+
+    for option, path in (("--output", args.output), ("--plot", args.plot)):
+        if path is not None:
+            check_output_path(option, path)
+    if args.plot is not None:
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            raise CommandError("--plot needs matplotlib; install it with: pip install 'spinorbit[plot]'") from None
+    span = quantity("--span", args.span, "d", "time", "1 yr")
+    step = quantity("--step", args.step, "d", "time", "1 d").to_value("d")
+    span_days = span.to_value("d")
+    if not 0 < span_days <= MAX_SPAN_DAYS:
+        raise CommandError(f"--span expects a positive duration up to 50 yr, got {' '.join(args.span)}.")
+    if not 0 < step <= span_days:
+        raise CommandError(f"--step expects a positive spacing no longer than --span, got {' '.join(args.step)}.")
+    moon = moon_at_de421(model=args.model, coupled=not args.one_way)
+    count = int(span_days / step + 1e-9) + 1
+    progress = Progress(count, "integrating")
+    done = [0]
+
+    def advance(n):
+        progress.advance(n - done[0])
+        done[0] = n
+
+    try:
+        comparison = compare_with_de421(moon, span_days, step, progress=advance)
+    finally:
+        progress.close()
+    span_text = f"{span.value:g} {span.unit.to_string()}"
+    print(f"model              {args.model}, {'one-way' if args.one_way else 'fully coupled'}")
+    print(f"wall time          {comparison.wall_seconds:.2f} s "
+          f"({comparison.wall_seconds / (span_days / 365.25):.3f} s per simulated year)")
+    print(f"final difference   {comparison.attitude_difference_arcsec[-1]:.3f} arcsec")
+    if args.output is not None:
+        table = libration_table(comparison, args.model, not args.one_way)
+        with atomic_output("--output", args.output) as temporary:
+            table.write(temporary, format="ascii.ecsv", overwrite=True)
+        print(f"wrote              {args.output} ({len(table)} rows)")
+    if args.plot is not None:
+        with atomic_output("--plot", args.plot) as temporary:
+            plot_comparison(comparison, temporary, f"Moon vs DE421, {args.model}, {span_text}")
+        print(f"wrote              {args.plot}")
+    print(f"max attitude difference vs DE421: {comparison.max_difference_arcsec:.3f} arcsec over {span_text}")
+    return 0

@@ -47,15 +47,22 @@ from ._jit import jit
 from .canonical import (
     FLIP_B,
     FLIP_NONE,
+    MO_ARG_PER_S,
+    MO_G_PER_S,
     MO_MODE,
     MO_PARAM_C,
+    MO_PN_COEFF,
     MODE_UNIFORM,
+    elliptic_constants,
     motion_from_elements,
     state_from_elements,
 )
+from .elliptic import MK_K_HI, MK_K_LO, NK_COMPLETE
 from .dynamics import force_function_and_torque_xyz
 from .jacobian import andoyer_jacobian
 from .rotations import matrix_to_quat
+
+TWO_PI = 2.0 * math.pi
 
 # Indices of ∂U/∂(L, G, H, l, g, h).
 DU_L, DU_G, DU_H, DU_SMALL_L, DU_SMALL_G, DU_SMALL_H = range(6)
@@ -205,3 +212,36 @@ def force_function_of_elements(t, elements, model, frame, ic):
     attitude, _ = attitude_and_momentum(elements, ic)
     q = inertial_quaternion(attitude, frame)
     return force_function_and_torque_xyz(t, q[0], q[1], q[2], q[3], model)[0]
+
+
+@jit
+def reduce_phase(elements, ic):
+    """Shift s by whole periods of the torque-free motion into |κ s| ≤ 2K, compensating in z, in place.
+
+    The backward map (eqs. 7–8) is invariant under (s, z) → (s − P, z + Δg) with P = 4K/κ the period
+    of the body momentum in s and Δg = (c/√(ad)) P + C_g · 4Π(n|m) the advance of g over one period
+    (pn(x + 4K) = pn(x) + 4Π). A map with Φ∘T = Φ between two branches of the canonical map Φ is
+    canonical, and K = ½ a S² − U∘Φ is invariant, so eq. (11) is unchanged by it: the shift changes
+    the representation, not the motion. Why shift at all: ∂(l, g)/∂(S, Z) contain terms proportional
+    to s (the dependence of the frequencies on S and Z), so with an unbounded s the RHS of s and z
+    carries oscillations whose amplitude grows with the number of turns, and the steps shrink.
+
+    Returns the number of periods removed (0: nothing done).
+    """
+    work, _ = working_elements(elements)
+    mo = motion_from_elements(work[0], work[1], ic)
+    if mo[MO_MODE] == MODE_UNIFORM or not (mo[MO_PARAM_C] > 0.0):
+        return 0.0
+    mk, pk = elliptic_constants(mo)
+    four_k = 4.0 * (mk[MK_K_HI] + mk[MK_K_LO])
+    arg = work[3] * mo[MO_ARG_PER_S]
+    periods = np.rint(arg / four_k)
+    if periods == 0.0:
+        return 0.0
+    period_s = four_k / mo[MO_ARG_PER_S]
+    advance_g = mo[MO_G_PER_S] * period_s + mo[MO_PN_COEFF] * 4.0 * pk[NK_COMPLETE]
+    shifted = work[3] - periods * period_s
+    elements[3] = -shifted if elements[0] < 0.0 else shifted
+    z = elements[4] + periods * advance_g
+    elements[4] = z - TWO_PI * np.rint(z / TWO_PI)  # z is an angle: keep it in [−π, π] as well
+    return periods

@@ -42,7 +42,7 @@ import numpy as np
 from ._jit import jit
 from .canonical import FLIP_A, FLIP_B, FLIP_C, MODE_UNIFORM, elements_from_state, inertia_constants
 from .dynamics import MODEL_PERTURBERS, validate_state
-from .element_forces import attitude_and_momentum, elements_rhs_into, inertial_quaternion
+from .element_forces import attitude_and_momentum, elements_rhs_into, inertial_quaternion, reduce_phase
 from .errors import SingularElementsError
 from .gravity_field import BODY_A, BODY_B, BODY_C
 from .integrate_quaternion import (
@@ -215,7 +215,7 @@ def _state_at(elements, frame, ic, big_a, big_b, big_c, out):
 
 
 @jit
-def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, first_step):
+def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, first_step, reduce_phases):
     """Adaptive DOP853 on the signed elements with output at ``t_out``.
 
     Parameters
@@ -233,6 +233,8 @@ def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, fir
     max_steps : int
     first_step : float
         > 0, or 0 for automatic.
+    reduce_phases : bool
+        Keep s within half a period of 0 (:func:`spinorbit.core.element_forces.reduce_phase`).
 
     Returns
     -------
@@ -343,6 +345,10 @@ def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, fir
         for i in range(n):
             y[i] = y_new[i]
             f[i] = f_new[i]
+        if reduce_phases and reduce_phase(y, ic) != 0.0:
+            # Same motion, new representation (s, z): its derivative must be re-evaluated.
+            dist = elements_rhs_into(t, y, model, frame, ic, f)
+            stats[STAT_RHS_CALLS] += 1
         status = _singular_status(dist)
         if status != STATUS_SUCCESS and i_out < n_out:
             stats[STAT_STATUS] = status
@@ -426,7 +432,7 @@ def default_element_atol(elements, y0, moments, rtol):
 
 
 def integrate_elements(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=DEFAULT_MAX_STEPS,
-                       first_step=0.0, return_stats=False, return_elements=False):
+                       first_step=0.0, reduce_phases=True, return_stats=False, return_elements=False):
     """Integrate the rotation through the canonical elements (paper eq. 11) with adaptive DOP853.
 
     Same state layout as :func:`spinorbit.core.integrate_quaternion.integrate_quaternion`, so the two
@@ -453,6 +459,9 @@ def integrate_elements(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=DE
     max_steps : int
     first_step : float
         Initial step (time unit), 0 = automatic.
+    reduce_phases : bool
+        Shift s by whole periods back towards 0 after each step (compensated in z; same motion). Off
+        only to measure what it buys: the RHS of s and z then grows with the number of turns.
     return_stats : bool
         Also return ``accepted``, ``rejected``, ``rhs_calls`` and the reference ``frame``.
     return_elements : bool
@@ -500,7 +509,7 @@ def integrate_elements(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=DE
     if not np.all(np.isfinite(atol)) or np.any(atol <= 0):
         raise ValueError(f"atol: expected absolute tolerances > 0 (scalar or 6 values), got {atol.tolist()}.")
     states, els, stats, t_stop = integrate_elements_kernel(el0, t0, t_out, model, frame, atol, int(max_steps),
-                                                           float(first_step))
+                                                           float(first_step), bool(reduce_phases))
     status = int(stats[STAT_STATUS])
     if status in _SINGULAR:
         kind, why = _SINGULAR[status]

@@ -505,7 +505,10 @@ def integrate_elements(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=DE
     el0 = elements_of_state(y0, model, frame)
     if atol is None:
         atol = default_element_atol(el0, y0, moments, float(rtol))
-    atol = np.broadcast_to(np.asarray(atol, dtype=float), (ELEMENT_SIZE,)).copy()
+    atol = np.asarray(atol, dtype=float)
+    if atol.shape not in ((), (ELEMENT_SIZE,)):
+        raise ValueError(f"atol: expected a scalar or 6 values for (S, Z, H, s, z, h), got shape {atol.shape}.")
+    atol = np.broadcast_to(atol, (ELEMENT_SIZE,)).copy()
     if not np.all(np.isfinite(atol)) or np.any(atol <= 0):
         raise ValueError(f"atol: expected absolute tolerances > 0 (scalar or 6 values), got {atol.tolist()}.")
     states, els, stats, t_stop = integrate_elements_kernel(el0, t0, t_out, model, frame, atol, int(max_steps),

@@ -372,9 +372,19 @@ def state_from_elements(elements, flip, ic):
     ``elements`` = (S, Z, H, s, z, h) of the working frame with S ≥ 0; ``flip`` turns the result back
     into the body frame. Returns (attitude (3, 3), momentum (3,)).
     """
-    big_s, big_z, big_h, s, z, h = elements[0], elements[1], elements[2], elements[3], elements[4], elements[5]
-    mo = motion_from_elements(big_s, big_z, ic)
+    mo = motion_from_elements(elements[0], elements[1], ic)
     mk, pk = elliptic_constants(mo)
+    return state_from_elements_motion(elements, flip, mo, mk, pk)
+
+
+@jit
+def state_from_elements_motion(elements, flip, mo, mk, pk):
+    """:func:`state_from_elements` with the motion and elliptic constants of (S, Z) supplied.
+
+    For callers that need them anyway (the element integrator's RHS also builds the Jacobian from
+    them): computing them costs about as much as the rest of the backward map.
+    """
+    big_z, big_h, s, z, h = elements[1], elements[2], elements[3], elements[4], elements[5]
     arg = s * mo[MO_ARG_PER_S]
     mx, my, mz, sin_l, cos_l = body_from_argument(arg, mo, mk)
     g = z + mo[MO_G_PER_S] * s + mo[MO_PN_COEFF] * pn_k(arg, mk, pk)

@@ -56,10 +56,11 @@ from .canonical import (
     elliptic_constants,
     motion_from_elements,
     state_from_elements,
+    state_from_elements_motion,
 )
 from .elliptic import MK_K_HI, MK_K_LO, NK_COMPLETE
 from .dynamics import force_function_and_torque_xyz
-from .jacobian import andoyer_jacobian
+from .jacobian import andoyer_jacobian_motion
 from .rotations import matrix_to_quat
 
 TWO_PI = 2.0 * math.pi
@@ -148,7 +149,11 @@ def singularity_distances(elements, attitude, momentum, ic):
     a separatrix distance of 0.
     """
     work, _ = working_elements(elements)
-    mo = motion_from_elements(work[0], work[1], ic)
+    return _distances(motion_from_elements(work[0], work[1], ic), attitude, momentum)
+
+
+@jit
+def _distances(mo, attitude, momentum):
     sep = 0.0 if mo[MO_MODE] == MODE_UNIFORM else mo[MO_PARAM_C]
     big_g = math.sqrt(momentum[0] ** 2 + momentum[1] ** 2 + momentum[2] ** 2)
     sin_j = math.hypot(momentum[0], momentum[1]) / big_g
@@ -185,11 +190,15 @@ def elements_rhs_into(t, elements, model, frame, ic, dy):
     sep, sin_j, sin_i : float
         :func:`singularity_distances` of the state (computed from quantities the RHS has anyway).
     """
-    attitude, momentum = attitude_and_momentum(elements, ic)
+    # The motion and elliptic constants of (S, Z) once, for both the backward map and the Jacobian.
+    work, flip = working_elements(elements)
+    mo = motion_from_elements(work[0], work[1], ic)
+    mk, pk = elliptic_constants(mo)
+    attitude, momentum = state_from_elements_motion(work, flip, mo, mk, pk)
     q = inertial_quaternion(attitude, frame)
     _, nx, ny, nz = force_function_and_torque_xyz(t, q[0], q[1], q[2], q[3], model)
     du_andoyer = andoyer_gradient_from_torque(attitude, momentum, nx, ny, nz)
-    jac = andoyer_jacobian(elements, ic)
+    jac = andoyer_jacobian_motion(elements, ic, mo, mk)
     du = np.zeros(6)
     for j in range(6):
         acc = 0.0
@@ -203,7 +212,7 @@ def elements_rhs_into(t, elements, model, frame, ic, dy):
     dy[3] = a * elements[0] - du[0]
     dy[4] = -du[1]
     dy[5] = -du[2]
-    return singularity_distances(elements, attitude, momentum, ic)
+    return _distances(mo, attitude, momentum)
 
 
 @jit

@@ -206,9 +206,16 @@ def _working_derivatives(big_s, big_z, s, ic):
     Returns a (3, 3) array: rows L, l, g; columns (value-free) d-derivative at fixed (s, G),
     s-derivative, and (∂X/∂G)* at fixed (d, s).
     """
+    mo = motion_from_elements(big_s, big_z, ic)
+    mk, _ = elliptic_constants(mo)
+    return _working_derivatives_motion(big_s, big_z, s, ic, mo, mk)
+
+
+@jit
+def _working_derivatives_motion(big_s, big_z, s, ic, mo, mk):
+    """:func:`_working_derivatives` with the motion and parameter constants of (S, Z) supplied."""
     a, b, c, a_b, b_c, a_c = ic
     out = np.full((3, 3), np.nan)
-    mo = motion_from_elements(big_s, big_z, ic)
     mode = mo[MO_MODE]
     if (mode != MODE_SAM and mode != MODE_LAM) or mo[MO_PARAM_C] <= 0.0:
         # permanent rotation, or the exact separatrix (m = 1): not covered (docs/theory.md)
@@ -222,7 +229,6 @@ def _working_derivatives(big_s, big_z, s, ic):
     q = mo[MO_PARAM]
     kappa = mo[MO_ARG_PER_S]
     x = kappa * s
-    mk, _ = elliptic_constants(mo)
     amp_z = mo[MO_Z_AMP]  # G √((a−d)/(a−c))
     g_s_direct = mo[MO_G_PER_S]  # c/√(ad)
     g_d_direct = -c * s / (2.0 * d * sqrt_ad)
@@ -299,11 +305,21 @@ def andoyer_jacobian(elements, ic):
     evaluated in (u, m), the LAM parts in (v, μ) = (√m u, 1/m) (module docstring). The 23 zero
     components are exactly zero.
     """
+    big_s, big_z = elements[0], elements[1]
+    mo = motion_from_elements(abs(big_s), big_z, ic)
+    mk, _ = elliptic_constants(mo)
+    return andoyer_jacobian_motion(elements, ic, mo, mk)
+
+
+@jit
+def andoyer_jacobian_motion(elements, ic, mo, mk):
+    """:func:`andoyer_jacobian` with the motion constants of (|S|, Z) and their parameter constants
+    (``motion_from_elements``, ``elliptic_constants``) supplied by a caller that has them already."""
     big_s, big_z, s = elements[0], elements[1], elements[3]
     sense = 1.0
     if big_s < 0.0:
         sense = -1.0
-    part = _working_derivatives(sense * big_s, big_z, sense * s, ic)
+    part = _working_derivatives_motion(sense * big_s, big_z, sense * s, ic, mo, mk)
     jac = np.zeros((6, 6))
     big_s_w = sense * big_s
     a = ic[0]

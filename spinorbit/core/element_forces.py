@@ -55,6 +55,7 @@ from .canonical import (
     MODE_UNIFORM,
     elliptic_constants,
     motion_from_elements,
+    multiply3,
     state_from_elements,
     state_from_elements_motion,
 )
@@ -94,7 +95,7 @@ def attitude_and_momentum(elements, ic):
 @jit
 def inertial_quaternion(attitude, frame):
     """Quaternion (body → inertial) of R_inertial = R_ref · F, F the (3, 3) inertial → reference matrix."""
-    r_inertial = attitude @ frame
+    r_inertial = multiply3(attitude, frame)
     return matrix_to_quat(np.ascontiguousarray(r_inertial.T))
 
 

@@ -21,11 +21,17 @@ Design choices
   ``AUTO_REFERENCE_MIN_SIN_I`` of its z axis, then the inertial frame turned by 90° about x (the
   "auto" rule of :mod:`spinorbit.state`). Fixed for the run.
 * **Error control is absolute on every component**: atol = rtol × (G₀, G₀, G₀, s_scale, 1, 1), with
-  s_scale = a |S₀| / |ω₀| (the change of s in the time the body turns by one radian, so an error
-  of rtol·s_scale in s is an attitude error of about rtol rad). A relative test on s would loosen as
-  s grows secularly (s ≈ a S t), letting the phase error grow with time; on S, Z, H (bounded by G)
-  relative and absolute are the same. s itself is integrated (not s − a S t: S is not constant); its
-  rounding, ulp(s) ≈ 1e-16 |s| per step, is far below the tolerances used for runs of 10⁴ turns.
+  s_scale = a |S₀| / |ω₀| (dimensionless, O(1): s = ∫ a S dt is in rad, and this is its change while
+  the body turns by one radian, so an error of rtol·s_scale in s is an attitude error of about rtol
+  rad). A relative test on s would loosen as s grows secularly (s ≈ a S t), letting the phase error
+  grow with time; on S, Z, H (bounded by G) relative and absolute are the same.
+* **s is kept within half a period of 0**: after every accepted step whole periods P of the free
+  motion are removed from s and the matching advance of g is added to z
+  (:func:`spinorbit.core.element_forces.reduce_phase`, a canonical symmetry of the backward map, so
+  the motion is unchanged). s itself is integrated (not s − a S t: S is not constant), and stays
+  small, so its rounding does not grow with the span either. Without the shift ∂(l, g)/∂(S, Z),
+  hence the RHS of s and z, carry terms proportional to s and the steps shrink as the run goes on
+  (2× more steps on 10³ turns of scene (c)). Element outputs are in the shifted representation.
 * **Singular sets are detected, not crossed**: at the end of each accepted step the RHS reports
   1 − m (or 1 − μ), sin J and sin I; below the ``MIN_*`` constants the run stops with
   :class:`ElementsSingularityError` naming the set and the time. Handing over to the quaternion
@@ -466,10 +472,10 @@ def integrate_elements(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=DE
     rtol : float
         Tolerance, 1e-15 ≤ rtol; the per-step error test is absolute with the scales of
         :func:`default_element_atol`.
-    atol : array_like (6,), optional
-        Absolute tolerances on (S, Z, H, s, z, h) (momentum unit, momentum unit, momentum unit,
-        time·rad⁻¹·… the unit of s = momentum⁻¹·rad... i.e. s·S is an action, rad, rad). Overrides rtol's
-        scales.
+    atol : float or array_like (6,), optional
+        Absolute tolerances on (S, Z, H, s, z, h), in (momentum, momentum, momentum, rad, rad, rad)
+        (s = ∫ a S dt is an angle-like variable, not 2π-periodic). Default
+        :func:`default_element_atol`; when given, it replaces the scales derived from rtol.
     max_steps : int
     first_step : float
         Initial step (time unit), 0 = automatic.

@@ -279,13 +279,25 @@ def node_to_body(sin_l, cos_l, sin_j, cos_j):
 
 
 @jit
+def multiply3(a, b):
+    """a · b for 3×3 arrays, written out: numba sends ``@`` on small matrices to BLAS, whose call
+    overhead (~150 ns) is larger than the 27 multiplications (measured in the element integrator's RHS)."""
+    out = np.empty((3, 3))
+    for i in range(3):
+        a0, a1, a2 = a[i, 0], a[i, 1], a[i, 2]
+        for j in range(3):
+            out[i, j] = a0 * b[0, j] + a1 * b[1, j] + a2 * b[2, j]
+    return out
+
+
+@jit
 def attitude_from_parts(mx, my, mz, big_g, sin_l, cos_l, g, cos_i, sin_i, h):
     """R = R3(l) R1(J) R3(g) R1(I) R3(h), with J from the momentum (sin J = |M⊥|/G, cos J = M_z/G)."""
     w = node_to_body(sin_l, cos_l, math.hypot(mx, my) / big_g, mz / big_g)
     cg, sg = math.cos(g), math.sin(g)
     r3g = np.zeros((3, 3))
     r3g[0, 0], r3g[0, 1], r3g[1, 0], r3g[1, 1], r3g[2, 2] = cg, sg, -sg, cg, 1.0
-    return w @ r3g @ node_frame(cos_i, sin_i, h)
+    return multiply3(multiply3(w, r3g), node_frame(cos_i, sin_i, h))
 
 
 @jit
@@ -372,9 +384,19 @@ def state_from_elements(elements, flip, ic):
     ``elements`` = (S, Z, H, s, z, h) of the working frame with S ≥ 0; ``flip`` turns the result back
     into the body frame. Returns (attitude (3, 3), momentum (3,)).
     """
-    big_s, big_z, big_h, s, z, h = elements[0], elements[1], elements[2], elements[3], elements[4], elements[5]
-    mo = motion_from_elements(big_s, big_z, ic)
+    mo = motion_from_elements(elements[0], elements[1], ic)
     mk, pk = elliptic_constants(mo)
+    return state_from_elements_motion(elements, flip, mo, mk, pk)
+
+
+@jit
+def state_from_elements_motion(elements, flip, mo, mk, pk):
+    """:func:`state_from_elements` with the motion and elliptic constants of (S, Z) supplied.
+
+    For callers that need them anyway (the element integrator's RHS also builds the Jacobian from
+    them): computing them costs about as much as the rest of the backward map.
+    """
+    big_z, big_h, s, z, h = elements[1], elements[2], elements[3], elements[4], elements[5]
     arg = s * mo[MO_ARG_PER_S]
     mx, my, mz, sin_l, cos_l = body_from_argument(arg, mo, mk)
     g = z + mo[MO_G_PER_S] * s + mo[MO_PN_COEFF] * pn_k(arg, mk, pk)

@@ -113,7 +113,7 @@ ZERO_COMPONENTS = (
 
 
 @jit
-def associate_integrals(x, mk, f):
+def associate_integrals(x, mk, f, want_jn=True, want_cn2_t=True):
     """sn, cn, dn of (x | q) and three associate integrals, from one period reduction (0 ≤ q < 1).
 
     Parameters
@@ -140,6 +140,10 @@ def associate_integrals(x, mk, f):
         analytic). On |r| < K: c² (s³/3) R_D(d², 1, c²); each half period adds −2E(q)/q_c to the
         integral (∫ sc² = (sn dn/cn − E(x))/q_c, DLMF 22.16.25 style, with sn dn/cn 2K-periodic).
 
+    want_jn, want_cn2_t : bool
+        False skips that integral (returned as 0.0): its Carlson R_J / R_D is a good part of the cost,
+        and the Jacobian itself needs only jm (SAM) or jm and cn² T (LAM).
+
     Notes
     -----
     Carlson forms: DLMF 19.25.14 family, ∫₀^φ sin²θ dθ/((1 − n sin²θ)Δ) = (s³/3) R_J(c², Δ², 1, 1 − n s²),
@@ -152,14 +156,16 @@ def associate_integrals(x, mk, f):
     s2, c2, d2 = s * s, c * c, d * d
     s3 = s * s2 / 3.0
     jm = s3 * rd(c2, 1.0, d2)
-    jn = s3 * rj(c2, d2, 1.0, 1.0 + f * s2)
+    jn = s3 * rj(c2, d2, 1.0, 1.0 + f * s2) if want_jn else 0.0
     # c² R_D(d², 1, c²) → 0 like |c| at the turning point; R_D itself is infinite there.
-    cn2_t = c2 * s3 * rd(d2, 1.0, c2) if c2 > 0.0 else 0.0
+    cn2_t = c2 * s3 * rd(d2, 1.0, c2) if (want_cn2_t and c2 > 0.0) else 0.0
     if j != 0.0:
         jm += 2.0 * j * rd(0.0, 1.0, qc) / 3.0
-        jn += 2.0 * j * rj(0.0, qc, 1.0, 1.0 + f) / 3.0
-        complete_e = rf(0.0, qc, 1.0) - q * rd(0.0, qc, 1.0) / 3.0
-        cn2_t -= 2.0 * j * c2 * complete_e / qc
+        if want_jn:
+            jn += 2.0 * j * rj(0.0, qc, 1.0, 1.0 + f) / 3.0
+        if want_cn2_t:
+            complete_e = rf(0.0, qc, 1.0) - q * rd(0.0, qc, 1.0) / 3.0
+            cn2_t -= 2.0 * j * c2 * complete_e / qc
     return sign * s, sign * c, d, jm, jn, cn2_t
 
 
@@ -206,9 +212,16 @@ def _working_derivatives(big_s, big_z, s, ic):
     Returns a (3, 3) array: rows L, l, g; columns (value-free) d-derivative at fixed (s, G),
     s-derivative, and (∂X/∂G)* at fixed (d, s).
     """
+    mo = motion_from_elements(big_s, big_z, ic)
+    mk, _ = elliptic_constants(mo)
+    return _working_derivatives_motion(big_s, big_z, s, ic, mo, mk)
+
+
+@jit
+def _working_derivatives_motion(big_s, big_z, s, ic, mo, mk):
+    """:func:`_working_derivatives` with the motion and parameter constants of (S, Z) supplied."""
     a, b, c, a_b, b_c, a_c = ic
     out = np.full((3, 3), np.nan)
-    mo = motion_from_elements(big_s, big_z, ic)
     mode = mo[MO_MODE]
     if (mode != MODE_SAM and mode != MODE_LAM) or mo[MO_PARAM_C] <= 0.0:
         # permanent rotation, or the exact separatrix (m = 1): not covered (docs/theory.md)
@@ -222,13 +235,12 @@ def _working_derivatives(big_s, big_z, s, ic):
     q = mo[MO_PARAM]
     kappa = mo[MO_ARG_PER_S]
     x = kappa * s
-    mk, _ = elliptic_constants(mo)
     amp_z = mo[MO_Z_AMP]  # G √((a−d)/(a−c))
     g_s_direct = mo[MO_G_PER_S]  # c/√(ad)
     g_d_direct = -c * s / (2.0 * d * sqrt_ad)
     if mode == MODE_SAM:
         f = a_b / b_c
-        sn, cn, dn, jm, _, _ = associate_integrals(x, mk, f)
+        sn, cn, dn, jm, _, _ = associate_integrals(x, mk, f, False, False)
         _, _, ddn, dam = jacobi_parameter_derivatives(sn, cn, dn, jm, q)
         x_d = -a * x / (2.0 * d * a_d)
         q_d = f * a_c / (a_d * a_d)
@@ -247,7 +259,7 @@ def _working_derivatives(big_s, big_z, s, ic):
         out[2, 1] = g_s_direct + coeff * kappa * b_c / denom
     else:
         f = a_d / d_c  # −n′ of pn(v, n′|μ); only cn² T is used below
-        sn, cn, dn, jm, _, cn2_t = associate_integrals(x, mk, f)
+        sn, cn, dn, jm, _, cn2_t = associate_integrals(x, mk, f, False, True)
         _, dcn, _, _ = jacobi_parameter_derivatives(sn, cn, dn, jm, q)
         x_d = c * x / (2.0 * d * d_c)
         q_d = -b_c * a_c / (a_b * d_c * d_c)
@@ -299,11 +311,21 @@ def andoyer_jacobian(elements, ic):
     evaluated in (u, m), the LAM parts in (v, μ) = (√m u, 1/m) (module docstring). The 23 zero
     components are exactly zero.
     """
+    big_s, big_z = elements[0], elements[1]
+    mo = motion_from_elements(abs(big_s), big_z, ic)
+    mk, _ = elliptic_constants(mo)
+    return andoyer_jacobian_motion(elements, ic, mo, mk)
+
+
+@jit
+def andoyer_jacobian_motion(elements, ic, mo, mk):
+    """:func:`andoyer_jacobian` with the motion constants of (|S|, Z) and their parameter constants
+    (``motion_from_elements``, ``elliptic_constants``) supplied by a caller that has them already."""
     big_s, big_z, s = elements[0], elements[1], elements[3]
     sense = 1.0
     if big_s < 0.0:
         sense = -1.0
-    part = _working_derivatives(sense * big_s, big_z, sense * s, ic)
+    part = _working_derivatives_motion(sense * big_s, big_z, sense * s, ic, mo, mk)
     jac = np.zeros((6, 6))
     big_s_w = sense * big_s
     a = ic[0]

@@ -43,7 +43,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from .body import RigidBody
 from .core import rotations as _rotations
-from .coupling.rebound_adapter import DEFAULT_BODIES, body_index, simulation_from_de421
+from .coupling.rebound_adapter import DEFAULT_BODIES, body_index, install_extra_forces, simulation_from_de421
 from .ephemeris import barycentric_state_au, de421_constants
 from .frames import icrf_to_ecliptic_matrix
 from .state import RotationState
@@ -61,6 +61,12 @@ __all__ = [
     "TOUTATIS_EPOCH",
     "encounter_state",
     "encounter_simulation",
+    "PublishedState",
+    "APOPHIS_HORIZONS",
+    "IAU_AU_KM",
+    "published_orbit_simulation",
+    "closest_approach",
+    "apophis_encounter_simulation",
     "apophis_rotation_state",
     "toutatis_rotation_state",
     "sam_state_from_periods",
@@ -246,6 +252,133 @@ def encounter_simulation(geometry, bodies=DEFAULT_BODIES, integrator="ias15"):
 def _tdb(time):
     days, remainder = tdb_days(time)
     return time_from_tdb_days(days, remainder)
+
+
+# ------------------------------------------------------------------------------------------------
+# Published orbit solutions (heliocentric states from JPL Horizons).
+
+#: IAU 2012 astronomical unit (km), the au of Horizons' output. DE421's au (its header ``AU``) is
+#: 149 597 870.6996262 km, 2.5e-12 smaller in relative terms (docs/ephemeris.md).
+IAU_AU_KM = 149_597_870.700
+
+
+@dataclass(frozen=True)
+class PublishedState:
+    """A heliocentric ICRF state of a small body from an orbit solution, as published.
+
+    ``position_au`` and ``velocity_au_day`` are in IAU 2012 au (:data:`IAU_AU_KM`) and TDB days, at
+    ``epoch`` (TDB). ``elements`` keeps the osculating elements printed with them (ecliptic J2000,
+    IAU76 obliquity; not used by the code, a record of what was published).
+    """
+
+    name: str
+    epoch: Time
+    position_au: tuple
+    velocity_au_day: tuple
+    elements: dict
+    non_gravitational: dict
+    source: str
+
+
+#: (99942) Apophis, JPL Horizons, orbit solution JPL#218 (solution date 2023-Nov-06), retrieved in 2024
+#: as Horizons output: "Equivalent ICRF heliocentric cartesian coordinates (au, au/d)" at
+#: EPOCH = 2459215.5 = 2021-Jan-01.00 TDB. Horizons' model also has the Yarkovsky terms A1, A2
+#: (au/d², g(r) = (1 au/r)²) and Earth J2; :func:`published_orbit_simulation` does not include A1/A2
+#: (docs/asteroids.md gives their measured effect on the 2029 encounter, −43 km).
+APOPHIS_HORIZONS = PublishedState(
+    "Apophis",
+    Time(2459215.5, format="jd", scale="tdb"),
+    (-4.098530837957945e-01, 9.070198867765817e-01, 3.267919471926086e-01),
+    (-1.507552412223498e-02, -3.713559924880165e-03, -1.761867984500986e-03),
+    dict(EC=0.1915216892529348, QR=0.7458270479403062, TP=2459101.039422418, OM=204.0389271089114,
+         W=126.6520518833791, IN=3.336751319526047, A=0.9225071817339578, MA=127.3225632500591),
+    dict(A1=4.999999873689e-13, A2=-2.901092102547e-14),
+    "JPL Horizons, (99942) Apophis, solution JPL#218 (2023-Nov-06), heliocentric ICRF state at "
+    "2021-01-01.0 TDB (retrieved 2024)",
+)
+
+
+def published_orbit_simulation(state=APOPHIS_HORIZONS, time=None, bodies=DEFAULT_BODIES, integrator="ias15",
+                               extra_forces=True):
+    """REBOUND simulation with a published heliocentric state, integrated to ``time``.
+
+    The Sun, planets, Moon and Pluto come from DE421 at ``state.epoch``
+    (:func:`~spinorbit.coupling.rebound_adapter.simulation_from_de421`); the body (named
+    ``state.name``, massless) is placed at the simulation's Sun + the published heliocentric state,
+    converted from IAU 2012 au to DE421's au (the simulation's unit). With ``extra_forces`` (default),
+    :func:`~spinorbit.coupling.rebound_adapter.install_extra_forces` adds Earth's J2 and the EIH 1PN
+    terms — Horizons' small-body model has both; left out are its Yarkovsky terms and the asteroid
+    perturbers. The run is IAS15 with ``exact_finish_time`` up to ``time`` (astropy Time; None: stay at
+    the epoch).
+    """
+    sim = simulation_from_de421(state.epoch, bodies=bodies, integrator=integrator)
+    if extra_forces:
+        install_extra_forces(sim)
+    scale = IAU_AU_KM / de421_constants().au_km
+    position = np.asarray(state.position_au, float) * scale
+    velocity = np.asarray(state.velocity_au_day, float) * scale
+    sun = sim.particles[body_index(sim, "sun")]
+    sim.add(m=0.0, x=sun.x + position[0], y=sun.y + position[1], z=sun.z + position[2],
+            vx=sun.vx + velocity[0], vy=sun.vy + velocity[1], vz=sun.vz + velocity[2], name=state.name)
+    if time is not None:
+        day, fraction = tdb_day_and_fraction(time)
+        sim.integrate(day + fraction)
+    return sim
+
+
+def closest_approach(sim, body, near, window_days=1.0, target="earth"):
+    """Closest approach of ``body`` to ``target`` within ``near`` ± ``window_days`` (moves ``sim``).
+
+    A 10-minute scan of the window, then Brent's method on the distance (IAS15 with
+    ``exact_finish_time`` runs back and forth; the simulation is left at the closest approach).
+
+    Returns
+    -------
+    time : Time (TDB)
+    distance_km : float
+        Centre-to-centre, DE421 km.
+    speed_km_s : float
+        Relative speed at closest approach.
+    """
+    au_km = de421_constants().au_km
+    i, j = body_index(sim, body), body_index(sim, target)
+    day, fraction = tdb_day_and_fraction(near)
+    centre = day + fraction
+
+    def distance(t):
+        sim.integrate(t)
+        a, b = sim.particles[i], sim.particles[j]
+        return math.dist((a.x, a.y, a.z), (b.x, b.y, b.z))
+
+    scan = centre + np.arange(-window_days, window_days + 1e-9, 1.0 / 144.0)
+    values = [distance(t) for t in scan]
+    k = int(np.argmin(values))
+    if k in (0, len(scan) - 1):
+        raise ValueError(f"no closest approach of {body} to {target} inside ±{window_days} d of {near.tdb.iso}.")
+    result = minimize_scalar(distance, bracket=(scan[k - 1], scan[k], scan[k + 1]), tol=1e-12)
+    distance(result.x)
+    a, b = sim.particles[i], sim.particles[j]
+    speed = math.dist((a.vx, a.vy, a.vz), (b.vx, b.vy, b.vz))
+    return time_from_tdb_days(result.x), result.fun * au_km, speed * au_km / 86400.0
+
+
+def apophis_encounter_simulation(orbit="published", extra_forces=None):
+    """Apophis for the 2029 encounter: a REBOUND simulation at :data:`APOPHIS_2029`'s time.
+
+    ``orbit="published"`` (default): :data:`APOPHIS_HORIZONS` integrated from 2021-01-01 TDB with
+    :func:`published_orbit_simulation` (Earth J2 + EIH on unless ``extra_forces=False``).
+    ``orbit="geometry"``: the documented fallback encounter geometry, :func:`encounter_simulation`
+    (no extra forces unless ``extra_forces=True``).
+    """
+    if orbit == "published":
+        return published_orbit_simulation(APOPHIS_HORIZONS, APOPHIS_2029.time_tdb,
+                                          extra_forces=True if extra_forces is None else extra_forces)
+    if orbit == "geometry":
+        sim = encounter_simulation(APOPHIS_2029)
+        if extra_forces:
+            install_extra_forces(sim)
+        return sim
+    raise ValueError(f"orbit must be 'published' or 'geometry', got {orbit!r}.")
 
 
 # ------------------------------------------------------------------------------------------------

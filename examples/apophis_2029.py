@@ -2,10 +2,13 @@
 
 Initial spin: Pravec et al. 2014 (Icarus 233, 48) — SAM, retrograde, P_ψ = 263 h, P_φ = 27.38 h,
 moments 0.61 : 0.965 : 1, angular momentum towards ecliptic (λ, β) = (250°, −75°)
-(:func:`spinorbit.asteroids.apophis_rotation_state`). Orbit: the documented encounter geometry
-(perigee 38 000 km from Earth's centre at 7.4 km/s at 2029-04-13 21:46 UTC, directions from rounded
-elements; :mod:`spinorbit.asteroids`), integrated with the Sun, planets, Moon and Pluto from DE421 in
-REBOUND (IAS15). Torques: Sun, Earth, Moon (degree 2, point masses), one way.
+(:func:`spinorbit.asteroids.apophis_rotation_state`). Orbit (default ``--orbit published``): the JPL
+Horizons solution JPL#218 state at 2021-01-01 TDB (:data:`spinorbit.asteroids.APOPHIS_HORIZONS`),
+integrated to 2029 with the Sun, planets, Moon and Pluto from DE421 in REBOUND (IAS15, Earth J2 + EIH);
+the encounter is then an outcome (printed). ``--orbit geometry`` uses the documented fallback encounter
+geometry instead (perigee imposed: 38 000 km from Earth's centre at 7.4 km/s at 2029-04-13 21:46 UTC,
+directions from rounded elements; :mod:`spinorbit.asteroids`). Torques: Sun, Earth, Moon (degree 2,
+point masses), one way.
 
 The rotation *phase* at perigee is not known from the published state, and the outcome depends on it
 strongly. ``--phases N`` repeats the run from N phases of the free motion (the published state moved
@@ -32,7 +35,14 @@ from astropy import units as u
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from spinorbit import RotationState
-from spinorbit.asteroids import APOPHIS_2029, apophis_rotation_state, encounter_simulation, encounter_state
+from spinorbit.asteroids import (
+    APOPHIS_2029,
+    APOPHIS_HORIZONS,
+    apophis_encounter_simulation,
+    apophis_rotation_state,
+    closest_approach,
+    encounter_state,
+)
 from spinorbit.coupling.one_way import propagate_one_way, sample_from_rebound
 from spinorbit.frames import icrf_to_ecliptic_matrix
 from spinorbit.time import tdb_days
@@ -56,17 +66,25 @@ def main(argv=None):
     parser.add_argument("--phases", type=int, default=8, help="rotation phases to try (default 8)")
     parser.add_argument("--tolerance", type=float, default=1e-10, help="sampling tolerance (relative position)")
     parser.add_argument("--rtol", type=float, default=1e-10, help="rotation integrator rtol")
+    parser.add_argument("--orbit", choices=("published", "geometry"), default="published",
+                        help="Horizons JPL#218 state integrated from 2021 (default) or the fallback encounter geometry")
     parser.add_argument("--output", default="apophis_2029.png", help="PNG to write ('' for none)")
     args = parser.parse_args(argv)
 
     clock = time.perf_counter()
     t_enc = APOPHIS_2029.time_tdb
     start, end = t_enc - args.days * u.day, t_enc + args.days * u.day
-    _, _, details = encounter_state(APOPHIS_2029, return_details=True)
-    print("Encounter geometry (documented fallback, not an orbit solution):")
-    print(f"  perigee {APOPHIS_2029.distance_km:.0f} km at {APOPHIS_2029.speed_km_s} km/s, {APOPHIS_2029.time.tt.iso[:16]} TT;"
-          f" v_inf = {details['v_inf_km_s']:.3f} km/s (rounded elements alone give {details['v_inf_elements_km_s']:.3f})")
-    sim = encounter_simulation(APOPHIS_2029)
+    if args.orbit == "published":
+        print(f"Orbit: {APOPHIS_HORIZONS.source}; DE421 planets, IAS15, Earth J2 + EIH, no Yarkovsky")
+        when, distance_km, speed_km_s = closest_approach(apophis_encounter_simulation("published"), "Apophis", t_enc)
+        print(f"  closest approach {when.tdb.iso} TDB, {distance_km:.1f} km from Earth's centre, {speed_km_s:.4f} km/s"
+              f" (JPL: 38 012 km, 7.42 km/s, 2029-04-13 21:46)")
+    else:
+        _, _, details = encounter_state(APOPHIS_2029, return_details=True)
+        print("Encounter geometry (documented fallback, not an orbit solution):")
+        print(f"  perigee {APOPHIS_2029.distance_km:.0f} km at {APOPHIS_2029.speed_km_s} km/s, {APOPHIS_2029.time.tt.iso[:16]} TT;"
+              f" v_inf = {details['v_inf_km_s']:.3f} km/s (rounded elements alone give {details['v_inf_elements_km_s']:.3f})")
+    sim = apophis_encounter_simulation(args.orbit)
     samples = sample_from_rebound(sim, "Apophis", start, end, tolerance=args.tolerance)
     when, distance = samples.closest["earth"]
     print(f"  REBOUND/IAS15 run: closest sampled distance {distance * 149_597_870.7:.0f} km; {samples.days.size} samples "

@@ -9,7 +9,13 @@ angular momentum towards ecliptic (λ, β) ≈ (250°, −75°). (4179) Toutatis
 (z the long axis), ZXZ Euler angles body → inertial (145.498°, 65.865°, 241.524°), body angular
 velocity (14.51, 33.529, −98.709) deg/day.
 
-**Orbits** (not an orbit solution): I cannot cite osculating elements *with* their epoch and mean
+**Apophis orbit (default)**: the JPL Horizons solution JPL#218 state at 2021-01-01 TDB
+(:data:`APOPHIS_HORIZONS`), integrated to 2029 by :func:`published_orbit_simulation` /
+:func:`apophis_encounter_simulation`; measured closest approach 38 054.9 km at 7.4209 km/s,
+2029-04-13 21:46:13.7 TDB (docs/asteroids.md). The encounter geometry below remains the fallback
+(``orbit="geometry"``) and is still used for Toutatis.
+
+**Fallback orbits** (not an orbit solution): I cannot cite osculating elements *with* their epoch and mean
 anomaly reliably from memory, and without the exact orbit solution no published element set pins a
 close approach down to a few 10³ km anyway. So each asteroid is placed on a **documented encounter
 geometry** that reproduces the published close-approach distance and speed:

@@ -141,8 +141,7 @@ def test_published_apophis_orbit_reproduces_the_2029_encounter():
     Reference: JPL 38 012 km from Earth's centre, 7.42 km/s, 2029-04-13 21:46 (taken as UTC; TT = UTC +
     69.184 s). Measured: 38 054.9 km, 7.4209 km/s, 21:46:13.7 TDB (= 21:45:04 UTC). Tolerance 150 km and
     2 min: the model omits Horizons' Yarkovsky term (measured with a Python force: −43 km, −1 s), the
-    asteroid perturbers (Ceres, Vesta, Pallas, … in Horizons, tens of km over 8 years at most from the
-    along-track drift they cause), and uses DE421 instead of DE441 planets; Earth J2 + EIH alone moved
+    asteroid perturbers (in Horizons' model; their effect is not measured here), and uses DE421 instead of DE441 planets; Earth J2 + EIH alone moved
     the distance by 177 km (Newtonian only: 38 231.6 km), so 150 km still separates a right from a
     wrong force model. ≈ 0.3 s.
     """

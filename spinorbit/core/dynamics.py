@@ -33,7 +33,7 @@ import numpy as np
 from ._jit import jit
 from .gravity_field import (BODY_A, BODY_B, BODY_C, BODY_MASS, FIGURE_SIZE, figure_field_without_monopole_xyz,
                             make_body)
-from .perturbers import PERTURBER_ROW, pack_perturbers, perturber_position_xyz
+from .perturbers import PERTURBER_ROW, pack_perturbers, perturber_position_xyz, sampled_span
 
 STATE_SIZE = 7
 
@@ -211,6 +211,21 @@ def scipy_rhs(model):
         return rhs(float(t), np.ascontiguousarray(y, dtype=float), model)
 
     return fun
+
+
+def validate_sampled_span(model, t0, t_out):
+    """Refuse a run that leaves the time span on which the model's sampled perturbers are defined.
+
+    Called by every integrator's Python wrapper, so a sampled perturber is never asked outside its
+    samples (which would give NaN positions deep inside a compiled loop).
+    """
+    lo, hi = sampled_span(model, MODEL_PERTURBERS)
+    t_min, t_max = min(t0, t_out.min()), max(t0, t_out.max())
+    if t_min < lo or t_max > hi:
+        raise ValueError(
+            f"t_out: the run spans [{t_min!r}, {t_max!r}] but sampled perturbers are defined only on "
+            f"[{lo!r}, {hi!r}]; extend the samples or shorten the run."
+        )
 
 
 def validate_state(y0):

@@ -47,7 +47,7 @@ import numpy as np
 
 from ._jit import jit
 from .canonical import FLIP_A, FLIP_B, FLIP_C, MODE_UNIFORM, elements_from_state, inertia_constants
-from .dynamics import MODEL_PERTURBERS, validate_state
+from .dynamics import validate_sampled_span, validate_state
 from .element_forces import attitude_and_momentum, elements_rhs_into, inertial_quaternion, reduce_phase
 from .errors import SingularElementsError
 from .gravity_field import BODY_A, BODY_B, BODY_C
@@ -69,12 +69,13 @@ from .integrate_quaternion import (
     _A,
     _B,
     _C,
-    _D,
+    _dense_polynomial,
+    _dense_rows,
     _error_norm,
+    _extra_stage_input,
     _validate_times,
 )
 from ._dop853_tableau import N_STAGES
-from .perturbers import sampled_span
 from .rotations import quat_to_attitude, rot1
 
 ELEMENT_SIZE = 6
@@ -139,41 +140,12 @@ def _rk_step(t, y, f0, h, model, frame, ic, k, y_new, tmp):
 
 @jit
 def _dense_coefficients(t, y, y_new, f_new, h, model, frame, ic, k, coeffs):
-    """Extra stages 13..15 and the 7 rows of DOP853's continuous extension (as in integrate_quaternion)."""
-    n = y.shape[0]
-    tmp = np.empty(n)
+    """Extra stages 13..15 of the element RHS, then the shared continuous-extension rows."""
+    tmp = np.empty(y.shape[0])
     for s in range(N_STAGES + 1, 16):
-        for i in range(n):
-            acc = 0.0
-            for j in range(s):
-                acc += _A[s, j] * k[j, i]
-            tmp[i] = y[i] + h * acc
+        _extra_stage_input(y, h, k, s, tmp)
         elements_rhs_into(t + _C[s] * h, tmp, model, frame, ic, k[s])
-    for i in range(n):
-        delta = y_new[i] - y[i]
-        coeffs[0, i] = delta
-        coeffs[1, i] = h * k[0, i] - delta
-        coeffs[2, i] = 2.0 * delta - h * (f_new[i] + k[0, i])
-        for r in range(4):
-            acc = 0.0
-            for j in range(16):
-                acc += _D[r, j] * k[j, i]
-            coeffs[3 + r, i] = h * acc
-
-
-@jit
-def _dense_evaluate(coeffs, y, x, out):
-    """Continuous extension at x = (t − t_old)/h ∈ [0, 1]."""
-    n = y.shape[0]
-    for i in range(n):
-        acc = 0.0
-        for r in range(6, -1, -1):
-            acc += coeffs[r, i]
-            if (6 - r) % 2 == 0:
-                acc *= x
-            else:
-                acc *= 1.0 - x
-        out[i] = y[i] + acc
+    _dense_rows(y, y_new, f_new, h, k, coeffs)
 
 
 @jit
@@ -358,7 +330,7 @@ def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, fir
                     _dense_coefficients(t, y, y_new, f_new, h, model, frame, ic, k, coeffs)
                     stats[STAT_RHS_CALLS] += 3
                     dense_ready = True
-                _dense_evaluate(coeffs, y, (t_out[i_out] - t) / h, els[i_out])
+                _dense_polynomial(coeffs, y, (t_out[i_out] - t) / h, els[i_out])
             _state_at(els[i_out], frame, ic, big_a, big_b, big_c, states[i_out])
             i_out += 1
         t = t_new
@@ -513,13 +485,7 @@ def integrate_elements(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=DE
     if rtol < 1e-15:
         raise ValueError(f"rtol: expected rtol ≥ 1e-15 (double precision cannot do better), got {rtol!r}.")
     model = np.ascontiguousarray(model, dtype=float)
-    lo, hi = sampled_span(model, MODEL_PERTURBERS)
-    t_min, t_max = min(t0, t_out.min()), max(t0, t_out.max())
-    if t_min < lo or t_max > hi:
-        raise ValueError(
-            f"t_out: the run spans [{t_min!r}, {t_max!r}] but sampled perturbers are defined only on "
-            f"[{lo!r}, {hi!r}]; extend the samples or shorten the run."
-        )
+    validate_sampled_span(model, t0, t_out)
     moments = np.array([model[BODY_A], model[BODY_B], model[BODY_C]])
     frame = reference_frame_for(y0, moments)
     el0 = elements_of_state(y0, model, frame)

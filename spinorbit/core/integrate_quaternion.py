@@ -42,8 +42,7 @@ from ._dop853_tableau import E3 as _E3
 from ._dop853_tableau import E5 as _E5
 from ._dop853_tableau import N_STAGES
 from ._jit import jit
-from .dynamics import MODEL_PERTURBERS, STATE_SIZE, rhs_into, validate_state
-from .perturbers import sampled_span
+from .dynamics import STATE_SIZE, rhs_into, validate_sampled_span, validate_state
 
 _A = np.ascontiguousarray(_A_FULL)
 _C = np.ascontiguousarray(_C_FULL)
@@ -132,18 +131,22 @@ def _error_norm(k, h, y, y_new, rtol, atol):
 
 
 @jit
-def _dense_coefficients(t, y, y_new, f_new, h, model, k, coeffs):
-    """Extra stages 13..15 and the 7 coefficient rows of the continuous extension (scipy's F)."""
-    n = y.shape[0]
-    tmp = np.empty(n)
-    for s in range(N_STAGES + 1, 16):
-        for i in range(n):
-            acc = 0.0
-            for j in range(s):
-                acc += _A[s, j] * k[j, i]
-            tmp[i] = y[i] + h * acc
-        rhs_into(t + _C[s] * h, tmp, model, k[s])
-    for i in range(n):
+def _extra_stage_input(y, h, k, s, tmp):
+    """State at which DOP853's stage s is evaluated: y + h Σ_j A[s, j] k_j (RHS-independent)."""
+    for i in range(y.shape[0]):
+        acc = 0.0
+        for j in range(s):
+            acc += _A[s, j] * k[j, i]
+        tmp[i] = y[i] + h * acc
+
+
+@jit
+def _dense_rows(y, y_new, f_new, h, k, coeffs):
+    """The 7 coefficient rows of DOP853's continuous extension from the 16 stages (scipy's F).
+
+    Independent of the right-hand side, so every DOP853 driver in the package shares it.
+    """
+    for i in range(y.shape[0]):
         delta = y_new[i] - y[i]
         coeffs[0, i] = delta
         coeffs[1, i] = h * k[0, i] - delta
@@ -156,10 +159,9 @@ def _dense_coefficients(t, y, y_new, f_new, h, model, k, coeffs):
 
 
 @jit
-def _dense_evaluate(coeffs, y, x, out):
-    """Evaluate the continuous extension at x = (t − t_old)/h ∈ [0, 1] and renormalise q."""
-    n = y.shape[0]
-    for i in range(n):
+def _dense_polynomial(coeffs, y, x, out):
+    """Evaluate the continuous extension at x = (t − t_old)/h ∈ [0, 1] (RHS-independent)."""
+    for i in range(y.shape[0]):
         acc = 0.0
         for r in range(6, -1, -1):
             acc += coeffs[r, i]
@@ -168,6 +170,22 @@ def _dense_evaluate(coeffs, y, x, out):
             else:
                 acc *= 1.0 - x
         out[i] = y[i] + acc
+
+
+@jit
+def _dense_coefficients(t, y, y_new, f_new, h, model, k, coeffs):
+    """Extra stages 13..15 of the quaternion RHS, then the continuous-extension rows."""
+    tmp = np.empty(y.shape[0])
+    for s in range(N_STAGES + 1, 16):
+        _extra_stage_input(y, h, k, s, tmp)
+        rhs_into(t + _C[s] * h, tmp, model, k[s])
+    _dense_rows(y, y_new, f_new, h, k, coeffs)
+
+
+@jit
+def _dense_evaluate(coeffs, y, x, out):
+    """Evaluate the continuous extension at x and renormalise q."""
+    _dense_polynomial(coeffs, y, x, out)
     _normalize_quaternion_part(out)
 
 
@@ -478,13 +496,7 @@ def integrate_quaternion(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=
     t_out = _validate_times(t0, t_out)
     rtol, atol = _validate_tolerances(rtol, default_atol(y0, rtol) if atol is None else atol)
     model = np.ascontiguousarray(model, dtype=float)
-    lo, hi = sampled_span(model, MODEL_PERTURBERS)
-    t_min, t_max = min(t0, t_out.min()), max(t0, t_out.max())
-    if t_min < lo or t_max > hi:
-        raise ValueError(
-            f"t_out: the run spans [{t_min!r}, {t_max!r}] but sampled perturbers are defined only on "
-            f"[{lo!r}, {hi!r}]; extend the samples or shorten the run."
-        )
+    validate_sampled_span(model, t0, t_out)
     ys, stats = integrate_dop853_kernel(y0, t0, t_out, model, rtol, atol, int(max_steps),
                                         bool(hit_output_times), float(first_step))
     status = int(stats[STAT_STATUS])

@@ -65,11 +65,11 @@ from .dynamics import (
     MODEL_PERTURBERS,
     STATE_SIZE,
     force_function_and_torque_xyz,
+    validate_sampled_span,
     validate_state,
 )
 from .gravity_field import BODY_A, BODY_B, BODY_C
 from .integrate_quaternion import _validate_times
-from .perturbers import sampled_span
 from .canonical import (
     MO_MODE,
     MO_PARAM_C,
@@ -451,13 +451,7 @@ def integrate_splitting(y0, t0, t_out, model, step, scheme="saba2", free_flow_se
             f"principal axes), got ({big_a!r}, {big_b!r}, {big_c!r}); reorder the body axes "
             "(docs/conventions.md) and rotate y0 accordingly."
         )
-    lo, hi = sampled_span(model, MODEL_PERTURBERS)
-    t_min, t_max = min(t0, t_out.min()), max(t0, t_out.max())
-    if t_min < lo or t_max > hi:
-        raise ValueError(
-            f"t_out: the run spans [{t_min!r}, {t_max!r}] but sampled perturbers are defined only on "
-            f"[{lo!r}, {hi!r}]; extend the samples or shorten the run."
-        )
+    validate_sampled_span(model, t0, t_out)
     if free_flow_setup not in ("short", "long"):
         raise ValueError(f"free_flow_setup: expected 'short' or 'long', got {free_flow_setup!r}.")
     c, d = SCHEMES[scheme]

@@ -252,6 +252,12 @@ def body_from_argument(arg, mo, mk):
     where M_x = M_y = 0 but l still moves (only l + g is physical there).
     """
     sn, cn, dn = sncndn_k(arg, mk)
+    return body_from_sncndn(sn, cn, dn, mo)
+
+
+@jit
+def body_from_sncndn(sn, cn, dn, mo):
+    """:func:`body_from_argument` from sn, cn, dn already at hand (callers that reduce the phase themselves)."""
     if mo[MO_MODE] == MODE_SAM:
         first, third = cn, dn
     else:

@@ -51,18 +51,14 @@ from .canonical import (
     FLIP_A,
     FLIP_B,
     FLIP_C,
-    MO_COS_L_W,
     MO_G,
     MO_MODE,
     MO_PARAM_C,
-    MO_SIN_L_W,
-    MO_X_AMP,
-    MO_Y_AMP,
-    MO_Z_AMP,
     MODE_SAM,
     MODE_UNIFORM,
     amplitude_from_momentum,
     body_from_argument,
+    body_from_sncndn,
     elliptic_constants,
     flip_attitude,
     flip_signs,
@@ -487,17 +483,8 @@ def evaluate_flow(t, flow, mo, mk, pk, q_out, m_out):
         ph, pl = dd_mul(flow[FL_KAPPA_HI], flow[FL_KAPPA_LO], pn_k(r, mk, pk), 0.0)
         gh, gl = dd_add(gh, gl, ph, pl)
     half_g = _reduced_half(gh, gl)
-    if mo[MO_MODE] == MODE_SAM:
-        first, third = c, d
-    else:
-        first, third = d, c
-    mx = mo[MO_X_AMP] * first
-    my = mo[MO_Y_AMP] * s
-    mz = mo[MO_Z_AMP] * third
-    ws = mo[MO_SIN_L_W] * first
-    wc = mo[MO_COS_L_W] * s
-    norm = math.hypot(ws, wc)
-    cl, sl = _half_angles(ws / norm, wc / norm)
+    mx, my, mz, sin_l, cos_l = body_from_sncndn(s, c, d, mo)
+    cl, sl = _half_angles(sin_l, cos_l)
     # half angles of J (cos J = M_z/G), from whichever of G ± M_z does not cancel
     big_g = mo[MO_G]
     perp = math.hypot(mx, my)

@@ -108,30 +108,48 @@ _P_C = 11  # word 10 unused
 _N_PARAMETERS = 12
 
 
-@intrinsic
-def _as_float64_pointer(typingctx, address):
-    """Reinterpret an integer address as ``double*`` (numba cannot cast int → pointer natively)."""
-    if not isinstance(address, types.Integer):
-        return None
-    signature = types.CPointer(types.float64)(address)
+def _address_as_pointer(pointee):
+    """An intrinsic that reinterprets an integer address as ``pointee*``.
 
-    def codegen(context, builder, sig, args):
-        return builder.inttoptr(args[0], context.get_value_type(types.CPointer(types.float64)))
+    numba cannot cast int → pointer natively; one factory serves every pointee type the adapter needs.
+    """
 
-    return signature, codegen
+    @intrinsic
+    def cast(typingctx, address):
+        if not isinstance(address, types.Integer):
+            return None
+        pointer = types.CPointer(pointee)
+
+        def codegen(context, builder, sig, args):
+            return builder.inttoptr(args[0], context.get_value_type(pointer))
+
+        return pointer(address), codegen
+
+    return cast
 
 
-@intrinsic
-def _word_as_float64(typingctx, word):
-    """Reinterpret the bits of a 64-bit word as a double (sim.G is read from the word view)."""
-    if not isinstance(word, types.Integer):
-        return None
-    signature = types.float64(word)
+#: ``double*`` from an address (particle arrays, the parameter block).
+_as_float64_pointer = _address_as_pointer(types.float64)
 
-    def codegen(context, builder, sig, args):
-        return builder.bitcast(args[0], context.get_value_type(types.float64))
 
-    return signature, codegen
+def _reinterpret_bits(source_kind, target):
+    """An intrinsic that reinterprets the 64 bits of a ``source_kind`` value as ``target`` (a bitcast)."""
+
+    @intrinsic
+    def cast(typingctx, value):
+        if not isinstance(value, source_kind):
+            return None
+
+        def codegen(context, builder, sig, args):
+            return builder.bitcast(args[0], context.get_value_type(target))
+
+        return target(value), codegen
+
+    return cast
+
+
+#: The bits of a 64-bit word as a double (sim.G is read from the word view).
+_word_as_float64 = _reinterpret_bits(types.Integer, types.float64)
 
 
 @jit
@@ -509,43 +527,14 @@ class RotationCallbackError(RuntimeError):
     """A compiled rotation callback found a problem during ``sim.integrate``; the run was stopped."""
 
 
-@intrinsic
-def _as_uint64_pointer(typingctx, address):
-    """Reinterpret an integer address as ``uint64*`` (a struct viewed as 64-bit words)."""
-    if not isinstance(address, types.Integer):
-        return None
-    signature = types.CPointer(types.uint64)(address)
-
-    def codegen(context, builder, sig, args):
-        return builder.inttoptr(args[0], context.get_value_type(types.CPointer(types.uint64)))
-
-    return signature, codegen
+#: ``uint64*`` from an address (REBOUND's struct read as 64-bit words).
+_as_uint64_pointer = _address_as_pointer(types.uint64)
+#: ``int32*`` from an address (to write REBOUND's C-int ``status``).
+_as_int32_pointer = _address_as_pointer(types.int32)
 
 
-@intrinsic
-def _as_int32_pointer(typingctx, address):
-    """Reinterpret an integer address as ``int32*`` (to write REBOUND's C-int ``status``)."""
-    if not isinstance(address, types.Integer):
-        return None
-    signature = types.CPointer(types.int32)(address)
-
-    def codegen(context, builder, sig, args):
-        return builder.inttoptr(args[0], context.get_value_type(types.CPointer(types.int32)))
-
-    return signature, codegen
-
-
-@intrinsic
-def _float64_bits(typingctx, value):
-    """The bits of a double as a uint64 (the ODE address is stored bit-exactly in the float block)."""
-    if not isinstance(value, types.Float):
-        return None
-    signature = types.uint64(value)
-
-    def codegen(context, builder, sig, args):
-        return builder.bitcast(args[0], context.get_value_type(types.uint64))
-
-    return signature, codegen
+#: The bits of a double as a uint64 (the ODE address is stored bit-exactly in the float block).
+_float64_bits = _reinterpret_bits(types.Float, types.uint64)
 
 
 @jit

@@ -22,10 +22,23 @@ from spinorbit.core.canonical import (
     MODE_SAM,
     body_from_argument,
     flip_attitude,
-    inertia_constants,
     node_angles,
 )
 from spinorbit.core.rotations import quat_to_attitude
+
+
+def secular_am(u, m):
+    """am(u|m) for 0 ≤ m < 1, continuous in u: u = 2jK + r, am = jπ + atan2(sn r, cn r)."""
+    k = mp.ellipk(m)
+    j = mp.nint(u / (2 * k))
+    r = u - 2 * j * k
+    return j * mp.pi + mp.atan2(mp.ellipfun("sn", r, m), mp.ellipfun("cn", r, m))
+
+
+def secular_pi(phi, n, m):
+    """Π(φ, n|m) for any real φ, 0 ≤ m < 1, n < 1: Π(φ + jπ) = Π(φ) + 2jΠ(n|m)."""
+    j = mp.nint(phi / mp.pi)
+    return mp.ellippi(n, phi - j * mp.pi, m) + 2 * j * mp.ellippi(n, m)
 
 
 def _qmul(a, b):
@@ -60,18 +73,12 @@ def exact_states(quaternion, momentum, moments, times, dps=40):
             p = (a - d) * b_c / (a_b * (d - c))
             n = -(a - d) / (d - c)
         kappa = a_c * big_g / nu
-        half_period = 2 * mp.ellipk(p)
-        complete_pi = mp.ellippi(n, p)
 
         def pn(u):
-            j = mp.nint(u / half_period)
-            r = u - j * half_period
-            sn, cn = mp.ellipfun("sn", r, m=p), mp.ellipfun("cn", r, m=p)
-            return 2 * j * complete_pi + mp.ellippi(n, mp.atan2(sn, cn), p)
+            return secular_pi(secular_am(u, p), n, p)
 
         arg0 = mp.mpf(float(flow[tf.FL_ARG0]))
         # g at t = 0 from the initial attitude (the package's Andoyer angles, not its g constant)
-        ic = inertia_constants(*moments)
         working = flip_attitude(quat_to_attitude(np.asarray(quaternion, float)), flip)
         m_working = np.array([float(mx), float(my), float(mz)])
         _, _, _, sin_l, cos_l = body_from_argument(float(arg0), mo, mk)

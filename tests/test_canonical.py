@@ -17,6 +17,8 @@ from spinorbit.core import SingularElementsError, andoyer_to_canonical, canonica
 from spinorbit.core import canonical as cn
 from spinorbit.core import rotations as rot
 
+from _mp_reference import secular_am, secular_pi
+
 mp.mp.dps = 40
 EPS = np.finfo(float).eps
 # Elements of O(1) from O(1) inputs through ~10 operations and the elliptic kernels (≤ 1e-15 each):
@@ -36,20 +38,6 @@ BODIES = [(1.0, 2.0, 2.5), (0.61, 0.965, 1.0), (2 / 3, 1.0, 2.0), (1.0, 1.3, 1.3
 # --------------------------------------------------------------------------------------------
 # Independent reference: the paper's angle forms in mpmath
 # --------------------------------------------------------------------------------------------
-def mp_am(u, m):
-    """am(u|m) for m < 1, secular: jπ + atan2(sn r, cn r), r = u − 2jK."""
-    big_k = mp.ellipk(m)
-    j = mp.nint(u / (2 * big_k))
-    r = u - 2 * j * big_k
-    return j * mp.pi + mp.atan2(mp.ellipfun("sn", r, m), mp.ellipfun("cn", r, m))
-
-
-def mp_pi_secular(phi, n, m):
-    """Π(φ, n|m) for any real φ (quasi-periodic continuation), m < 1."""
-    j = mp.nint(phi / mp.pi)
-    return mp.ellippi(n, phi - j * mp.pi, m) + 2 * j * mp.ellippi(n, m)
-
-
 def mp_reference_forward(big_l, big_g, big_h, l, g, h, big_a, big_b, big_c):
     """Paper eq. (4) with eq. (5)'s φ, for SAM about +C (L > 0) and LAM about +A (sin l > 0)."""
     big_l, big_g, l, g = (mp.mpf(x) for x in (big_l, big_g, l, g))
@@ -60,16 +48,16 @@ def mp_reference_forward(big_l, big_g, big_h, l, g, h, big_a, big_b, big_c):
     phi = mp.pi / 2 - l - mp.atan(f * mp.sin(l) * mp.cos(l) / (mp.sqrt(1 + f) + 1 + f * mp.sin(l) ** 2))
     root = mp.sqrt((a - d) * (b - c))
     if m < 1:
-        big_f = mp.ellipf(phi, m) if abs(phi) <= mp.pi / 2 else mp_pi_secular(phi, 0, m)
-        big_pi = mp_pi_secular(phi, -f, m)
+        big_f = mp.ellipf(phi, m) if abs(phi) <= mp.pi / 2 else secular_pi(phi, 0, m)
+        big_pi = secular_pi(phi, -f, m)
     else:
         # Reciprocal modulus (A&S 17.4.15): sin β = √m sin φ; L < 0 puts the body in the other half cycle.
         mu = 1 / m
         beta = mp.asin(mp.sqrt(m) * mp.sin(phi))
         if big_l < 0:
             beta = mp.pi - beta if beta >= 0 else -mp.pi - beta
-        big_f = mp_pi_secular(beta, 0, mu) / mp.sqrt(m)
-        big_pi = mp_pi_secular(beta, -f / m, mu) / mp.sqrt(m)
+        big_f = secular_pi(beta, 0, mu) / mp.sqrt(m)
+        big_pi = secular_pi(beta, -f / m, mu) / mp.sqrt(m)
     big_s = mp.sqrt(d / a) * big_g
     s = mp.sqrt(a * d / ((a - d) * (b - c))) * big_f
     z = g - (c * big_f + (a - c) * big_pi) / root
@@ -94,14 +82,14 @@ def mp_reference_backward(big_s, big_z, big_h, s, z, h, big_a, big_b, big_c):
     u = mp.sqrt((a - d) * (b - c) / (a * d)) * s
     if m < 1:
         sn, cn_, dn = (mp.ellipfun(k, u, m) for k in ("sn", "cn", "dn"))
-        am = mp_am(u, m)
-        pn = mp_pi_secular(am, -f, m)
+        am = secular_am(u, m)
+        pn = secular_pi(am, -f, m)
     else:
         mu, v = 1 / m, mp.sqrt(m) * u
         sn = mp.ellipfun("sn", v, mu) / mp.sqrt(m)
         cn_, dn = mp.ellipfun("dn", v, mu), mp.ellipfun("cn", v, mu)
         am = mp.atan2(sn, cn_)
-        pn = mp_pi_secular(mp_am(v, mu), -f / m, mu) / mp.sqrt(m)
+        pn = secular_pi(secular_am(v, mu), -f / m, mu) / mp.sqrt(m)
     big_l = mp.sqrt((a - d) / (a - c)) * big_z * dn
     l = mp.pi / 2 - am - mp.atan(f * sn * cn_ / (mp.sqrt(1 + f) + 1 + f * sn**2))
     g = z + (c * u + (a - c) * pn) / mp.sqrt((a - d) * (b - c))

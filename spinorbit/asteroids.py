@@ -49,7 +49,13 @@ from scipy.optimize import brentq, minimize_scalar
 
 from .body import RigidBody
 from .core import rotations as _rotations
-from .coupling.rebound_adapter import DEFAULT_BODIES, body_index, install_extra_forces, simulation_from_de421
+from .coupling.rebound_adapter import (
+    DEFAULT_BODIES,
+    body_index,
+    install_extra_forces,
+    set_nongravitational,
+    simulation_from_de421,
+)
 from .ephemeris import barycentric_state_au, de421_constants
 from .frames import icrf_to_ecliptic_matrix
 from .state import RotationState
@@ -288,9 +294,8 @@ class PublishedState:
 
 #: (99942) Apophis, JPL Horizons, orbit solution JPL#218 (solution date 2023-Nov-06), retrieved in 2024
 #: as Horizons output: "Equivalent ICRF heliocentric cartesian coordinates (au, au/d)" at
-#: EPOCH = 2459215.5 = 2021-Jan-01.00 TDB. Horizons' model also has the Yarkovsky terms A1, A2
-#: (au/d², g(r) = (1 au/r)²) and Earth J2; :func:`published_orbit_simulation` does not include A1/A2
-#: (docs/asteroids.md gives their measured effect on the 2029 encounter, −43 km).
+#: EPOCH = 2459215.5 = 2021-Jan-01.00 TDB. Horizons' model also has the non-gravitational terms A1, A2
+#: (au/d², g(r) = (1 au/r)²) and Earth J2; :func:`published_orbit_simulation` includes both.
 APOPHIS_HORIZONS = PublishedState(
     "Apophis",
     Time(2459215.5, format="jd", scale="tdb"),
@@ -305,7 +310,7 @@ APOPHIS_HORIZONS = PublishedState(
 
 
 def published_orbit_simulation(state=APOPHIS_HORIZONS, time=None, bodies=DEFAULT_BODIES, integrator="ias15",
-                               extra_forces=True):
+                               extra_forces=True, non_gravitational=True):
     """REBOUND simulation with a published heliocentric state, integrated to ``time``.
 
     The Sun, planets, Moon and Pluto come from DE421 at ``state.epoch``
@@ -313,10 +318,17 @@ def published_orbit_simulation(state=APOPHIS_HORIZONS, time=None, bodies=DEFAULT
     ``state.name``, massless) is placed at the simulation's Sun + the published heliocentric state,
     converted from IAU 2012 au to DE421's au (the simulation's unit). With ``extra_forces`` (default),
     :func:`~spinorbit.coupling.rebound_adapter.install_extra_forces` adds Earth's J2 and the EIH 1PN
-    terms — Horizons' small-body model has both; left out are its Yarkovsky terms and the asteroid
-    perturbers. The run is IAS15 with ``exact_finish_time`` up to ``time`` (astropy Time; None: stay at
-    the epoch).
+    terms — Horizons' small-body model has both — and, with ``non_gravitational`` (default), the
+    solution's own non-gravitational terms ``state.non_gravitational`` (A1, A2, A3 in au/d², g(r) =
+    (1 au/r)², :func:`~spinorbit.coupling.rebound_adapter.set_nongravitational`). Left out are the
+    asteroid perturbers. The run is IAS15 with ``exact_finish_time`` up to ``time`` (astropy Time;
+    None: stay at the epoch).
     """
+    if non_gravitational and not extra_forces:
+        raise ValueError(
+            "non_gravitational=True needs extra_forces=True (the terms live in the same compiled "
+            "force); pass non_gravitational=False for a purely Newtonian run."
+        )
     sim = simulation_from_de421(state.epoch, bodies=bodies, integrator=integrator)
     if extra_forces:
         install_extra_forces(sim)
@@ -326,6 +338,9 @@ def published_orbit_simulation(state=APOPHIS_HORIZONS, time=None, bodies=DEFAULT
     sun = sim.particles[body_index(sim, "sun")]
     sim.add(m=0.0, x=sun.x + position[0], y=sun.y + position[1], z=sun.z + position[2],
             vx=sun.vx + velocity[0], vy=sun.vy + velocity[1], vz=sun.vz + velocity[2], name=state.name)
+    if non_gravitational and state.non_gravitational:
+        a = {k: state.non_gravitational.get(k, 0.0) * scale for k in ("A1", "A2", "A3")}  # IAU au → DE421 au
+        set_nongravitational(sim, state.name, a["A1"], a["A2"], a["A3"])
     if time is not None:
         day, fraction = tdb_day_and_fraction(time)
         sim.integrate(day + fraction)
@@ -372,13 +387,15 @@ def apophis_encounter_simulation(orbit="published", extra_forces=None):
     """Apophis for the 2029 encounter: a REBOUND simulation at :data:`APOPHIS_2029`'s time.
 
     ``orbit="published"`` (default): :data:`APOPHIS_HORIZONS` integrated from 2021-01-01 TDB with
-    :func:`published_orbit_simulation` (Earth J2 + EIH on unless ``extra_forces=False``).
+    :func:`published_orbit_simulation` (Earth J2 + EIH + the solution's Yarkovsky terms on unless
+    ``extra_forces=False``).
     ``orbit="geometry"``: the documented fallback encounter geometry, :func:`encounter_simulation`
     (no extra forces unless ``extra_forces=True``).
     """
     if orbit == "published":
+        full = True if extra_forces is None else bool(extra_forces)
         return published_orbit_simulation(APOPHIS_HORIZONS, APOPHIS_2029.time_tdb,
-                                          extra_forces=True if extra_forces is None else extra_forces)
+                                          extra_forces=full, non_gravitational=full)
     if orbit == "geometry":
         sim = encounter_simulation(APOPHIS_2029)
         if extra_forces:

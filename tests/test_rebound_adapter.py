@@ -13,6 +13,7 @@ from spinorbit.coupling.rebound_adapter import (
     body_index,
     install_extra_forces,
     perturber_positions,
+    set_nongravitational,
     simulation_from_de421,
 )
 from spinorbit.ephemeris import barycentric_state_au, barycentric_state_km, de421_constants
@@ -152,3 +153,80 @@ def test_forces_survive_garbage_collection():
     sim.integrate(30.0)
     assert np.all(np.isfinite(sim.particles["Moon"].xyz))
     assert isinstance(sim, rebound.Simulation)
+
+
+def _sun_and_circular_body(gm_effective=1.0):
+    """Sun (GM = 1, at rest) and a massless body on a circular 1 au orbit for the given effective GM."""
+    sim = rebound.Simulation()
+    sim.G = 1.0
+    sim.add(m=1.0, name="Sun")
+    sim.add(m=0.0, x=1.0, vy=np.sqrt(gm_effective), name="Body")
+    sim.integrator = "ias15"
+    install_extra_forces(sim, earth_j2=False, gr=False)
+    return sim
+
+
+def test_nongravitational_terms_obey_the_gauss_equations():
+    """Each of A1, A2, A3 against what it must do on a circular orbit at r0 = 1 au (GM = 1).
+
+    - A1 (radial, ∝ 1/r²) is a reduction of GM by A1: a circular orbit for GM − A1 stays at r = 1
+      (without the force it would not: 5e-4 of GM gives an eccentricity of 5e-4).
+    - A2 (transverse): da/dt = 2 A2 / n (Gauss, circular orbit), so Δa = 2 A2 T over T with n = 1.
+      Second-order terms are (A2 T)² ~ 1e-10 relative to Δa ≈ 2e-7: tolerance 1e-4 relative.
+    - A3 (normal): z'' = −z + A3 (n = 1) gives z = A3 (1 − cos t), largest 2 A3 at half an orbit;
+      checked as A3/2 < max|z| ≤ 2 A3 (1 + 1e-3) over one orbit (1e-3: A3² and sampling terms).
+    """
+    a1 = 5e-4
+    sim = _sun_and_circular_body(gm_effective=1.0 - a1)
+    set_nongravitational(sim, "Body", a1)
+    radii = []
+    for t in np.linspace(0.0, 20.0, 81):
+        sim.integrate(t)
+        radii.append(np.linalg.norm(sim.particles["Body"].xyz))
+    assert np.max(np.abs(np.array(radii) - 1.0)) < 1e-12
+
+    a2, span = 1e-8, 10.0
+    sim = _sun_and_circular_body()
+    set_nongravitational(sim, "Body", 0.0, a2)
+    sim.integrate(span)
+    assert sim.particles["Body"].orbit(primary=sim.particles["Sun"]).a - 1.0 == pytest.approx(
+        2.0 * a2 * span, rel=1e-4)
+
+    a3 = 1e-6
+    sim = _sun_and_circular_body()
+    set_nongravitational(sim, "Body", 0.0, 0.0, a3)
+    z = []
+    for t in np.linspace(0.0, 2.0 * np.pi, 64):
+        sim.integrate(t)
+        z.append(sim.particles["Body"].z)
+    assert 0.5 * a3 < np.max(np.abs(z)) <= 2.0 * a3 * (1.0 + 1e-3)
+
+
+def test_nongravitational_needs_installed_forces_and_a_real_body():
+    sim = rebound.Simulation()
+    sim.add(m=1.0, name="Sun")
+    sim.add(m=0.0, x=1.0, vy=1.0, name="Body")
+    with pytest.raises(ForceInstallError, match="install_extra_forces"):
+        set_nongravitational(sim, "Body", 1e-12)
+    install_extra_forces(sim, earth_j2=False, gr=False)
+    with pytest.raises(MissingBodyError, match="Apophis"):
+        set_nongravitational(sim, "Apophis", 1e-12)
+    with pytest.raises(ValueError, match="finite"):
+        set_nongravitational(sim, "Body", float("nan"))
+
+
+def test_reinstalled_forces_carry_every_parameter():
+    """A rebuilt copy (the one-way sampler's route) integrates bit-for-bit like the original."""
+    from spinorbit.coupling.rebound_adapter import reinstall_extra_forces
+
+    original = _sun_and_circular_body()
+    set_nongravitational(original, "Body", 1e-6, -3e-7, 2e-7)
+    copy = rebound.Simulation()
+    copy.G = 1.0
+    for p in original.particles:
+        copy.add(m=p.m, x=p.x, y=p.y, z=p.z, vx=p.vx, vy=p.vy, vz=p.vz, name="Sun" if p.m else "Body")
+    copy.integrator = "ias15"
+    reinstall_extra_forces(copy, original._afp)
+    for sim in (original, copy):
+        sim.integrate(5.0)
+    assert original.particles["Body"].xyz == copy.particles["Body"].xyz

@@ -58,7 +58,7 @@ from ..core.perturbers import sampled_source
 from ..ephemeris import DE421_SPAN_JD_TDB, EphemerisRangeError, _resolve_body, barycentric_state_au, de421_constants
 from ..state import RotationState
 from ..time import J2000_JD_TDB, tdb_days, time_from_tdb_days
-from .rebound_adapter import ExtraForces, body_index, install_extra_forces
+from .rebound_adapter import ExtraForces, body_index, reinstall_extra_forces
 
 __all__ = [
     "DEFAULT_PERTURBERS",
@@ -404,10 +404,9 @@ class _Snapshot:
             sim.add(m=m, x=r[0], y=r[1], z=r[2], vx=v[0], vy=v[1], vz=v[2], name=name)
         sim.exact_finish_time = 1
         if self.extra_forces is not None:
-            # The raw force pointer does not survive a copy; reinstall the same forces. Words 7–9 of
-            # the parameter array are the Earth pole (rebound_adapter's layout).
-            install_extra_forces(sim, earth_j2=self.extra_forces.earth_j2, gr=self.extra_forces.gr,
-                                 earth_pole=self.extra_forces.parameters[7:10])
+            # The raw force pointer does not survive a copy; reinstall the same forces (same
+            # particle order, so the whole parameter block carries over: pole, Yarkovsky, ...).
+            reinstall_extra_forces(sim, self.extra_forces)
         return sim
 
 

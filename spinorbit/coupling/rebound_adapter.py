@@ -47,6 +47,8 @@ __all__ = [
     "ExtraForces",
     "simulation_from_de421",
     "install_extra_forces",
+    "set_nongravitational",
+    "reinstall_extra_forces",
     "body_index",
     "perturber_positions",
     "RotationCallbackError",
@@ -105,7 +107,12 @@ _P_EARTH, _P_USE_J2, _P_USE_GR = 1, 2, 3  # word 0 unused
 _P_EARTH_GM, _P_EARTH_J2, _P_EARTH_RADIUS = 4, 5, 6
 _P_POLE = 7  # 7, 8, 9: unit vector of Earth's figure axis (ICRF)
 _P_C = 11  # word 10 unused
-_N_PARAMETERS = 12
+# Marsden–Sekanina–Yeomans (1973) non-gravitational acceleration on one body (e.g. Yarkovsky):
+# a = g(r) (A1 r̂ + A2 t̂ + A3 n̂), g(r) = (r0/r)², r heliocentric; 0 in _P_NG_BODY means "off".
+_P_NG_BODY, _P_NG_SUN = 12, 13
+_P_NG_A = 14  # 14, 15, 16: A1, A2, A3 in au/day²
+_P_NG_R0 = 17
+_N_PARAMETERS = 18
 
 
 def _address_as_pointer(pointee):
@@ -243,12 +250,43 @@ def _apply_extra_forces(words, p):
             particles[earth + _AX + 1] -= ratio * ay
             particles[earth + _AX + 2] -= ratio * az
 
+    if p[_P_NG_BODY] != 0.0:
+        _add_nongravitational(particles, p)
+
     if p[_P_USE_GR] != 0.0:
         for i in range(n):
             bi = i * _PARTICLE_WORDS
             particles[bi + _AX] += correction[i, 0] / c2
             particles[bi + _AX + 1] += correction[i, 1] / c2
             particles[bi + _AX + 2] += correction[i, 2] / c2
+
+
+@jit
+def _add_nongravitational(particles, p):
+    """Add g(r) (A1 r̂ + A2 t̂ + A3 n̂) to the body's acceleration (no reaction: photon recoil).
+
+    r̂ from the Sun to the body, n̂ along r × v (heliocentric), t̂ = n̂ × r̂ (along the motion), as in
+    JPL's small-body model (Marsden, Sekanina & Yeomans 1973, AJ 78, 211) with g(r) = (r0/r)².
+    """
+    b = np.int64(p[_P_NG_BODY]) * _PARTICLE_WORDS
+    s = np.int64(p[_P_NG_SUN]) * _PARTICLE_WORDS
+    x = particles[b + _X] - particles[s + _X]
+    y = particles[b + _X + 1] - particles[s + _X + 1]
+    z = particles[b + _X + 2] - particles[s + _X + 2]
+    vx = particles[b + _VX] - particles[s + _VX]
+    vy = particles[b + _VX + 1] - particles[s + _VX + 1]
+    vz = particles[b + _VX + 2] - particles[s + _VX + 2]
+    r = np.sqrt(x * x + y * y + z * z)
+    nx, ny, nz = y * vz - z * vy, z * vx - x * vz, x * vy - y * vx
+    h = np.sqrt(nx * nx + ny * ny + nz * nz)
+    rx, ry, rz = x / r, y / r, z / r
+    nx, ny, nz = nx / h, ny / h, nz / h
+    tx, ty, tz = ny * rz - nz * ry, nz * rx - nx * rz, nx * ry - ny * rx
+    g = (p[_P_NG_R0] / r) ** 2
+    a1, a2, a3 = p[_P_NG_A], p[_P_NG_A + 1], p[_P_NG_A + 2]
+    particles[b + _AX] += g * (a1 * rx + a2 * tx + a3 * nx)
+    particles[b + _AX + 1] += g * (a1 * ry + a2 * ty + a3 * ny)
+    particles[b + _AX + 2] += g * (a1 * rz + a2 * tz + a3 * nz)
 
 
 @cfunc(types.void(types.CPointer(types.uint64)), cache=True)
@@ -425,6 +463,73 @@ def install_extra_forces(sim, earth_j2: bool = True, gr: bool = True, earth_pole
     if gr:
         sim.force_is_velocity_dependent = 1  # IAS15 must iterate the velocity-dependent EIH terms
     return handle
+
+
+def reinstall_extra_forces(sim, handle: ExtraForces) -> ExtraForces:
+    """Install on ``sim`` the same forces, with the same parameters, as ``handle`` (from another sim).
+
+    For rebuilt copies of a simulation (the raw pointer does not survive ``sim.copy()`` or a
+    Simulationarchive): ``sim`` must hold the same particles in the same order, since the parameter
+    block refers to particles by index (Earth for J2, the body and the Sun for the
+    non-gravitational terms).
+    """
+    copy = install_extra_forces(sim, earth_j2=handle.earth_j2, gr=handle.gr,
+                                earth_pole=handle.parameters[_P_POLE:_P_POLE + 3])
+    copy.parameters[:] = handle.parameters  # in place: sim.extras points at this array
+    return copy
+
+
+def set_nongravitational(sim, body: str, a1: float, a2: float = 0.0, a3: float = 0.0, r0_au: float = 1.0):
+    """Switch on the non-gravitational acceleration of one body in forces from :func:`install_extra_forces`.
+
+    JPL's small-body model (Marsden, Sekanina & Yeomans 1973): a = g(r) (A1 r̂ + A2 t̂ + A3 n̂) with
+    g(r) = (r0/r)², r the heliocentric distance, r̂ radial, n̂ along r × v, t̂ = n̂ × r̂. For asteroids
+    A2 is the Yarkovsky drift (e.g. Apophis, JPL#218: A2 = −2.90e-14 au/d²).
+
+    Parameters
+    ----------
+    sim : rebound.Simulation
+        With forces from :func:`install_extra_forces`, a particle named 'Sun' and the body itself
+        (add the body first, then call this), in DE421 units ("AU", "day", "Msun").
+    body : str
+        The body's name.
+    a1, a2, a3 : float
+        Radial, transverse and normal coefficients, au/day².
+    r0_au : float, optional
+        Normalising distance of g(r), au (JPL: 1 au for asteroids).
+
+    Raises
+    ------
+    ForceInstallError
+        If :func:`install_extra_forces` has not been called on ``sim``.
+    MissingBodyError
+        If the body or the Sun is missing.
+    ValueError
+        If a coefficient is not finite or ``r0_au`` is not positive.
+    """
+    handle = getattr(sim, "_afp", None)
+    if not isinstance(handle, ExtraForces):
+        raise ForceInstallError(
+            "non-gravitational forces live in the block of install_extra_forces; call "
+            "install_extra_forces(sim) first, then set_nongravitational(sim, ...)."
+        )
+    coefficients = np.array([a1, a2, a3, r0_au], dtype=float)
+    if not np.all(np.isfinite(coefficients)) or r0_au <= 0.0:
+        raise ValueError(
+            f"A1, A2, A3 must be finite (au/day²) and r0_au > 0; got A=({a1!r}, {a2!r}, {a3!r}), "
+            f"r0_au={r0_au!r}."
+        )
+    index, sun = body_index(sim, body), body_index(sim, "sun")
+    if index == 0:
+        raise ValueError(
+            f"{body!r} is particle 0; the parameter block uses index 0 for 'off'. Add the Sun (or "
+            "another body) first, as simulation_from_de421 does."
+        )
+    p = handle.parameters  # written in place: the cfunc reads this very array through sim.extras
+    p[_P_NG_SUN] = sun
+    p[_P_NG_A:_P_NG_A + 3] = coefficients[:3]
+    p[_P_NG_R0] = r0_au
+    p[_P_NG_BODY] = index  # last: the force switches on only once its parameters are complete
 
 
 def perturber_positions(sim, body: str, perturbers=None):

@@ -75,7 +75,7 @@ def main(argv=None):
     t_enc = APOPHIS_2029.time_tdb
     start, end = t_enc - args.days * u.day, t_enc + args.days * u.day
     if args.orbit == "published":
-        print(f"Orbit: {APOPHIS_HORIZONS.source}; DE421 planets, IAS15, Earth J2 + EIH, no Yarkovsky")
+        print(f"Orbit: {APOPHIS_HORIZONS.source}; DE421 planets, IAS15, Earth J2 + EIH + Yarkovsky (A1, A2 of the solution)")
         when, distance_km, speed_km_s = closest_approach(apophis_encounter_simulation("published"), "Apophis", t_enc)
         print(f"  closest approach {when.tdb.iso} TDB, {distance_km:.1f} km from Earth's centre, {speed_km_s:.4f} km/s"
               f" (JPL: 38 012 km, 7.42 km/s, 2029-04-13 21:46)")

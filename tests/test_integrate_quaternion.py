@@ -162,6 +162,7 @@ def test_sampled_perturber_outside_its_span_is_refused():
         (dict(rtol=0.0), "rtol"),
         (dict(rtol=-1e-8), "rtol"),
         (dict(atol=-1.0), "atol"),
+        (dict(atol=[1e-10, 1e-10, 1e-10]), "scalar or 7 values"),
     ],
 )
 def test_bad_input_raises_value_error(kwargs, match):

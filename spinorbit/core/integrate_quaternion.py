@@ -442,7 +442,13 @@ def _validate_tolerances(rtol, atol):
         raise ValueError(f"rtol: expected a relative tolerance > 0, got {rtol!r}; try 1e-10.")
     if rtol < 1e-15:
         raise ValueError(f"rtol: expected rtol ≥ 1e-15 (double precision cannot do better), got {rtol!r}.")
-    atol = np.broadcast_to(np.asarray(atol, dtype=float), (STATE_SIZE,)).copy()
+    atol = np.asarray(atol, dtype=float)
+    if atol.shape not in ((), (1,), (STATE_SIZE,)):
+        raise ValueError(
+            f"atol: expected a scalar or {STATE_SIZE} values (q0..q3, ωx, ωy, ωz), got shape {atol.shape}; "
+            "pass one number for all components or one per component."
+        )
+    atol = np.broadcast_to(atol, (STATE_SIZE,)).copy()
     if not np.all(np.isfinite(atol)) or np.any(atol < 0):
         raise ValueError(f"atol: expected absolute tolerances ≥ 0 (scalar or 7 values), got {atol.tolist()}.")
     return float(rtol), atol

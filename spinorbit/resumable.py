@@ -27,7 +27,11 @@ import numpy as np
 from .checkpoint import Checkpoint, CheckpointSchedule, fingerprint
 from .core.dynamics import validate_state
 from .core.integrate_elements import integrate_elements
-from .core.integrate_quaternion import _validate_times, default_atol, integrate_quaternion
+from .core.integrate_quaternion import (
+    _validate_times,
+    default_atol,
+    integrate_quaternion,
+)
 from .core.integrate_splitting import integrate_splitting
 
 __all__ = ["METHODS", "RESUMABLE_KIND", "integrate_resumable"]

@@ -16,7 +16,12 @@ import numpy as np
 import pytest
 
 from spinorbit.atomic import atomic_path, write_bytes_atomically
-from spinorbit.checkpoint import Checkpoint, CheckpointError, CheckpointSchedule, RunStopped
+from spinorbit.checkpoint import (
+    Checkpoint,
+    CheckpointError,
+    CheckpointSchedule,
+    RunStopped,
+)
 from spinorbit.core.dynamics import make_model
 from spinorbit.core.gravity_field import make_body
 from spinorbit.core.perturbers import kepler_source

@@ -61,14 +61,9 @@ def integrate_resumable(method: str, y0, t0, t_out, model, chunk: float, schedul
         :func:`~spinorbit.core.integrate_quaternion.integrate_quaternion`,
         :func:`~spinorbit.core.integrate_elements.integrate_elements` or
         :func:`~spinorbit.core.integrate_splitting.integrate_splitting`.
-    y0 : array_like (7,)
-        Initial (q0..q3, ωx, ωy, ωz): scalar-first quaternion body → inertial, ω in rad per time unit.
-    t0 : float
-        Initial time (model time unit).
-    t_out : array_like (n,)
-        Output times, strictly monotone away from t0.
-    model : ndarray
-        :func:`spinorbit.core.dynamics.make_model`.
+    y0, t0, t_out, model
+        As in :func:`~spinorbit.core.integrate_quaternion.integrate_quaternion`: state (q0..q3, ωx,
+        ωy, ωz) with ω in rad per model time unit, start time, output times monotone away from t0.
     chunk : float
         Simulated time per chunk (model time unit, > 0). Checkpoints can only be written at chunk
         boundaries; choose a chunk that takes seconds of wall time, not milliseconds.
@@ -100,12 +95,9 @@ def integrate_resumable(method: str, y0, t0, t_out, model, chunk: float, schedul
     y0 = validate_state(y0)
     t0 = float(t0)
     t_out = _validate_times(t0, t_out)
-    try:
-        chunk = float(chunk)
-    except (TypeError, ValueError):
-        chunk = math.nan
+    given, chunk = chunk, float(chunk) if isinstance(chunk, (int, float, np.integer, np.floating)) else math.nan
     if not (math.isfinite(chunk) and chunk > 0.0):
-        raise ValueError(f"chunk: expected a finite simulated time > 0 per chunk (model time unit), got {chunk!r}.")
+        raise ValueError(f"chunk: expected a finite simulated time > 0 per chunk (model time unit), got {given!r}.")
     model = np.ascontiguousarray(model, dtype=float)
     if method == "dop853" and options.get("atol") is None:
         options["atol"] = default_atol(y0, options.get("rtol", 1e-10))

@@ -7,10 +7,7 @@ simulations (``simulation_from_de421``): au, day (TDB), Msun-mass units (GM/G), 
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
-import rebound
 
 from ..checkpoint import CHECKPOINT_FORMAT_VERSION, Checkpoint, CheckpointError
 from ..core.dynamics import (
@@ -23,6 +20,8 @@ from .rebound_adapter import (
     RotationHooks,
     attach_rotation_hooks,
     body_index,
+    integrate_interruptibly,
+    simulation_from_binary,
 )
 
 __all__ = ["CHECKPOINT_KIND", "SAVE_FORMAT_VERSION", "CoupledRigidBody", "RestoreError"]
@@ -121,8 +120,10 @@ class CoupledRigidBody:
         ------
         spinorbit.coupling.rebound_adapter.RotationCallbackError
             A compiled callback found a problem and stopped the run (message says what and when).
+        KeyboardInterrupt
+            Ctrl-C (SIGINT) during the call, also when REBOUND's own handler caught it.
         """
-        self.sim.integrate(t)
+        integrate_interruptibly(self.sim, t)  # a Ctrl-C REBOUND absorbed still stops the run
         self.hooks.raise_if_failed()
 
     # ---------------------------------------------------------------------------------------
@@ -179,18 +180,17 @@ class CoupledRigidBody:
                 "earth_pole": np.array(self.earth_pole),
             },
             meta={"body": self.body, "perturbers": list(self.perturbers), "coupled": self.coupled,
-                  "earth_j2": self.earth_j2, "gr": self.gr},
+                  "earth_j2": self.earth_j2, "gr": self.gr,
+                  # REBOUND's binary does not restore names reliably (simulation_from_binary)
+                  "particle_names": [particle.name for particle in self.sim.particles]},
         )
 
     @classmethod
     def from_checkpoint(cls, checkpoint: Checkpoint) -> CoupledRigidBody:
         """Rebuild the simulation and its attached body from :meth:`checkpoint`; continues bit-for-bit."""
         arrays, meta = checkpoint.arrays, checkpoint.meta
-        with warnings.catch_warnings():
-            # REBOUND warns that function pointers are not restored: the constructor below
-            # re-attaches the ODE and the forces, which is exactly what the warning asks for.
-            warnings.filterwarnings("ignore", message="You have to reset function pointers")
-            sim = rebound.Simulation(arrays["simulation"].tobytes())
+        # The constructor below re-attaches the ODE and the forces (REBOUND does not store them).
+        sim = simulation_from_binary(arrays["simulation"].tobytes(), meta["particle_names"])
         return cls(sim, meta["body"], arrays["figure"], arrays["rotation_state"], perturbers=meta["perturbers"],
                    coupled=meta["coupled"], earth_j2=meta["earth_j2"], gr=meta["gr"],
                    earth_pole=arrays["earth_pole"], perturber_degrees=[int(d) for d in arrays["perturber_degrees"]])

@@ -8,9 +8,10 @@ from __future__ import annotations
 
 import os
 import platform
-import tempfile
 from datetime import datetime, timezone
 from pathlib import Path
+
+from spinorbit.atomic import write_bytes_atomically
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 
@@ -45,7 +46,5 @@ def write_section(name: str, markdown: str, page: str = "performance.md") -> Pat
     else:
         text = text.rstrip("\n") + "\n\n" + block
     path.parent.mkdir(parents=True, exist_ok=True)
-    with tempfile.NamedTemporaryFile("w", dir=path.parent, delete=False, suffix=".tmp") as tmp:
-        tmp.write(text)
-    os.replace(tmp.name, path)
+    write_bytes_atomically(path, text.encode())
     return path

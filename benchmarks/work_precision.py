@@ -36,6 +36,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from benchmarks._report import DOCS, machine_line, write_section  # noqa: E402
 from benchmarks.peers import METHODS, prepare_spinorbit, reference_solution  # noqa: E402
 from benchmarks.scenes import all_scenes  # noqa: E402
+from spinorbit.atomic import atomic_path
 from spinorbit.core.integrate_quaternion import integrate_fixed_step  # noqa: E402
 from spinorbit.core.rotations import rotation_angle_between_many  # noqa: E402
 
@@ -221,7 +222,8 @@ def main(argv=None):
         img = DOCS / "img" / f"work_precision_{scene.name}.png"
         if not args.no_write:
             img.parent.mkdir(parents=True, exist_ok=True)
-            fig.savefig(img, dpi=120)
+            with atomic_path(img) as temporary:
+                fig.savefig(temporary, format="png", dpi=120)
         plt.close(fig)
 
         # Table.

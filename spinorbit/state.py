@@ -42,6 +42,11 @@ MODE_NAMES = {
 }
 
 
+#: Range of G (momentum units) that :meth:`RotationState.from_andoyer` accepts: the maps square the
+#: momentum components, which under/overflows in float64 beyond ~1e±154.
+ANDOYER_G_RANGE = (1e-150, 1e150)
+
+
 class InvalidStateError(ValueError):
     """The attitude or spin given cannot describe a rotation state."""
 
@@ -52,7 +57,8 @@ def _as_quaternion(q) -> np.ndarray:
         raise InvalidStateError(f"a quaternion has 4 components (w, x, y, z), scalar first; got shape {q.shape}.")
     if not np.all(np.isfinite(q)):
         raise InvalidStateError(f"quaternion components must be finite; got {q.tolist()}.")
-    norm = float(np.linalg.norm(q))
+    # |q| of components beyond ~1e154 would overflow (a warning, then inf): such q are refused anyway.
+    norm = float(np.linalg.norm(q)) if np.abs(q).max() <= 2.0 else float(np.abs(q).max())
     if abs(norm - 1.0) > QUATERNION_NORM_TOLERANCE:
         raise InvalidStateError(
             f"attitude quaternions must have unit norm; got |q| = {norm!r}. Normalize it (q / |q|) if that is "
@@ -67,6 +73,11 @@ def _as_rotation_matrix(matrix) -> np.ndarray:
         raise InvalidStateError(f"an attitude matrix is 3×3; got shape {m.shape}.")
     if not np.all(np.isfinite(m)):
         raise InvalidStateError("attitude matrix entries must be finite.")
+    if np.abs(m).max() > 2.0:  # a rotation's entries are ≤ 1; R Rᵀ of huge entries would overflow
+        raise InvalidStateError(
+            f"the attitude matrix is not a rotation (largest entry {np.abs(m).max():.6g}, a rotation's are ≤ 1); "
+            "give an orthonormal matrix with determinant +1 (inertial → body)."
+        )
     error = float(np.abs(m @ m.T - np.eye(3)).max())
     if error > MATRIX_ORTHONORMALITY_TOLERANCE or np.linalg.det(m) < 0:
         raise InvalidStateError(
@@ -296,6 +307,11 @@ class RotationState:
             raise InvalidStateError(
                 f"Andoyer variables need finite values with G > 0 and |L|, |H| ≤ G; got L={big_l!r}, G={big_g!r}, "
                 f"H={big_h!r}."
+            )
+        if not ANDOYER_G_RANGE[0] <= big_g <= ANDOYER_G_RANGE[1]:
+            raise InvalidStateError(
+                f"G = {big_g!r} is outside [{ANDOYER_G_RANGE[0]:g}, {ANDOYER_G_RANGE[1]:g}], where squares of the "
+                "momentum components under- or overflow; express the momentum in other units."
             )
         frame = np.eye(3) if reference is None else _as_rotation_matrix(reference)
         attitude_ref, momentum = _andoyer.attitude_from_andoyer(*values)

@@ -5,7 +5,6 @@ from __future__ import annotations
 import contextlib
 import os
 import sys
-import tempfile
 import time
 
 from ..cli import CommandError
@@ -69,24 +68,17 @@ def check_output_path(option: str, path: str) -> None:
 def atomic_output(option: str, path: str):
     """Yield a temporary path next to ``path``; on success move it into place, on failure delete it.
 
-    Readers never see a half-written file, and a failed run leaves nothing behind. An ``OSError``
-    becomes a :class:`~spinorbit.cli.CommandError` that names the option and the path.
+    :func:`spinorbit.atomic.atomic_path` with the command line's error wording: readers never see a
+    half-written file, a failed run leaves nothing behind, and an ``OSError`` becomes a
+    :class:`~spinorbit.cli.CommandError` that names the option and the path.
     """
-    directory = os.path.dirname(os.path.abspath(path))
-    suffix = os.path.splitext(path)[1]
+    from ..atomic import atomic_path
+
     try:
-        handle, temporary = tempfile.mkstemp(dir=directory, prefix=f".{os.path.basename(path)}.", suffix=suffix)
-        os.close(handle)
+        with atomic_path(path) as temporary:
+            yield temporary
     except OSError as error:
         raise CommandError(f"{option}: cannot write '{path}' ({error.strerror}); choose another path.") from None
-    try:
-        yield temporary
-        os.replace(temporary, path)
-    except OSError as error:
-        raise CommandError(f"{option}: cannot write '{path}' ({error.strerror}); choose another path.") from None
-    finally:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(temporary)
 
 
 class Progress:

@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import math
+import os
+import sys
 
 from ..cli import CommandError
 from ._common import Progress, atomic_output, check_output_path, quantity
@@ -23,6 +26,8 @@ EXAMPLES = """\
 examples:
   spinorbit moon                                   # 1 year, core-corrected model
   spinorbit moon --span 20 yr --model rigid --step 5 d --output moon.ecsv --plot moon.png
+  spinorbit moon --span 50 yr --checkpoint moon.ckpt --output moon.ecsv   # killed? then:
+  spinorbit moon --span 50 yr --resume moon.ckpt --output moon.ecsv
 
 exit status: 0 on success; 2 with a one-line message if the input is wrong or an output file
 cannot be written (nothing is left half-written)."""
@@ -45,6 +50,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     files = parser.add_argument_group("output files")
     files.add_argument("--output", metavar="FILE.ecsv", help="write time, attitude difference and angles as ECSV")
     files.add_argument("--plot", metavar="FILE.png", help="plot the difference and the libration (needs matplotlib)")
+    long_runs = parser.add_argument_group("long runs")
+    long_runs.add_argument("--checkpoint", metavar="PATH",
+                           help="write a checkpoint (orbits + rotation + results so far) to PATH during the run")
+    long_runs.add_argument("--checkpoint-every", type=float, default=60.0, metavar="SECONDS",
+                           help="wall-clock seconds between checkpoints (default 60)")
+    long_runs.add_argument("--resume", metavar="PATH",
+                           help="continue the interrupted run whose checkpoint is PATH (same options); it "
+                                "ends bit for bit where the uninterrupted run would, and keeps checkpointing to "
+                                "PATH unless --checkpoint names another file")
 
 
 def libration_table(comparison, model: str, coupled: bool):
@@ -104,6 +118,24 @@ def plot_comparison(comparison, path: str, title: str) -> None:
     figure.savefig(path, format="png", dpi=120)
 
 
+def _checkpoint_schedule(args, span_days: float, step_days: float):
+    """The checkpoint schedule of ``--checkpoint``/``--resume`` and the settings a resume must match."""
+    from ..checkpoint import CheckpointSchedule
+
+    settings = {"command": NAME, "model": args.model, "coupled": not args.one_way, "span_days": span_days,
+                "step_days": step_days}
+    if args.resume is not None and not os.path.isfile(args.resume):
+        raise CommandError(f"--resume expects an existing checkpoint file; '{args.resume}' does not exist. "
+                           "Give the --checkpoint file of the interrupted run.")
+    path = args.checkpoint if args.checkpoint is not None else args.resume
+    if path is None:
+        return None, settings
+    check_output_path("--checkpoint", path)
+    if not (math.isfinite(args.checkpoint_every) and args.checkpoint_every > 0):
+        raise CommandError(f"--checkpoint-every expects a positive number of seconds, got {args.checkpoint_every!r}.")
+    return CheckpointSchedule(path, every_seconds=args.checkpoint_every), settings
+
+
 def run(args) -> int:
     """Run ``spinorbit moon``; return the exit status."""
     from ..coupling.moon import compare_with_de421, moon_at_de421
@@ -123,6 +155,7 @@ def run(args) -> int:
         raise CommandError(f"--span expects a positive duration up to 50 yr, got {' '.join(args.span)}.")
     if not 0 < step <= span_days:
         raise CommandError(f"--step expects a positive spacing no longer than --span, got {' '.join(args.step)}.")
+    schedule, settings = _checkpoint_schedule(args, span_days, step)
     moon = moon_at_de421(model=args.model, coupled=not args.one_way)
     count = int(span_days / step + 1e-9) + 1
     progress = Progress(count, "integrating")
@@ -133,7 +166,13 @@ def run(args) -> int:
         done[0] = n
 
     try:
-        comparison = compare_with_de421(moon, span_days, step, progress=advance)
+        comparison = compare_with_de421(moon, span_days, step, progress=advance, schedule=schedule,
+                                        resume=args.resume, settings=settings)
+    except KeyboardInterrupt:
+        if schedule is not None and os.path.exists(schedule.path):
+            print(f"{args._prog}: the last checkpoint is '{schedule.path}'; continue with the same options and "
+                  f"--resume {schedule.path}", file=sys.stderr)
+        raise
     finally:
         progress.close()
     span_text = f"{span.value:g} {span.unit.to_string()}"

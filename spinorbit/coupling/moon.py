@@ -19,7 +19,6 @@ Units: au (DE421), TDB days since J2000, masses GM/G ("AU", "day", "Msun"), ω i
 
 from __future__ import annotations
 
-import time as _time
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,6 +28,7 @@ from ..core.gravity_field import make_body
 from ..core.rotations import attitude_to_euler313, quat_to_attitude_many
 from ..ephemeris import de421_constants, moon_libration_angles_raw, moon_orientation_raw
 from ..time import tdb_day_and_fraction
+from .chunked_run import integrate_to_outputs
 from .rebound_adapter import DEFAULT_BODIES, simulation_from_de421
 from .rigid_body import CoupledRigidBody
 
@@ -171,17 +171,21 @@ def _euler313_many(quaternions):
 
 
 def compare_with_de421(moon: CoupledRigidBody, span_days: float, step_days: float = 1.0,
-                       progress=None) -> LibrationComparison:
+                       progress=None, schedule=None, resume=None, settings=None) -> LibrationComparison:
     """Integrate ``moon`` over ``span_days`` and compare its attitude with DE421 every ``step_days``.
 
     Parameters
     ----------
     moon : CoupledRigidBody
-        From :func:`moon_at_de421` (its ``sim.t`` is the start).
+        From :func:`moon_at_de421` (its ``sim.t`` is the start; when resuming, build it with the
+        same arguments: the checkpoint then replaces its state).
     span_days, step_days : float
         Span and output spacing (days, TDB).
     progress : callable, optional
         Called with the number of output times done.
+    schedule, resume, settings
+        Checkpoints (:func:`spinorbit.coupling.chunked_run.integrate_to_outputs`): each output time
+        is a chunk; an interrupted run resumed from its checkpoint ends with the same bits.
 
     Returns
     -------
@@ -190,15 +194,8 @@ def compare_with_de421(moon: CoupledRigidBody, span_days: float, step_days: floa
     start = moon.sim.t
     count = int(np.floor(span_days / step_days + 1e-9)) + 1
     times = start + step_days * np.arange(count)
-    quaternions = np.empty((count, 4))
-    wall = 0.0
-    for i, t in enumerate(times):
-        begin = _time.perf_counter()
-        moon.integrate(t)
-        wall += _time.perf_counter() - begin
-        quaternions[i] = moon.quaternion
-        if progress is not None:
-            progress(i + 1)
+    _, quaternions, wall = integrate_to_outputs(moon, times, lambda body: body.quaternion, 4, schedule=schedule,
+                                                resume=resume, settings=settings, progress=progress)
     days = np.round(times)
     reference, _ = moon_orientation_raw(days, times - days)
     # δq = conj(q_DE421) ⊗ q_model: the model frame seen from the DE421 frame (mantle axes).

@@ -7,29 +7,33 @@ simulations (``simulation_from_de421``): au, day (TDB), Msun-mass units (GM/G), 
 
 from __future__ import annotations
 
-import os
-import tempfile
-import warnings
-
 import numpy as np
-import rebound
 
+from ..checkpoint import CHECKPOINT_FORMAT_VERSION, Checkpoint, CheckpointError
+from ..core.dynamics import (
+    body_frame_position,
+    inertial_angular_momentum,
+    kinetic_energy,
+)
 from ..core.gravity_field import figure_force_function_and_gradient
-from ..core.dynamics import body_frame_position, inertial_angular_momentum, kinetic_energy
 from .rebound_adapter import (
     RotationHooks,
     attach_rotation_hooks,
     body_index,
+    integrate_interruptibly,
+    simulation_from_binary,
 )
 
-__all__ = ["CoupledRigidBody", "SAVE_FORMAT_VERSION", "RestoreError"]
+__all__ = ["CHECKPOINT_KIND", "SAVE_FORMAT_VERSION", "CoupledRigidBody", "RestoreError"]
 
-#: Version of the npz save format written by :meth:`CoupledRigidBody.save`.
-SAVE_FORMAT_VERSION = 1
+#: Version of the file format written by :meth:`CoupledRigidBody.save` (:mod:`spinorbit.checkpoint`).
+SAVE_FORMAT_VERSION = CHECKPOINT_FORMAT_VERSION
+#: ``kind`` of the checkpoints written by :meth:`CoupledRigidBody.checkpoint`.
+CHECKPOINT_KIND = "coupled-rigid-body"
 
 
-class RestoreError(ValueError):
-    """A file is not a spinorbit coupled-rotation save (or has an unknown format version)."""
+class RestoreError(CheckpointError):
+    """A file is not a complete spinorbit coupled-rotation save (see :class:`CheckpointError`)."""
 
 
 class CoupledRigidBody:
@@ -116,8 +120,10 @@ class CoupledRigidBody:
         ------
         spinorbit.coupling.rebound_adapter.RotationCallbackError
             A compiled callback found a problem and stopped the run (message says what and when).
+        KeyboardInterrupt
+            Ctrl-C (SIGINT) during the call, also when REBOUND's own handler caught it.
         """
-        self.sim.integrate(t)
+        integrate_interruptibly(self.sim, t)  # a Ctrl-C REBOUND absorbed still stops the run
         self.hooks.raise_if_failed()
 
     # ---------------------------------------------------------------------------------------
@@ -156,59 +162,54 @@ class CoupledRigidBody:
         return np.array(self.sim.angular_momentum()) + inertial_angular_momentum(y, self.hooks.figure)
 
     # ---------------------------------------------------------------------------------------
-    def save(self, path) -> None:
-        """Write orbits + rotation + coupling settings to one ``.npz``, atomically.
+    def checkpoint(self) -> Checkpoint:
+        """Orbits + rotation + coupling settings as one :class:`~spinorbit.checkpoint.Checkpoint`.
 
-        The REBOUND simulation (its binary form, including ``t`` and the integrator settings and
-        step size) and the rotation state are in the same file, so they cannot get out of step.
-        A temporary file in the same directory is renamed over ``path`` (no half-written file).
+        The REBOUND simulation in its binary form (``t``, particles, ``dt`` and the BS controller's
+        state: ``first_or_last_step``, ``previous_rejected``, ``target_iter``) and the rotation state
+        travel together, so they cannot get out of step. REBOUND's own binary does not hold user
+        ODEs; the rotation state is stored next to it and :meth:`from_checkpoint` re-attaches it.
         """
-        sim_bytes = self.sim.__reduce__()[1][0]
-        directory = os.path.dirname(os.path.abspath(path)) or "."
-        handle, temporary = tempfile.mkstemp(suffix=".npz", dir=directory)
-        try:
-            with os.fdopen(handle, "wb") as stream:
-                np.savez(
-                    stream,
-                    format_version=np.int64(SAVE_FORMAT_VERSION),
-                    simulation=np.frombuffer(sim_bytes, dtype=np.uint8),
-                    rotation_state=self.state,
-                    figure=self.figure,
-                    body=np.str_(self.body),
-                    perturbers=np.array(self.perturbers, dtype=str),
-                    flags=np.array([self.coupled, self.earth_j2, self.gr]),
-                    perturber_degrees=np.array(self.perturber_degrees, dtype=np.int64),
-                    earth_pole=np.array(self.earth_pole),
-                )
-            os.replace(temporary, path)
-        except BaseException:
-            if os.path.exists(temporary):
-                os.unlink(temporary)
-            raise
+        return Checkpoint(
+            kind=CHECKPOINT_KIND,
+            arrays={
+                "simulation": np.frombuffer(self.sim.__reduce__()[1][0], dtype=np.uint8),
+                "rotation_state": self.state,
+                "figure": self.figure,
+                "perturber_degrees": np.array(self.perturber_degrees, dtype=np.int64),
+                "earth_pole": np.array(self.earth_pole),
+            },
+            meta={"body": self.body, "perturbers": list(self.perturbers), "coupled": self.coupled,
+                  "earth_j2": self.earth_j2, "gr": self.gr,
+                  # REBOUND's binary does not restore names reliably (simulation_from_binary)
+                  "particle_names": [particle.name for particle in self.sim.particles]},
+        )
 
     @classmethod
-    def restore(cls, path) -> "CoupledRigidBody":
+    def from_checkpoint(cls, checkpoint: Checkpoint) -> CoupledRigidBody:
+        """Rebuild the simulation and its attached body from :meth:`checkpoint`; continues bit-for-bit."""
+        arrays, meta = checkpoint.arrays, checkpoint.meta
+        # The constructor below re-attaches the ODE and the forces (REBOUND does not store them).
+        sim = simulation_from_binary(arrays["simulation"].tobytes(), meta["particle_names"])
+        return cls(sim, meta["body"], arrays["figure"], arrays["rotation_state"], perturbers=meta["perturbers"],
+                   coupled=meta["coupled"], earth_j2=meta["earth_j2"], gr=meta["gr"],
+                   earth_pole=arrays["earth_pole"], perturber_degrees=[int(d) for d in arrays["perturber_degrees"]])
+
+    def save(self, path) -> None:
+        """Write :meth:`checkpoint` to ``path`` atomically (temporary file, fsync, rename)."""
+        self.checkpoint().write(path)
+
+    @classmethod
+    def restore(cls, path) -> CoupledRigidBody:
         """Rebuild a simulation and its attached body from :meth:`save`; continues bit-for-bit.
 
         Raises
         ------
         RestoreError
-            Not a save of this kind, or an unknown format version.
+            Missing, unreadable, truncated or corrupted file, or a checkpoint of another kind.
         """
         try:
-            with np.load(path, allow_pickle=False) as data:
-                contents = {key: data[key] for key in data.files}
-        except (OSError, ValueError) as error:
-            raise RestoreError(f"{path}: not a readable spinorbit coupled-rotation save ({error}).") from None
-        if "format_version" not in contents or int(contents["format_version"]) != SAVE_FORMAT_VERSION:
-            raise RestoreError(f"{path}: expected format_version {SAVE_FORMAT_VERSION}.")
-        with warnings.catch_warnings():
-            # REBOUND warns that function pointers are not restored: the constructor below
-            # re-attaches the ODE and the forces, which is exactly what the warning asks for.
-            warnings.filterwarnings("ignore", message="You have to reset function pointers")
-            sim = rebound.Simulation(contents["simulation"].tobytes())
-        coupled, earth_j2, gr = (bool(v) for v in contents["flags"])
-        return cls(sim, str(contents["body"]), contents["figure"], contents["rotation_state"],
-                   perturbers=[str(n) for n in contents["perturbers"]], coupled=coupled,
-                   earth_j2=earth_j2, gr=gr, earth_pole=contents["earth_pole"],
-                   perturber_degrees=[int(d) for d in contents["perturber_degrees"]])
+            checkpoint = Checkpoint.read(path, kind=CHECKPOINT_KIND)
+        except CheckpointError as error:
+            raise RestoreError(str(error)) from None
+        return cls.from_checkpoint(checkpoint)

@@ -34,8 +34,8 @@ Design choices
   (2× more steps on 10³ turns of scene (c)). Element outputs are in the shifted representation.
 * **Singular sets are detected, not crossed**: at the end of each accepted step the RHS reports
   1 − m (or 1 − μ), sin J and sin I; below the ``MIN_*`` constants the run stops with
-  :class:`ElementsSingularityError` naming the set and the time. Handing over to the quaternion
-  integrator there is left to the caller (or a later automatic switch).
+  :class:`ElementsSingularityError` naming the set and the time. The automatic hand-over to the
+  quaternion integrator there (and back) is :mod:`spinorbit.core.integrate_handover`.
 * **Driver**: its own small DOP853 loop sharing the tableau (``_dop853_tableau.py``) and the error
   norm with :mod:`spinorbit.core.integrate_quaternion`, whose kernel is specialised to the quaternion
   RHS and the renormalisation of q; it is left untouched so its speed cannot change.
@@ -101,9 +101,6 @@ PREVIOUS_ERROR_FLOOR = 1e-4
 STATUS_SEPARATRIX = 10
 STATUS_SPIN_ABOUT_C = 11
 STATUS_REFERENCE_POLE = 12
-
-# Extra slots in the stats array: time of the last accepted step (as float bits is overkill: the
-# kernel returns it separately).
 
 
 @jit
@@ -230,6 +227,8 @@ def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, fir
         [accepted, rejected, RHS calls, status].
     t_stop : float
         Time of the last accepted step.
+    el_stop : (6,) ndarray
+        Signed elements at ``t_stop`` (where a hand-over to the quaternion integrator starts).
     """
     n = 6
     n_out = t_out.shape[0]
@@ -253,7 +252,7 @@ def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, fir
     status = _singular_status(dist)
     if status != STATUS_SUCCESS:
         stats[STAT_STATUS] = status
-        return states, els, stats, t
+        return states, els, stats, t, y
     if first_step > 0.0:
         h_abs = first_step
     else:
@@ -261,7 +260,7 @@ def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, fir
         stats[STAT_RHS_CALLS] += 1
     if not (math.isfinite(h_abs) and h_abs > 0.0):
         stats[STAT_STATUS] = STATUS_NOT_FINITE
-        return states, els, stats, t
+        return states, els, stats, t, y
     i_out = 0
     while i_out < n_out and t_out[i_out] == t0:
         els[i_out] = y
@@ -278,10 +277,10 @@ def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, fir
         while not accepted:
             if steps >= max_steps:
                 stats[STAT_STATUS] = STATUS_MAX_STEPS
-                return states, els, stats, t
+                return states, els, stats, t, y
             if not (h_abs >= min_step):
                 stats[STAT_STATUS] = STATUS_STEP_TOO_SMALL
-                return states, els, stats, t
+                return states, els, stats, t, y
             h = direction * h_abs
             t_new = t + h
             if direction * (t_new - t_end) > 0.0:
@@ -295,7 +294,7 @@ def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, fir
             if not math.isfinite(err):
                 if h_abs <= min_step:
                     stats[STAT_STATUS] = STATUS_NOT_FINITE
-                    return states, els, stats, t
+                    return states, els, stats, t, y
                 h_abs *= MIN_FACTOR
                 rejected = True
                 stats[STAT_REJECTED] += 1
@@ -344,9 +343,9 @@ def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, fir
         status = _singular_status(dist)
         if status != STATUS_SUCCESS and i_out < n_out:
             stats[STAT_STATUS] = status
-            return states, els, stats, t
+            return states, els, stats, t, y
     stats[STAT_STATUS] = STATUS_SUCCESS
-    return states, els, stats, t
+    return states, els, stats, t, y
 
 
 # ---------------------------------------------------------------------------------------------
@@ -356,14 +355,17 @@ def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, fir
 class ElementsSingularityError(SingularElementsError):
     """The run approached a singular set of the canonical elements and stopped there.
 
-    Attributes ``t_stop`` (time of the last accepted step) and ``kind`` ("separatrix", "spin about C",
-    "reference pole"); continue from there with :func:`integrate_quaternion`.
+    Attributes ``t_stop`` (time of the last accepted step), ``kind`` ("separatrix", "spin about C",
+    "reference pole") and ``y_stop`` (the state (q, ω) at ``t_stop``, from the backward map of the elements
+    there); continue from there with :func:`integrate_quaternion`, or let
+    :func:`spinorbit.core.integrate_handover.integrate_with_handover` do it.
     """
 
-    def __init__(self, message, t_stop, kind):
+    def __init__(self, message, t_stop, kind, y_stop=None):
         super().__init__(message)
         self.t_stop = t_stop
         self.kind = kind
+        self.y_stop = y_stop
 
 
 _SINGULAR = {
@@ -477,6 +479,46 @@ def integrate_elements(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=DE
     IntegrationError
         Step cap, step underflow, non-finite state.
     """
+    states, els, stats, t_stop, y_stop, frame = run_elements(y0, t0, t_out, model, rtol, atol, max_steps,
+                                                             first_step, reduce_phases)
+    status = int(stats[STAT_STATUS])
+    if status in _SINGULAR:
+        kind, why = _SINGULAR[status]
+        raise ElementsSingularityError(
+            f"integrate_elements stopped at t = {t_stop!r}: {why}; continue from there with "
+            "integrate_quaternion.", t_stop, kind, y_stop)
+    if status != STATUS_SUCCESS:
+        raise IntegrationError(f"integration stopped at step {int(stats[0] + stats[1])}: {_STATUS_MESSAGES[status]}.")
+    out = [states]
+    if return_elements:
+        out.append(els)
+    if return_stats:
+        out.append({"accepted": int(stats[0]), "rejected": int(stats[1]), "rhs_calls": int(stats[2]),
+                    "frame": frame})
+    return out[0] if len(out) == 1 else tuple(out)
+
+
+def run_elements(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=DEFAULT_MAX_STEPS, first_step=0.0,
+                 reduce_phases=True):
+    """Validate, then run the element kernel; a singular stop is returned, not raised.
+
+    Parameters are those of :func:`integrate_elements`.
+
+    Returns
+    -------
+    states : (n, 7) ndarray
+        (q, ω) at t_out, NaN after a stop.
+    elements : (n, 6) ndarray
+    stats : (4,) int64 ndarray
+        [accepted, rejected, RHS calls, status] (``STATUS_*`` of this module and of
+        :mod:`spinorbit.core.integrate_quaternion`).
+    t_stop : float
+        Time of the last accepted step.
+    y_stop : (7,) ndarray
+        (q, ω) at ``t_stop`` from the backward map of the elements there.
+    frame : (3, 3) ndarray
+        Inertial → reference rotation of H, h used for the run.
+    """
     y0 = validate_state(y0)
     t0 = float(t0)
     t_out = _validate_times(t0, t_out)
@@ -497,20 +539,9 @@ def integrate_elements(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=DE
     atol = np.broadcast_to(atol, (ELEMENT_SIZE,)).copy()
     if not np.all(np.isfinite(atol)) or np.any(atol <= 0):
         raise ValueError(f"atol: expected absolute tolerances > 0 (scalar or 6 values), got {atol.tolist()}.")
-    states, els, stats, t_stop = integrate_elements_kernel(el0, t0, t_out, model, frame, atol, int(max_steps),
-                                                           float(first_step), bool(reduce_phases))
-    status = int(stats[STAT_STATUS])
-    if status in _SINGULAR:
-        kind, why = _SINGULAR[status]
-        raise ElementsSingularityError(
-            f"integrate_elements stopped at t = {t_stop!r}: {why}; continue from there with "
-            "integrate_quaternion.", t_stop, kind)
-    if status != STATUS_SUCCESS:
-        raise IntegrationError(f"integration stopped at step {int(stats[0] + stats[1])}: {_STATUS_MESSAGES[status]}.")
-    out = [states]
-    if return_elements:
-        out.append(els)
-    if return_stats:
-        out.append({"accepted": int(stats[0]), "rejected": int(stats[1]), "rhs_calls": int(stats[2]),
-                    "frame": frame})
-    return out[0] if len(out) == 1 else tuple(out)
+    states, els, stats, t_stop, el_stop = integrate_elements_kernel(el0, t0, t_out, model, frame, atol,
+                                                                    int(max_steps), float(first_step),
+                                                                    bool(reduce_phases))
+    y_stop = np.empty(7)
+    _state_at(el_stop, frame, inertia_constants(*moments), *moments, y_stop)
+    return states, els, stats, t_stop, y_stop, frame

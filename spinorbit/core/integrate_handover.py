@@ -114,15 +114,10 @@ def integrate_with_handover(y0, t0, t_out, model, rtol=1e-10, check_interval=Non
 
     Parameters
     ----------
-    y0 : array_like (7,)
-        Initial (q0, q1, q2, q3, ωx, ωy, ωz): scalar-first quaternion (body → inertial, normalised
-        here) and body angular velocity (rad per time unit), principal moments A ≤ B ≤ C.
-    t0 : float
-        Initial time (model time unit).
-    t_out : array_like (n,)
-        Output times, strictly monotone away from t0.
-    model : ndarray
-        :func:`spinorbit.core.dynamics.make_model`.
+    y0, t0, t_out, model
+        As in :func:`spinorbit.core.integrate_elements.integrate_elements`: initial (q, ω) (scalar-first
+        quaternion body → inertial, body angular velocity in rad per time unit), initial time,
+        strictly monotone output times, model array with A ≤ B ≤ C.
     rtol : float
         Tolerance of both integrators (their own error scales: :func:`.integrate_elements.default_element_atol`
         and :func:`.integrate_quaternion.default_atol`), 1e-15 ≤ rtol.

@@ -1,8 +1,9 @@
 """Canonical elements with an automatic hand-over to the quaternion integrator near singular sets.
 
 The elements (S, Z, H; s, z, h) are singular at the separatrix (1 − m → 0: the period and ∂m/∂d
-diverge, and the mode changes across it), at spin about ±C (sin J → 0) and with the angular momentum
-along the reference z axis (sin I → 0); :func:`spinorbit.core.integrate_elements.integrate_elements`
+diverge, and the mode changes across it), at spin about ±C (sin J → 0) or ±A (the centres of the
+SAM and LAM elements) and with the angular momentum along the reference z axis (sin I → 0), and they
+cannot resolve a body spherical to better than ~200 rtol; :func:`spinorbit.core.integrate_elements.integrate_elements`
 detects these and stops (its ``MIN_*`` constants). The non-singular quaternion equations
 (:mod:`spinorbit.core.dynamics`) have none of them. This driver runs the elements while they are
 well defined and the quaternion DOP853 through the passage:
@@ -35,9 +36,11 @@ from .gravity_field import BODY_A, BODY_B, BODY_C
 from .integrate_elements import (
     _SINGULAR,
     _STATUS_MESSAGES,
+    MIN_ASPHERICITY_PER_RTOL,
     MIN_SEPARATRIX_DISTANCE,
     MIN_SIN_I,
     MIN_SIN_J,
+    MIN_SIN_J_A,
     STATUS_SUCCESS,
     reference_frame_for,
     run_elements,
@@ -65,8 +68,8 @@ QUATERNION = "quaternion"
 class Switch(NamedTuple):
     """One hand-over: at time ``t`` the integrator ``to`` took over, because of ``reason``.
 
-    ``reason`` is a singular set ("separatrix", "spin about C", "reference pole", "permanent
-    rotation") for a switch to the quaternion integrator, "safely away" for a switch back.
+    ``reason`` is a singular set ("separatrix", "spin about C", "spin about A", "reference pole",
+    "permanent rotation", "nearly spherical body": then for the whole run) for a switch to the quaternion integrator, "safely away" for a switch back.
     """
 
     t: float
@@ -75,7 +78,10 @@ class Switch(NamedTuple):
 
 
 def singularity_distances_of_state(y, moments):
-    """(1 − m or 1 − μ, sin J, sin I) of a state (q, ω), sin I in the frame the elements would use.
+    """(1 − m or 1 − μ, sin J, sin I, sin J_A) of a state (q, ω), sin I in the frame the elements would use.
+
+    As :func:`spinorbit.core.element_forces.singularity_distances`; sin J_A is the sine of the angle of
+    M from the A axis (spin about ±A, the centre of the LAM elements).
 
     Parameters
     ----------
@@ -86,7 +92,7 @@ def singularity_distances_of_state(y, moments):
 
     Returns
     -------
-    tuple of 3 floats
+    tuple of 4 floats
         0 for the separatrix distance of a permanent rotation (no elements), as in the kernel.
     """
     ic = inertia_constants(*moments)
@@ -98,11 +104,13 @@ def singularity_distances_of_state(y, moments):
 
 def _singular_reason(distances, margin):
     """The first singular set closer than ``margin`` × its threshold, or None."""
-    sep, sin_j, sin_i = distances
+    sep, sin_j, sin_i, sin_j_a = distances
     if not sep >= margin * MIN_SEPARATRIX_DISTANCE:
         return "separatrix" if sep > 0.0 else "permanent rotation"
     if not sin_j >= margin * MIN_SIN_J:
         return "spin about C"
+    if not sin_j_a >= margin * MIN_SIN_J_A:
+        return "spin about A"
     if not sin_i >= margin * MIN_SIN_I:
         return "reference pole"
     return None
@@ -158,11 +166,15 @@ def integrate_with_handover(y0, t0, t_out, model, rtol=1e-10, check_interval=Non
     ys = np.full((t_out.size, 7), np.nan)
     switches = []
     i_out = 0
-    reason = _singular_reason(singularity_distances_of_state(y, moments), resume_margin)
+    resolvable = (moments[2] - moments[0]) / moments[2] >= MIN_ASPHERICITY_PER_RTOL * rtol
+    reason = _singular_reason(singularity_distances_of_state(y, moments), resume_margin) if resolvable else (
+        "nearly spherical body")
     if reason is not None:
         switches.append(Switch(t, QUATERNION, reason))
     while i_out < t_out.size:
-        if reason is None:
+        if not resolvable:  # the elements never take over (integrate_elements.MIN_ASPHERICITY_PER_RTOL)
+            i_out, t, y = _quaternion_probe(y, t, t_out, i_out, model, rtol, max_steps, direction, math.inf, ys)
+        elif reason is None:
             i_out, t, y, reason = _elements_stretch(y, t, t_out, i_out, model, rtol, max_steps, ys)
             if reason is not None:
                 switches.append(Switch(t, QUATERNION, reason))

@@ -178,3 +178,23 @@ def test_nearly_spherical_body_is_refused_at_a_tolerance_that_cannot_resolve_it(
     y0 = np.r_[Q_GENERIC, np.array([0.3, -0.4, 0.8]) / np.array(body)]
     with pytest.raises(SingularElementsError, match=r"spherical to \(C − A\)/C = 2e-12"):
         integrate_elements(y0, 0.0, [1.0], make_model(body), rtol=RTOL)
+
+
+def test_momentum_passing_the_reference_pole_is_handed_over_and_back():
+    """M starts 0.15 rad from inertial z (so the elements keep the inertial frame) and precesses about
+    the normal of an orbit inclined 0.07 rad towards it: it passes 2e-4 rad from z near t = 76. The
+    elements stop there (sin I < 1e-3), DOP853 takes over, and the elements resume in the frame
+    turned by 90° about x; the result is at least as accurate as DOP853 alone (measured 8.6e-11
+    against 2.2e-9 rad)."""
+    body = np.array([0.5, 0.3, 2.9])  # body momentum, |M| ≈ 2.96
+    target = np.array([math.sin(0.15), 0.0, math.cos(0.15)])  # its inertial direction
+    axis = np.cross(body / np.linalg.norm(body), target)
+    half = 0.5 * math.atan2(np.linalg.norm(axis), body @ target / np.linalg.norm(body))
+    y0 = np.r_[math.cos(half), math.sin(half) * axis / np.linalg.norm(axis), body / MOMENTS]
+    pole_model = make_model(MOMENTS, [kepler_source(3.0, 2.0, 0.0, 0.07, math.pi / 2, 0.0, 0.0)])
+    times = np.linspace(0.0, 100.0, 51)[1:]
+    ys, switches = integrate_with_handover(y0, 0.0, times, pole_model, rtol=RTOL)
+    assert [(s.to, s.reason) for s in switches] == [(QUATERNION, "reference pole"), (ELEMENTS, "safely away")]
+    ref = integrate_quaternion(y0, 0.0, times, pole_model, rtol=1e-15)
+    plain = integrate_quaternion(y0, 0.0, times, pole_model, rtol=RTOL)
+    assert angle(ys, ref) <= angle(plain, ref)

@@ -68,8 +68,9 @@ QUATERNION = "quaternion"
 class Switch(NamedTuple):
     """One hand-over: at time ``t`` the integrator ``to`` took over, because of ``reason``.
 
-    ``reason`` is a singular set ("separatrix", "spin about C", "spin about A", "reference pole",
-    "permanent rotation", "nearly spherical body": then for the whole run) for a switch to the quaternion integrator, "safely away" for a switch back.
+    ``reason`` is a singular set for a switch to the quaternion integrator ("separatrix", "spin
+    about C", "spin about A", "reference pole", "permanent rotation", or "nearly spherical body":
+    then for the whole run), "safely away" for a switch back.
     """
 
     t: float
@@ -157,6 +158,8 @@ def integrate_with_handover(y0, t0, t_out, model, rtol=1e-10, check_interval=Non
     t_out = _validate_times(t, t_out)
     model = np.ascontiguousarray(model, dtype=float)
     moments = np.array([model[BODY_A], model[BODY_B], model[BODY_C]])
+    if not (math.isfinite(rtol) and rtol >= 1e-15):
+        raise ValueError(f"rtol: expected a relative tolerance ≥ 1e-15, got {rtol!r}; try 1e-10.")
     if not (math.isfinite(resume_margin) and resume_margin >= 1.0):
         raise ValueError(f"resume_margin: expected a factor ≥ 1 on the stop thresholds, got {resume_margin!r}; "
                          f"try the default {RESUME_MARGIN:g}.")
@@ -212,6 +215,8 @@ def _quaternion_probe(y, t, t_out, i_out, model, rtol, max_steps, direction, che
     t_check = t + direction * check_interval
     if direction * (t_check - t_out[-1]) >= 0.0:
         t_check = t_out[-1]
+    if t_check == t:  # a probe shorter than the spacing of doubles at t: go to the next output
+        t_check = t_out[i_out]
     inside = t_out[i_out:][direction * (t_out[i_out:] - t_check) <= 0.0]
     times = inside if inside.size and inside[-1] == t_check else np.append(inside, t_check)
     states = integrate_quaternion(y, t, times, model, rtol=rtol, max_steps=max_steps)

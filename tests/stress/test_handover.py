@@ -123,6 +123,7 @@ def test_start_next_to_spin_about_c_begins_with_the_quaternion_integrator():
     ({"resume_margin": 0.5}, "resume_margin.*0.5"),
     ({"check_interval": -1.0}, "check_interval.*-1.0"),
     ({"check_interval": math.nan}, "check_interval.*nan"),
+    ({"rtol": 1e-16}, "rtol.*1e-16"),
 ])
 def test_bad_driver_parameters_say_what_was_expected(kwargs, pattern):
     with pytest.raises(ValueError, match=pattern):

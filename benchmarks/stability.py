@@ -1,6 +1,6 @@
 """Numerical stability at the edges and over long runs; writes a section of docs/stability.md + plots.
 
-Run: ``python benchmarks/stability.py`` (≈ 3 min on 2 shared cores; ``--quick`` for a 10× shorter
+Run: ``python benchmarks/stability.py`` (≈ 2 min on 2 shared cores; ``--quick`` for a 10× shorter
 smoke run that does not touch docs/). Every error is printed next to the machine-precision floor it
 is compared to:
 

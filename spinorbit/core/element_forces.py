@@ -143,11 +143,12 @@ def andoyer_gradient_from_torque(attitude, momentum, nx, ny, nz):
 
 @jit
 def singularity_distances(elements, attitude, momentum, ic):
-    """(1 − m or 1 − μ, sin J, sin I) of a state: how far it is from the elements' singular sets.
+    """(1 − m or 1 − μ, sin J, sin I, sin J_A) of a state: how far it is from the elements' singular sets.
 
-    1 − m → 0 at the separatrix (and the mode changes across it); sin J → 0 at spin about ±C;
-    sin I → 0 when the angular momentum is along the reference z axis. A permanent rotation returns
-    a separatrix distance of 0.
+    1 − m → 0 at the separatrix (and the mode changes across it); sin J → 0 at spin about ±C (the
+    centre of the SAM elements); sin I → 0 when the angular momentum is along the reference z axis;
+    sin J_A = |M × A axis| / G → 0 at spin about ±A (the centre of the LAM elements, S → Z, where
+    the Jacobian's 1/√(a − d) terms overflow). A permanent rotation returns a separatrix distance of 0.
     """
     work, _ = working_elements(elements)
     return _distances(motion_from_elements(work[0], work[1], ic), attitude, momentum)
@@ -158,10 +159,11 @@ def _distances(mo, attitude, momentum):
     sep = 0.0 if mo[MO_MODE] == MODE_UNIFORM else mo[MO_PARAM_C]
     big_g = math.sqrt(momentum[0] ** 2 + momentum[1] ** 2 + momentum[2] ** 2)
     sin_j = math.hypot(momentum[0], momentum[1]) / big_g
+    sin_j_a = math.hypot(momentum[1], momentum[2]) / big_g
     m0 = attitude[0, 0] * momentum[0] + attitude[1, 0] * momentum[1] + attitude[2, 0] * momentum[2]
     m1 = attitude[0, 1] * momentum[0] + attitude[1, 1] * momentum[1] + attitude[2, 1] * momentum[2]
     sin_i = math.hypot(m0, m1) / big_g
-    return sep, sin_j, sin_i
+    return sep, sin_j, sin_i, sin_j_a
 
 
 @jit
@@ -188,7 +190,7 @@ def elements_rhs_into(t, elements, model, frame, ic, dy):
 
     Returns
     -------
-    sep, sin_j, sin_i : float
+    sep, sin_j, sin_i, sin_j_a : float
         :func:`singularity_distances` of the state (computed from quantities the RHS has anyway).
     """
     # The motion and elliptic constants of (S, Z) once, for both the backward map and the Jacobian.

@@ -33,9 +33,11 @@ Design choices
   hence the RHS of s and z, carry terms proportional to s and the steps shrink as the run goes on
   (2× more steps on 10³ turns of scene (c)). Element outputs are in the shifted representation.
 * **Singular sets are detected, not crossed**: at the end of each accepted step the RHS reports
-  1 − m (or 1 − μ), sin J and sin I; below the ``MIN_*`` constants the run stops with
-  :class:`ElementsSingularityError` naming the set and the time. Handing over to the quaternion
-  integrator there is left to the caller (or a later automatic switch).
+  1 − m (or 1 − μ), sin J, sin I and the sine of the angle of M from the A axis; below the
+  ``MIN_*`` constants the run stops with :class:`ElementsSingularityError` naming the set and the
+  time. Bodies too nearly spherical for the tolerance are refused up front
+  (``MIN_ASPHERICITY_PER_RTOL``). The automatic hand-over to the
+  quaternion integrator there (and back) is :mod:`spinorbit.core.integrate_handover`.
 * **Driver**: its own small DOP853 loop sharing the tableau (``_dop853_tableau.py``) and the error
   norm with :mod:`spinorbit.core.integrate_quaternion`, whose kernel is specialised to the quaternion
   RHS and the renormalisation of q; it is left untouched so its speed cannot change.
@@ -86,8 +88,16 @@ ELEMENT_SIZE = 6
 MIN_SEPARATRIX_DISTANCE = 1e-4
 #: Stop near spin about ±C: ds/dt and ∂U/∂L grow like 1/sin J there (polar-coordinate singularity).
 MIN_SIN_J = 1e-3
+#: Stop near spin about ±A (LAM's centre, S → Z): the Jacobian's 1/√(a − d) terms overflow there.
+MIN_SIN_J_A = 1e-3
 #: Stop near the reference z axis: dh/dt grows like 1/sin I (the node is undefined at I = 0).
 MIN_SIN_I = 1e-3
+#: Refuse bodies closer to a sphere than (C − A)/C < MIN_ASPHERICITY_PER_RTOL × rtol: S lies in
+#: [√(A/C) Z, Z], an interval of relative width ≈ (C − A)/(2C), and the step error test allows
+#: rtol·G in S; below this ratio S (hence the energy, the mode parameter and the period) is not
+#: located within its interval to 1 %, and the run returns an attitude that is wrong by O(1) rad
+#: without any warning (measured 2.9 rad after 20 turns at (C − A)/C = 2e-12, rtol 1e-12).
+MIN_ASPHERICITY_PER_RTOL = 200.0
 #: Same rule and value as spinorbit.state.AUTO_REFERENCE_MIN_SIN_I: if the initial sin I is below
 #: this, H and h are referred to the inertial frame turned by 90° about x.
 AUTO_REFERENCE_MIN_SIN_I = 0.1
@@ -101,9 +111,7 @@ PREVIOUS_ERROR_FLOOR = 1e-4
 STATUS_SEPARATRIX = 10
 STATUS_SPIN_ABOUT_C = 11
 STATUS_REFERENCE_POLE = 12
-
-# Extra slots in the stats array: time of the last accepted step (as float bits is overkill: the
-# kernel returns it separately).
+STATUS_SPIN_ABOUT_A = 13
 
 
 @jit
@@ -150,11 +158,13 @@ def _dense_coefficients(t, y, y_new, f_new, h, model, frame, ic, k, coeffs):
 
 @jit
 def _singular_status(distances):
-    sep, sin_j, sin_i = distances
+    sep, sin_j, sin_i, sin_j_a = distances
     if not (sep >= MIN_SEPARATRIX_DISTANCE):
         return STATUS_SEPARATRIX
     if not (sin_j >= MIN_SIN_J):
         return STATUS_SPIN_ABOUT_C
+    if not (sin_j_a >= MIN_SIN_J_A):
+        return STATUS_SPIN_ABOUT_A
     if not (sin_i >= MIN_SIN_I):
         return STATUS_REFERENCE_POLE
     return STATUS_SUCCESS
@@ -230,6 +240,8 @@ def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, fir
         [accepted, rejected, RHS calls, status].
     t_stop : float
         Time of the last accepted step.
+    el_stop : (6,) ndarray
+        Signed elements at ``t_stop`` (where a hand-over to the quaternion integrator starts).
     """
     n = 6
     n_out = t_out.shape[0]
@@ -253,7 +265,7 @@ def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, fir
     status = _singular_status(dist)
     if status != STATUS_SUCCESS:
         stats[STAT_STATUS] = status
-        return states, els, stats, t
+        return states, els, stats, t, y
     if first_step > 0.0:
         h_abs = first_step
     else:
@@ -261,7 +273,7 @@ def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, fir
         stats[STAT_RHS_CALLS] += 1
     if not (math.isfinite(h_abs) and h_abs > 0.0):
         stats[STAT_STATUS] = STATUS_NOT_FINITE
-        return states, els, stats, t
+        return states, els, stats, t, y
     i_out = 0
     while i_out < n_out and t_out[i_out] == t0:
         els[i_out] = y
@@ -278,10 +290,10 @@ def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, fir
         while not accepted:
             if steps >= max_steps:
                 stats[STAT_STATUS] = STATUS_MAX_STEPS
-                return states, els, stats, t
+                return states, els, stats, t, y
             if not (h_abs >= min_step):
                 stats[STAT_STATUS] = STATUS_STEP_TOO_SMALL
-                return states, els, stats, t
+                return states, els, stats, t, y
             h = direction * h_abs
             t_new = t + h
             if direction * (t_new - t_end) > 0.0:
@@ -295,7 +307,7 @@ def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, fir
             if not math.isfinite(err):
                 if h_abs <= min_step:
                     stats[STAT_STATUS] = STATUS_NOT_FINITE
-                    return states, els, stats, t
+                    return states, els, stats, t, y
                 h_abs *= MIN_FACTOR
                 rejected = True
                 stats[STAT_REJECTED] += 1
@@ -344,9 +356,9 @@ def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, fir
         status = _singular_status(dist)
         if status != STATUS_SUCCESS and i_out < n_out:
             stats[STAT_STATUS] = status
-            return states, els, stats, t
+            return states, els, stats, t, y
     stats[STAT_STATUS] = STATUS_SUCCESS
-    return states, els, stats, t
+    return states, els, stats, t, y
 
 
 # ---------------------------------------------------------------------------------------------
@@ -356,19 +368,24 @@ def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, fir
 class ElementsSingularityError(SingularElementsError):
     """The run approached a singular set of the canonical elements and stopped there.
 
-    Attributes ``t_stop`` (time of the last accepted step) and ``kind`` ("separatrix", "spin about C",
-    "reference pole"); continue from there with :func:`integrate_quaternion`.
+    Attributes ``t_stop`` (time of the last accepted step), ``kind`` ("separatrix", "spin about C",
+    "spin about A", "reference pole") and ``y_stop`` (the state (q, ω) at ``t_stop``, from the backward map of the elements
+    there); continue from there with :func:`integrate_quaternion`, or let
+    :func:`spinorbit.core.integrate_handover.integrate_with_handover` do it.
     """
 
-    def __init__(self, message, t_stop, kind):
+    def __init__(self, message, t_stop, kind, y_stop=None):
         super().__init__(message)
         self.t_stop = t_stop
         self.kind = kind
+        self.y_stop = y_stop
 
 
 _SINGULAR = {
     STATUS_SEPARATRIX: ("separatrix", f"1 − m (or 1 − μ) fell below MIN_SEPARATRIX_DISTANCE = {MIN_SEPARATRIX_DISTANCE:g}"),
     STATUS_SPIN_ABOUT_C: ("spin about C", f"sin J fell below MIN_SIN_J = {MIN_SIN_J:g} (spin about ±C)"),
+    STATUS_SPIN_ABOUT_A: ("spin about A", f"the angle of M from the A axis fell below MIN_SIN_J_A = {MIN_SIN_J_A:g} "
+                          "(spin about ±A)"),
     STATUS_REFERENCE_POLE: ("reference pole", f"sin I fell below MIN_SIN_I = {MIN_SIN_I:g} (angular momentum "
                             "along the reference z axis)"),
 }
@@ -388,6 +405,20 @@ def reference_frame_for(y0, moments):
     if math.hypot(momentum_inertial[0], momentum_inertial[1]) < AUTO_REFERENCE_MIN_SIN_I * g:
         return np.ascontiguousarray(rot1(math.pi / 2))
     return np.eye(3)
+
+
+def check_resolvable_body(moments, rtol):
+    """Raise SingularElementsError if the body is too nearly spherical for the elements at ``rtol``.
+
+    See ``MIN_ASPHERICITY_PER_RTOL``.
+    """
+    asphericity = (moments[2] - moments[0]) / moments[2]
+    if not asphericity >= MIN_ASPHERICITY_PER_RTOL * rtol:
+        raise SingularElementsError(
+            f"model: the body is spherical to (C − A)/C = {asphericity:.3g}, below "
+            f"{MIN_ASPHERICITY_PER_RTOL:g} × rtol = {MIN_ASPHERICITY_PER_RTOL * rtol:.3g}: the elements cannot "
+            "resolve its energy at this tolerance; use integrate_quaternion (or integrate_with_handover)."
+        )
 
 
 def elements_of_state(y0, model, frame):
@@ -471,11 +502,52 @@ def integrate_elements(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=DE
     ValueError
         Bad y0, times, tolerances; sampled perturbers not covering the run.
     SingularElementsError
-        y0 is a permanent rotation or on the separatrix.
+        y0 is a permanent rotation or on the separatrix, or the body is too nearly spherical for rtol
+        (:func:`check_resolvable_body`).
     ElementsSingularityError
-        The run approached the separatrix, spin about C, or the reference pole (``t_stop``, ``kind``).
+        The run approached the separatrix, spin about C or A, or the reference pole (``t_stop``, ``kind``).
     IntegrationError
         Step cap, step underflow, non-finite state.
+    """
+    states, els, stats, t_stop, y_stop, frame = run_elements(y0, t0, t_out, model, rtol, atol, max_steps,
+                                                             first_step, reduce_phases)
+    status = int(stats[STAT_STATUS])
+    if status in _SINGULAR:
+        kind, why = _SINGULAR[status]
+        raise ElementsSingularityError(
+            f"integrate_elements stopped at t = {t_stop!r}: {why}; continue from there with "
+            "integrate_quaternion.", t_stop, kind, y_stop)
+    if status != STATUS_SUCCESS:
+        raise IntegrationError(f"integration stopped at step {int(stats[0] + stats[1])}: {_STATUS_MESSAGES[status]}.")
+    out = [states]
+    if return_elements:
+        out.append(els)
+    if return_stats:
+        out.append({"accepted": int(stats[0]), "rejected": int(stats[1]), "rhs_calls": int(stats[2]),
+                    "frame": frame})
+    return out[0] if len(out) == 1 else tuple(out)
+
+
+def run_elements(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=DEFAULT_MAX_STEPS, first_step=0.0,
+                 reduce_phases=True):
+    """Validate, then run the element kernel; a singular stop is returned, not raised.
+
+    Parameters are those of :func:`integrate_elements`.
+
+    Returns
+    -------
+    states : (n, 7) ndarray
+        (q, ω) at t_out, NaN after a stop.
+    elements : (n, 6) ndarray
+    stats : (4,) int64 ndarray
+        [accepted, rejected, RHS calls, status] (``STATUS_*`` of this module and of
+        :mod:`spinorbit.core.integrate_quaternion`).
+    t_stop : float
+        Time of the last accepted step.
+    y_stop : (7,) ndarray
+        (q, ω) at ``t_stop`` from the backward map of the elements there.
+    frame : (3, 3) ndarray
+        Inertial → reference rotation of H, h used for the run.
     """
     y0 = validate_state(y0)
     t0 = float(t0)
@@ -487,6 +559,7 @@ def integrate_elements(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=DE
     model = np.ascontiguousarray(model, dtype=float)
     validate_sampled_span(model, t0, t_out)
     moments = np.array([model[BODY_A], model[BODY_B], model[BODY_C]])
+    check_resolvable_body(moments, rtol)
     frame = reference_frame_for(y0, moments)
     el0 = elements_of_state(y0, model, frame)
     if atol is None:
@@ -497,20 +570,9 @@ def integrate_elements(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=DE
     atol = np.broadcast_to(atol, (ELEMENT_SIZE,)).copy()
     if not np.all(np.isfinite(atol)) or np.any(atol <= 0):
         raise ValueError(f"atol: expected absolute tolerances > 0 (scalar or 6 values), got {atol.tolist()}.")
-    states, els, stats, t_stop = integrate_elements_kernel(el0, t0, t_out, model, frame, atol, int(max_steps),
-                                                           float(first_step), bool(reduce_phases))
-    status = int(stats[STAT_STATUS])
-    if status in _SINGULAR:
-        kind, why = _SINGULAR[status]
-        raise ElementsSingularityError(
-            f"integrate_elements stopped at t = {t_stop!r}: {why}; continue from there with "
-            "integrate_quaternion.", t_stop, kind)
-    if status != STATUS_SUCCESS:
-        raise IntegrationError(f"integration stopped at step {int(stats[0] + stats[1])}: {_STATUS_MESSAGES[status]}.")
-    out = [states]
-    if return_elements:
-        out.append(els)
-    if return_stats:
-        out.append({"accepted": int(stats[0]), "rejected": int(stats[1]), "rhs_calls": int(stats[2]),
-                    "frame": frame})
-    return out[0] if len(out) == 1 else tuple(out)
+    states, els, stats, t_stop, el_stop = integrate_elements_kernel(el0, t0, t_out, model, frame, atol,
+                                                                    int(max_steps), float(first_step),
+                                                                    bool(reduce_phases))
+    y_stop = np.empty(7)
+    _state_at(el_stop, frame, inertia_constants(*moments), *moments, y_stop)
+    return states, els, stats, t_stop, y_stop, frame

@@ -273,6 +273,33 @@ def hermite_position_xyz(t, arr, first, count, xv_first):
             h00 * arr[i0 + 2] + h10 * arr[i0 + 5] + h01 * arr[i1 + 2] + h11 * arr[i1 + 5])
 
 
+@jit(inline="always")
+def hermite_velocity_xyz(t, arr, first, count, xv_first):
+    """Derivative of :func:`hermite_position_xyz` (the interpolant's velocity, O(h³)); NaN outside."""
+    if not (arr[first] <= t <= arr[first + count - 1]):
+        return np.nan, np.nan, np.nan
+    lo = _find_interval(t, arr, first, count)
+    h = arr[lo + 1] - arr[lo]
+    s = (t - arr[lo]) / h
+    s2 = s * s
+    d00 = (6.0 * s2 - 6.0 * s) / h
+    d10 = 3.0 * s2 - 4.0 * s + 1.0
+    d01 = -d00
+    d11 = 3.0 * s2 - 2.0 * s
+    i0 = xv_first + 6 * (lo - first)
+    i1 = i0 + 6
+    return (d00 * arr[i0] + d10 * arr[i0 + 3] + d01 * arr[i1] + d11 * arr[i1 + 3],
+            d00 * arr[i0 + 1] + d10 * arr[i0 + 4] + d01 * arr[i1 + 1] + d11 * arr[i1 + 4],
+            d00 * arr[i0 + 2] + d10 * arr[i0 + 5] + d01 * arr[i1 + 2] + d11 * arr[i1 + 5])
+
+
+@jit(inline="always")
+def sampled_velocity_xyz(t, arr, row):
+    """Velocity (inertial) of the sampled perturber whose row starts at arr[row]; allocation-free."""
+    off = row + 2
+    return hermite_velocity_xyz(t, arr, int(arr[off]), int(arr[off + 1]), int(arr[off + 2]))
+
+
 @jit
 def hermite_state(t, times, xv):
     """Cubic Hermite interpolation of positions and velocities sampled at sorted ``times`` → (6,).

@@ -266,9 +266,9 @@ def _comparison(times, quaternions, wall):
 #: J2), the Sun second (it also acts on the distortion ΔI); the planets act on the undistorted figure.
 #: Mercury, Uranus, Neptune: (μ/r³) below 1e-9 of the Earth's, left out.
 INTERIOR_PERTURBERS = ("earth", "sun", "venus", "mars", "jupiter", "saturn")
-#: Relative interpolation error of the sampled DE421 positions. Measured: 1e-10 and 1e-12 give the
-#: same 5-year comparison to 1e-5″; the sampling is the dominant cost (docs/coupling.md).
-INTERIOR_SAMPLE_TOLERANCE = 1e-10
+#: Relative interpolation error of the sampled DE421 positions. Measured: 1e-9, 1e-10 and 1e-12 give
+#: the same 5- and 20-year comparisons to 1e-5″; the sampling is the dominant cost (docs/coupling.md).
+INTERIOR_SAMPLE_TOLERANCE = 1e-9
 #: DOP853 local tolerance for the "de421" model; 1e-11 … 1e-13 agree to 1e-5″ over 5 years.
 INTERIOR_RTOL = 1e-12
 #: Lunar mean motion n (rad/day) in the rotational-distortion term: 2π per sidereal month
@@ -301,10 +301,13 @@ def interior_model(start_day, end_day, perturbers=INTERIOR_PERTURBERS,
         raise ValueError(f"perturbers: expected the Earth and the Sun first, got {perturbers!r}.")
     constants = de421_constants()
     gravitational_constant = constants.gm["sun"]  # G in (au, day, Msun): GM_Sun / M_Sun
-    samples = sample_from_ephemeris(de421_orbit("moon"), time_from_tdb_days(start_day - 1.0),
-                                    time_from_tdb_days(end_day + 1.0), perturbers, tolerance=sample_tolerance)
+    # One grid per perturber: seen from the Moon the Earth's direction turns in a month, the Sun's
+    # and the planets' in a year or more, so their grids are much coarser than a shared one would be.
+    start, end = time_from_tdb_days(start_day - 1.0), time_from_tdb_days(end_day + 1.0)
+    sources = [sample_from_ephemeris(de421_orbit("moon"), start, end, (name,), tolerance=sample_tolerance).sources()[0]
+               for name in perturbers]
     figure = moon_figure(constants.gm["moon"] / gravitational_constant, "rigid", 4)
-    body = np.concatenate([figure, pack_perturbers(samples.sources(), base=MODEL_PERTURBERS)])
+    body = np.concatenate([figure, pack_perturbers(sources, base=MODEL_PERTURBERS)])
     polar = figure[2]  # C_T, Msun·au²
     interior = make_interior_block(
         earth_row=MODEL_PERTURBERS + 1, gravitational_constant=gravitational_constant,

@@ -7,7 +7,12 @@ moments A ≤ B ≤ C::
     q̇ = ½ q ⊗ (0, ω)
     I ω̇ = Iω × ω + N,   N = Σ_perturbers (∂U/∂r) × r     (gravity_field.py for U and the sign)
 
-r is the perturber's position in the body frame, r = R r_inertial with R = M(q)ᵀ. Every back end
+r is the perturber's position in the body frame, r = R r_inertial with R = M(q)ᵀ.
+
+A 10-component state (q, ω, ω_c) with a model array that ends with an interior block is the Moon of
+the JPL ephemerides (elastic mantle with tides around a fluid core): :func:`lunar_rhs_into`, built from
+:mod:`spinorbit.core.lunar_interior`; :func:`rhs_into` dispatches on the state's length, so the same
+integrators run both. Every back end
 (the numba integrator, scipy's ``solve_ivp`` through :func:`scipy_rhs`, the benchmark peers) calls
 :func:`rhs`; nothing else defines the dynamics.
 

@@ -100,6 +100,16 @@ def test_cli_moon_last_line_and_files(tmp_path, capsys):
     assert plot_path.stat().st_size > 0
 
 
+def test_cli_moon_default_is_the_de421_model(capsys):
+    from spinorbit import cli
+
+    assert cli.main(["moon", "--span", "30", "d"]) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert lines[0].split()[1] == "de421,"
+    value = float(lines[-1].removeprefix("max attitude difference vs DE421: ").removesuffix(" arcsec over 30 d"))
+    assert value < DE421_MODEL_ONE_YEAR_ARCSEC  # 30 days inside the 1-year run: measured 0.00018″
+
+
 def test_cli_moon_refuses_a_span_past_the_model_range(capsys):
     from spinorbit import cli
 

@@ -81,9 +81,9 @@ def make_interior_block(earth_row, gravitational_constant, love_number, time_del
     """
     values = np.array([love_number, time_delay, radius, mean_motion, core_polar_moment, friction,
                        gravitational_constant], dtype=float)
-    if not np.all(np.isfinite(values)) or np.any(values[[0, 1, 2, 3, 4, 6]] < 0) or values[5] < 0:
-        raise ValueError(f"interior parameters: expected finite, non-negative k2, tau, R, n, C_c, k_v, G; "
-                         f"got {values.tolist()}.")
+    if not np.all(np.isfinite(values)) or np.any(values < 0) or values[-1] == 0:
+        raise ValueError(f"interior parameters: expected finite, non-negative k2, tau, R, n, C_c, k_v and "
+                         f"G > 0; got {values.tolist()}.")
     if not 0.0 <= core_flattening < 1.0:
         raise ValueError(f"core_flattening: expected 0 ≤ f_c < 1, got {core_flattening!r}.")
     pole = np.asarray(earth_pole, dtype=float)

@@ -46,6 +46,7 @@ __all__ = [
     "de421_constants",
     "barycentric_state",
     "barycentric_state_au",
+    "earth_from_moon_au",
     "barycentric_state_km",
     "moon_libration_angles",
     "moon_libration_angles_raw",
@@ -186,6 +187,18 @@ def barycentric_state_km(body: str, day, fraction=0.0):
     share = 1.0 / (1.0 + emrat) if name == "earth" else -emrat / (1.0 + emrat)
     # Earth = EMB − Moon_geo·M_moon/(M_earth+M_moon); Moon = EMB + Moon_geo·M_earth/(M_earth+M_moon).
     return emb_r - share * moon_r, emb_v - share * moon_v
+
+
+def earth_from_moon_au(day, fraction=0.0):
+    """Position and velocity of the Earth relative to the Moon (ICRF, au_DE421 and au/day).
+
+    Minus DE421's geocentric Moon series, evaluated directly: one Chebyshev series instead of the
+    four that the difference of two barycentric states needs, and no cancellation.
+    """
+    _check_span(day, fraction)
+    position, velocity = _evaluate("moon", day, fraction)
+    au_km = _ephemeris().AU
+    return -position / au_km, -velocity / au_km
 
 
 def barycentric_state_au(body: str, day, fraction=0.0):

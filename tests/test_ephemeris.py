@@ -163,3 +163,14 @@ def test_constants_are_read_and_moments_derived():
     assert (b - a) / 4 == pytest.approx(c.moon_c22, rel=1e-12)
     with pytest.raises(TypeError):
         c.header["AU"] = 1.0  # read-only
+
+
+def test_earth_from_moon_is_the_difference_of_the_barycentric_states():
+    from spinorbit.ephemeris import barycentric_state_au, earth_from_moon_au
+
+    days = np.linspace(-3000.0, 7000.0, 11)
+    relative, rate = earth_from_moon_au(days)
+    (earth, earth_v), (moon, moon_v) = barycentric_state_au("earth", days), barycentric_state_au("moon", days)
+    # The barycentric difference cancels ~1 au to 0.0026 au: rounding ~ ε·400 ≈ 1e-13 relative.
+    np.testing.assert_allclose(relative, earth - moon, rtol=0, atol=1e-12 * np.abs(relative).max())
+    np.testing.assert_allclose(rate, earth_v - moon_v, rtol=0, atol=1e-12 * np.abs(rate).max())

@@ -10,6 +10,9 @@ import sys
 from ..cli import CommandError
 from ._common import Progress, atomic_output, check_output_path, quantity
 
+#: The models (spinorbit.coupling.moon.MOON_MODELS, repeated so that --help does not import REBOUND).
+MOON_MODELS = ("de421", "rigid", "core-corrected")
+
 NAME = "moon"
 SUMMARY = "lunar physical libration from DE421 at J2000, coupled to the orbits, compared with DE421"
 DESCRIPTION = """\
@@ -18,13 +21,17 @@ DE421 constants, torques from the Sun, planets and Earth) together with the orbi
 point masses + EIH 1PN + Earth J2 + the lunar figure's back-reaction), starting from DE421 at J2000,
 and compare the attitude with DE421's librations at every output time.
 
-Models: 'rigid' uses DE421's total moments; 'core-corrected' removes the fluid core's share of the
-polar moment (IFAC) from the moments the mantle's Euler equations see (docs/coupling.md).
+Models: 'de421' (default) is DE421's own lunar rotation model (mantle with tidal and rotational
+distortion, fluid core, Earth J2 on the lunar figure), driven one-way by DE421's orbits and started
+from DE421's published state (the core carried from DE421's epoch 1969); 'rigid' uses DE421's total
+moments; 'core-corrected' removes the fluid core's share of the polar moment (IFAC) from the moments
+the mantle's Euler equations see. The two rigid models run fully coupled in REBOUND
+(docs/coupling.md).
 
 The last line printed is 'max attitude difference vs DE421: <x> arcsec over <span>'."""
 EXAMPLES = """\
 examples:
-  spinorbit moon                                   # 1 year, core-corrected model
+  spinorbit moon                                   # 1 year, DE421's mantle-and-core model
   spinorbit moon --span 20 yr --model rigid --step 5 d --output moon.ecsv --plot moon.png
   spinorbit moon --span 50 yr --checkpoint moon.ckpt --output moon.ecsv   # killed? then:
   spinorbit moon --span 50 yr --resume moon.ckpt --output moon.ecsv
@@ -43,10 +50,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                      help="how long to integrate from J2000, e.g. '1 yr' (default), '20 yr', '200 d'")
     run.add_argument("--step", nargs="+", default=["1", "d"], metavar="STEP",
                      help="spacing of the comparison times (default 1 d)")
-    run.add_argument("--model", choices=("rigid", "core-corrected"), default="core-corrected",
-                     help="moments of the whole Moon (rigid) or of the mantle (core-corrected, default)")
+    run.add_argument("--model", choices=MOON_MODELS, default="de421",
+                     help="de421: mantle + fluid core + tides on DE421's orbits (default); rigid / "
+                          "core-corrected: rigid Moon with the whole Moon's / the mantle's moments, in REBOUND")
     run.add_argument("--one-way", action="store_true",
-                     help="do not let the lunar figure act back on the orbits (default: fully coupled)")
+                     help="rigid models: do not let the lunar figure act back on the orbits "
+                          "(default: fully coupled); the de421 model is always one-way")
     files = parser.add_argument_group("output files")
     files.add_argument("--output", metavar="FILE.ecsv", help="write time, attitude difference and angles as ECSV")
     files.add_argument("--plot", metavar="FILE.png", help="plot the difference and the libration (needs matplotlib)")
@@ -138,7 +147,7 @@ def _checkpoint_schedule(args, span_days: float, step_days: float):
 
 def run(args) -> int:
     """Run ``spinorbit moon``; return the exit status."""
-    from ..coupling.moon import compare_with_de421, moon_at_de421
+    from ..coupling.moon import compare_model_with_de421, compare_with_de421, moon_at_de421
 
     for option, path in (("--output", args.output), ("--plot", args.plot)):
         if path is not None:
@@ -156,7 +165,9 @@ def run(args) -> int:
     if not 0 < step <= span_days:
         raise CommandError(f"--step expects a positive spacing no longer than --span, got {' '.join(args.step)}.")
     schedule, settings = _checkpoint_schedule(args, span_days, step)
-    moon = moon_at_de421(model=args.model, coupled=not args.one_way)
+    if schedule is not None and args.model == "de421":
+        raise CommandError("--checkpoint/--resume apply to the REBOUND-coupled models (--model rigid or "
+                           "core-corrected); the de421 model runs at ≈ 0.1 s per simulated year and needs none.")
     count = int(span_days / step + 1e-9) + 1
     progress = Progress(count, "integrating")
     done = [0]
@@ -166,8 +177,12 @@ def run(args) -> int:
         done[0] = n
 
     try:
-        comparison = compare_with_de421(moon, span_days, step, progress=advance, schedule=schedule,
-                                        resume=args.resume, settings=settings)
+        if args.model == "de421":
+            comparison = compare_model_with_de421(args.model, span_days, step, progress=advance)
+        else:
+            moon = moon_at_de421(model=args.model, coupled=not args.one_way)
+            comparison = compare_with_de421(moon, span_days, step, progress=advance, schedule=schedule,
+                                            resume=args.resume, settings=settings)
     except KeyboardInterrupt:
         if schedule is not None and os.path.exists(schedule.path):
             print(f"{args._prog}: the last checkpoint is '{schedule.path}'; continue with the same options and "
@@ -176,12 +191,15 @@ def run(args) -> int:
     finally:
         progress.close()
     span_text = f"{span.value:g} {span.unit.to_string()}"
-    print(f"model              {args.model}, {'one-way' if args.one_way else 'fully coupled'}")
+    coupling = "one-way on DE421's orbits" if args.model == "de421" or args.one_way else "fully coupled"
+    print(f"model              {args.model}, {coupling}")
     print(f"wall time          {comparison.wall_seconds:.2f} s "
           f"({comparison.wall_seconds / (span_days / 365.25):.3f} s per simulated year)")
-    print(f"final difference   {comparison.attitude_difference_arcsec[-1]:.3f} arcsec")
+    if comparison.sampling_seconds:
+        print(f"orbit sampling     {comparison.sampling_seconds:.2f} s (DE421 positions before the run)")
+    print(f"final difference   {comparison.attitude_difference_arcsec[-1]:.5f} arcsec")
     if args.output is not None:
-        table = libration_table(comparison, args.model, not args.one_way)
+        table = libration_table(comparison, args.model, args.model != "de421" and not args.one_way)
         with atomic_output("--output", args.output) as temporary:
             table.write(temporary, format="ascii.ecsv", overwrite=True)
         print(f"wrote              {args.output} ({len(table)} rows)")
@@ -189,5 +207,5 @@ def run(args) -> int:
         with atomic_output("--plot", args.plot) as temporary:
             plot_comparison(comparison, temporary, f"Moon vs DE421, {args.model}, {span_text}")
         print(f"wrote              {args.plot}")
-    print(f"max attitude difference vs DE421: {comparison.max_difference_arcsec:.3f} arcsec over {span_text}")
+    print(f"max attitude difference vs DE421: {comparison.max_difference_arcsec:.5f} arcsec over {span_text}")
     return 0

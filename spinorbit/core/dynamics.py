@@ -7,7 +7,12 @@ moments A ≤ B ≤ C::
     q̇ = ½ q ⊗ (0, ω)
     I ω̇ = Iω × ω + N,   N = Σ_perturbers (∂U/∂r) × r     (gravity_field.py for U and the sign)
 
-r is the perturber's position in the body frame, r = R r_inertial with R = M(q)ᵀ. Every back end
+r is the perturber's position in the body frame, r = R r_inertial with R = M(q)ᵀ.
+
+A 10-component state (q, ω, ω_c) with a model array that ends with an interior block is the Moon of
+the JPL ephemerides (elastic mantle with tides around a fluid core): :func:`lunar_rhs_into`, built from
+:mod:`spinorbit.core.lunar_interior`; :func:`rhs_into` dispatches on the state's length, so the same
+integrators run both. Every back end
 (the numba integrator, scipy's ``solve_ivp`` through :func:`scipy_rhs`, the benchmark peers) calls
 :func:`rhs`; nothing else defines the dynamics.
 
@@ -31,9 +36,43 @@ import math
 import numpy as np
 
 from ._jit import jit
-from .gravity_field import (BODY_A, BODY_B, BODY_C, BODY_MASS, FIGURE_SIZE, figure_field_without_monopole_xyz,
-                            make_body)
-from .perturbers import PERTURBER_ROW, pack_perturbers, perturber_position_xyz, sampled_span
+from .gravity_field import (
+    BODY_A,
+    BODY_B,
+    BODY_C,
+    BODY_MASS,
+    FIGURE_SIZE,
+    figure_field_without_monopole_xyz,
+    make_body,
+)
+from .lunar_interior import (
+    IN_CORE_A,
+    IN_CORE_C,
+    IN_DISTORTION_ROWS,
+    IN_EARTH_J2R2,
+    IN_EARTH_ROW,
+    IN_POLE_X,
+    IN_POLE_Y,
+    IN_POLE_Z,
+    IN_TAU,
+    INTERIOR_SIZE,
+    INTERIOR_STATE_SIZE,
+    core_mantle_torque,
+    distortion,
+    figure_figure_torque,
+    j2_hessian,
+    point_mass_torque,
+    rotate_about,
+    symmetric_solve,
+    symmetric_times,
+)
+from .perturbers import (
+    PERTURBER_ROW,
+    pack_perturbers,
+    perturber_position_xyz,
+    sampled_span,
+    sampled_velocity_xyz,
+)
 
 STATE_SIZE = 7
 
@@ -135,7 +174,14 @@ def force_function(t, q, model):
 
 @jit(inline="always")
 def rhs_into(t, y, model, dy):
-    """Write dy/dt into ``dy`` (no allocation; the integrators' inner call)."""
+    """Write dy/dt into ``dy`` (no allocation; the integrators' inner call).
+
+    A 10-component state (q, ω, ω_c) is the mantle-and-core model of :func:`lunar_rhs_into` (its
+    model array ends with an interior block); a 7-component one is the rigid body.
+    """
+    if y.shape[0] == INTERIOR_STATE_SIZE:
+        lunar_rhs_into(t, y, model, dy)
+        return
     q0, q1, q2, q3 = y[0], y[1], y[2], y[3]
     if model[MODEL_PERTURBERS] > 0.0:
         _, nx, ny, nz = force_function_and_torque_xyz(t, q0, q1, q2, q3, model)
@@ -168,9 +214,97 @@ def kinematics_and_euler_into(y, nx, ny, nz, model, dy):
 
 
 @jit
+def _delayed_distortion(t, q0, q1, q2, q3, wx, wy, wz, ax, ay, az, model, block, out, rate):
+    """ΔI and dΔI/dt from the Earth's state and the mantle spin at t − τ (lunar_interior.distortion).
+
+    The delayed attitude is the present one turned back about ω by |ω|τ (ω − τ ω̇/2 as the mean
+    rate over the delay); the delayed ω is ω − τ ω̇. Both neglect ω̈ τ², ~1e-8 of the delay's effect.
+    """
+    tau = block[IN_TAU]
+    row = int(block[IN_EARTH_ROW])
+    mu = model[row + 1]
+    ex, ey, ez = perturber_position_xyz(t - tau, model, row)
+    vx, vy, vz = sampled_velocity_xyz(t - tau, model, row)
+    mx, my, mz = wx - 0.5 * tau * ax, wy - 0.5 * tau * ay, wz - 0.5 * tau * az
+    rx, ry, rz = body_frame_xyz(q0, q1, q2, q3, ex, ey, ez)
+    rx, ry, rz = rotate_about(mx, my, mz, tau, rx, ry, rz)
+    ux, uy, uz = body_frame_xyz(q0, q1, q2, q3, vx, vy, vz)
+    ux, uy, uz = rotate_about(mx, my, mz, tau, ux, uy, uz)
+    dx, dy_, dz = wx - tau * ax, wy - tau * ay, wz - tau * az
+    # Body-frame derivative of the delayed position: inertial velocity minus ω × r.
+    ux, uy, uz = ux - (dy_ * rz - dz * ry), uy - (dz * rx - dx * rz), uz - (dx * ry - dy_ * rx)
+    distortion(block, rx, ry, rz, ux, uy, uz, mu, dx, dy_, dz, ax, ay, az, out, rate)
+
+
+@jit
+def lunar_rhs_into(t, y, model, dy):
+    """dy/dt of the mantle-and-core model (``spinorbit.core.lunar_interior``; DE4xx lunar equations).
+
+    State y = (q, ω, ω_c): mantle attitude, mantle angular velocity and core angular velocity, both
+    on the mantle axes. Torques: every perturber on the undistorted figure I_T (degrees 2..n_max, the
+    rigid body's :func:`force_function_and_torque_xyz`), the first ``distortion_rows`` perturbers on
+    ΔI, the Earth's J₂ on I_T + ΔI, and the core–mantle torque. ω̇ is solved twice: the first pass
+    (ω̇ ≈ 0 in the delayed terms) gives the ω̇ used for the delayed spin and dΔI/dt in the second.
+    """
+    base = model.shape[0] - INTERIOR_SIZE
+    block = model[base:]
+    q0, q1, q2, q3 = y[0], y[1], y[2], y[3]
+    wx, wy, wz = y[4], y[5], y[6]
+    cx, cy, cz = y[7], y[8], y[9]
+    _, nx, ny, nz = force_function_and_torque_xyz(t, q0, q1, q2, q3, model)
+    row = int(block[IN_EARTH_ROW])
+    # Earth → Moon in the mantle frame, and the Earth's pole there (figure–figure torque).
+    ex, ey, ez = perturber_position_xyz(t, model, row)
+    sx, sy, sz = body_frame_xyz(q0, q1, q2, q3, -ex, -ey, -ez)
+    px, py, pz = body_frame_xyz(q0, q1, q2, q3, block[IN_POLE_X], block[IN_POLE_Y], block[IN_POLE_Z])
+    hessian = np.empty(6)
+    j2_hessian(block, model[row + 1], sx, sy, sz, px, py, pz, hessian)
+    core_a, core_c = block[IN_CORE_A], block[IN_CORE_C]
+    ncx, ncy, ncz = core_mantle_torque(block, wx, wy, wz, cx, cy, cz)
+    delta = np.empty(6)
+    rate = np.empty(6)
+    total = np.empty(6)
+    mantle = np.empty(6)
+    ax = ay = az = 0.0
+    for _ in range(2):
+        _delayed_distortion(t, q0, q1, q2, q3, wx, wy, wz, ax, ay, az, model, block, delta, rate)
+        for i in range(6):
+            total[i] = delta[i]
+        total[0] += model[BODY_A]
+        total[1] += model[BODY_B]
+        total[2] += model[BODY_C]
+        for i in range(6):
+            mantle[i] = total[i]
+        mantle[0] -= core_a
+        mantle[1] -= core_a
+        mantle[2] -= core_c
+        tx, ty, tz = nx + ncx, ny + ncy, nz + ncz
+        for k in range(int(block[IN_DISTORTION_ROWS])):
+            r_row = row + k * PERTURBER_ROW
+            ix, iy, iz = perturber_position_xyz(t, model, r_row)
+            bx, by, bz = body_frame_xyz(q0, q1, q2, q3, ix, iy, iz)
+            fx, fy, fz = point_mass_torque(delta, model[r_row + 1], bx, by, bz)
+            tx, ty, tz = tx + fx, ty + fy, tz + fz
+        if block[IN_EARTH_J2R2] != 0.0:
+            fx, fy, fz = figure_figure_torque(total, hessian)
+            tx, ty, tz = tx + fx, ty + fy, tz + fz
+        lx, ly, lz = symmetric_times(mantle, wx, wy, wz)
+        gx, gy, gz = symmetric_times(rate, wx, wy, wz)
+        ax, ay, az = symmetric_solve(mantle, tx - gx - (wy * lz - wz * ly), ty - gy - (wz * lx - wx * lz),
+                                     tz - gz - (wx * ly - wy * lx))
+    kinematics_and_euler_into(y, 0.0, 0.0, 0.0, model, dy)  # q̇ (ω̇ overwritten below)
+    dy[4], dy[5], dy[6] = ax, ay, az
+    # Core: I_c ω̇_c = −ω × I_c ω_c − N_cmb.
+    jx, jy, jz = core_a * cx, core_a * cy, core_c * cz
+    dy[7] = (-(wy * jz - wz * jy) - ncx) / core_a
+    dy[8] = (-(wz * jx - wx * jz) - ncy) / core_a
+    dy[9] = (-(wx * jy - wy * jx) - ncz) / core_c
+
+
+@jit
 def rhs(t, y, model):
     """dy/dt of the state y = (q, ω) at time t: the one definition of the dynamics."""
-    dy = np.empty(STATE_SIZE)
+    dy = np.empty(y.shape[0])
     rhs_into(t, y, model, dy)
     return dy
 
@@ -228,8 +362,10 @@ def validate_sampled_span(model, t0, t_out):
         )
 
 
-def validate_state(y0):
-    """Check an initial state (q, ω) and return it as a float array with q normalised.
+def validate_state(y0, size=STATE_SIZE):
+    """Check an initial state (q, ω[, ω_c]) and return it as a float array with q normalised.
+
+    ``size`` is 7 (rigid body) or 10 (mantle and core, :func:`lunar_rhs_into`).
 
     Raises
     ------
@@ -237,10 +373,9 @@ def validate_state(y0):
         Wrong shape, NaN/inf, or a zero quaternion.
     """
     y0 = np.asarray(y0, dtype=float)
-    if y0.shape != (STATE_SIZE,):
-        raise ValueError(
-            f"y0: expected 7 numbers (q0, q1, q2, q3, ωx, ωy, ωz), got shape {y0.shape}."
-        )
+    if y0.shape != (size,):
+        what = "(q0, q1, q2, q3, ωx, ωy, ωz)" if size == STATE_SIZE else "(q0..q3, ωx, ωy, ωz, ω_cx, ω_cy, ω_cz)"
+        raise ValueError(f"y0: expected {size} numbers {what}, got shape {y0.shape}.")
     if not np.all(np.isfinite(y0)):
         raise ValueError(f"y0: expected finite numbers, got {y0.tolist()}; check the initial state for NaN/inf.")
     norm = math.sqrt(float(np.dot(y0[:4], y0[:4])))

@@ -43,6 +43,7 @@ from ._dop853_tableau import E5 as _E5
 from ._dop853_tableau import N_STAGES
 from ._jit import jit
 from .dynamics import STATE_SIZE, rhs_into, validate_sampled_span, validate_state
+from .lunar_interior import INTERIOR_STATE_SIZE, has_interior
 
 _A = np.ascontiguousarray(_A_FULL)
 _C = np.ascontiguousarray(_C_FULL)
@@ -427,30 +428,30 @@ def _validate_times(t0, t_out):
 
 
 def default_atol(y0, rtol):
-    """atol = rtol × (1, 1, 1, 1, |ω₀|, |ω₀|, |ω₀|): the natural scale of each component.
+    """atol = rtol × (1, 1, 1, 1, |ω₀|, |ω₀|, |ω₀|[, |ω₀|, |ω₀|, |ω₀|]): each component's natural scale.
 
     Quaternion components are O(1) but pass through zero twice a turn, so a purely relative test would
-    demand absurd accuracy near the zeros; the ω components share the scale |ω₀|.
+    demand absurd accuracy near the zeros; the ω components (and a core's ω_c) share the scale |ω₀|.
     """
-    scale = np.ones(STATE_SIZE)
+    scale = np.ones(y0.shape[0])
     scale[4:] = max(float(np.linalg.norm(y0[4:])), 1e-300)
     return rtol * scale
 
 
-def _validate_tolerances(rtol, atol):
+def _validate_tolerances(rtol, atol, size=STATE_SIZE):
     if not (np.isfinite(rtol) and rtol > 0):
         raise ValueError(f"rtol: expected a relative tolerance > 0, got {rtol!r}; try 1e-10.")
     if rtol < 1e-15:
         raise ValueError(f"rtol: expected rtol ≥ 1e-15 (double precision cannot do better), got {rtol!r}.")
     atol = np.asarray(atol, dtype=float)
-    if atol.shape not in ((), (1,), (STATE_SIZE,)):
+    if atol.shape not in ((), (1,), (size,)):
         raise ValueError(
-            f"atol: expected a scalar or {STATE_SIZE} values (q0..q3, ωx, ωy, ωz), got shape {atol.shape}; "
+            f"atol: expected a scalar or {size} values (one per state component), got shape {atol.shape}; "
             "pass one number for all components or one per component."
         )
-    atol = np.broadcast_to(atol, (STATE_SIZE,)).copy()
+    atol = np.broadcast_to(atol, (size,)).copy()
     if not np.all(np.isfinite(atol)) or np.any(atol < 0):
-        raise ValueError(f"atol: expected absolute tolerances ≥ 0 (scalar or 7 values), got {atol.tolist()}.")
+        raise ValueError(f"atol: expected absolute tolerances ≥ 0 (scalar or {size} values), got {atol.tolist()}.")
     return float(rtol), atol
 
 
@@ -460,9 +461,10 @@ def integrate_quaternion(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=
 
     Parameters
     ----------
-    y0 : array_like (7,)
+    y0 : array_like (7,) or (10,)
         Initial state (q0, q1, q2, q3, ωx, ωy, ωz): scalar-first quaternion (normalised here) and
-        body angular velocity (rad/time unit).
+        body angular velocity (rad/time unit); with a model that ends with an interior block
+        (:mod:`spinorbit.core.lunar_interior`), also the core's ω_c on the body axes.
     t0 : float
         Initial time (time unit of the model, e.g. days).
     t_out : array_like (n,)
@@ -497,11 +499,11 @@ def integrate_quaternion(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=
     IntegrationError
         The kernel stopped early (see the message).
     """
-    y0 = validate_state(y0)
+    model = np.ascontiguousarray(model, dtype=float)
+    y0 = validate_state(y0, INTERIOR_STATE_SIZE if has_interior(model) else STATE_SIZE)
     t0 = float(t0)
     t_out = _validate_times(t0, t_out)
-    rtol, atol = _validate_tolerances(rtol, default_atol(y0, rtol) if atol is None else atol)
-    model = np.ascontiguousarray(model, dtype=float)
+    rtol, atol = _validate_tolerances(rtol, default_atol(y0, rtol) if atol is None else atol, y0.shape[0])
     validate_sampled_span(model, t0, t_out)
     ys, stats = integrate_dop853_kernel(y0, t0, t_out, model, rtol, atol, int(max_steps),
                                         bool(hit_output_times), float(first_step))

@@ -252,25 +252,51 @@ def _find_interval(t, arr, first, count):
 
 
 @jit(inline="always")
+def _hermite_locate(t, arr, first, count, xv_first):
+    """(h, s, i0, i1) of the sample interval containing t: its length, t's position in it ∈ [0, 1]
+    and the offsets of its two (position, velocity) rows. h and s are NaN outside the span, so every
+    weighted sum formed from them is NaN too."""
+    if not (arr[first] <= t <= arr[first + count - 1]):
+        return np.nan, np.nan, xv_first, xv_first
+    lo = _find_interval(t, arr, first, count)
+    h = arr[lo + 1] - arr[lo]
+    i0 = xv_first + 6 * (lo - first)
+    return h, (t - arr[lo]) / h, i0, i0 + 6
+
+
+@jit(inline="always")
+def _hermite_combine(arr, i0, i1, a, b, c, d):
+    """a·p0 + b·v0 + c·p1 + d·v1 for x, y, z (p, v the interval's end-point positions and velocities)."""
+    return (a * arr[i0] + b * arr[i0 + 3] + c * arr[i1] + d * arr[i1 + 3],
+            a * arr[i0 + 1] + b * arr[i0 + 4] + c * arr[i1 + 1] + d * arr[i1 + 4],
+            a * arr[i0 + 2] + b * arr[i0 + 5] + c * arr[i1 + 2] + d * arr[i1 + 5])
+
+
+@jit(inline="always")
 def hermite_position_xyz(t, arr, first, count, xv_first):
     """Cubic Hermite position (x, y, z) from a flat array: sample times at arr[first:first+count],
     positions and velocities (6 per sample, row-major) from arr[xv_first]. NaN outside the span."""
-    if not (arr[first] <= t <= arr[first + count - 1]):
-        return np.nan, np.nan, np.nan
-    lo = _find_interval(t, arr, first, count)
-    h = arr[lo + 1] - arr[lo]
-    s = (t - arr[lo]) / h
+    h, s, i0, i1 = _hermite_locate(t, arr, first, count, xv_first)
     s2 = s * s
     s3 = s2 * s
-    h00 = 2.0 * s3 - 3.0 * s2 + 1.0
-    h10 = (s3 - 2.0 * s2 + s) * h
-    h01 = -2.0 * s3 + 3.0 * s2
-    h11 = (s3 - s2) * h
-    i0 = xv_first + 6 * (lo - first)
-    i1 = i0 + 6
-    return (h00 * arr[i0] + h10 * arr[i0 + 3] + h01 * arr[i1] + h11 * arr[i1 + 3],
-            h00 * arr[i0 + 1] + h10 * arr[i0 + 4] + h01 * arr[i1 + 1] + h11 * arr[i1 + 4],
-            h00 * arr[i0 + 2] + h10 * arr[i0 + 5] + h01 * arr[i1 + 2] + h11 * arr[i1 + 5])
+    return _hermite_combine(arr, i0, i1, 2.0 * s3 - 3.0 * s2 + 1.0, (s3 - 2.0 * s2 + s) * h,
+                            -2.0 * s3 + 3.0 * s2, (s3 - s2) * h)
+
+
+@jit(inline="always")
+def hermite_velocity_xyz(t, arr, first, count, xv_first):
+    """Derivative of :func:`hermite_position_xyz` (the interpolant's velocity, O(h³)); NaN outside."""
+    h, s, i0, i1 = _hermite_locate(t, arr, first, count, xv_first)
+    s2 = s * s
+    d00 = (6.0 * s2 - 6.0 * s) / h
+    return _hermite_combine(arr, i0, i1, d00, 3.0 * s2 - 4.0 * s + 1.0, -d00, 3.0 * s2 - 2.0 * s)
+
+
+@jit(inline="always")
+def sampled_velocity_xyz(t, arr, row):
+    """Velocity (inertial) of the sampled perturber whose row starts at arr[row]; allocation-free."""
+    off = row + 2
+    return hermite_velocity_xyz(t, arr, int(arr[off]), int(arr[off + 1]), int(arr[off + 2]))
 
 
 @jit

@@ -14,28 +14,64 @@ compiled force), plus the lunar figure's back-reaction (fully coupled). Figure (
   COBLAT = 3.8e-4 and the core–mantle friction KVC are left out). Removing a spherical part leaves
   the degree-2 field (MacCullagh) unchanged, so U and the moments stay consistent.
 
+- model ``"de421"`` (:func:`compare_interior_with_de421`): DE421's own lunar rotation model —
+  mantle with tidal and rotational distortion (k2M, TAUM), fluid core with its own angular velocity
+  (IFAC, COBLAT, KVC), Earth J2 acting on the lunar figure — driven one-way by DE421's orbits and
+  started from DE421's published initial conditions (JDEPOC; ``spinorbit.core.lunar_interior``).
+
 Units: au (DE421), TDB days since J2000, masses GM/G ("AU", "day", "Msun"), ω in rad/day.
 """
 
 from __future__ import annotations
 
+import functools
+import time as _time
 from dataclasses import dataclass
 
 import numpy as np
 from astropy.time import Time
 
+from ..core.dynamics import MODEL_PERTURBERS
 from ..core.gravity_field import make_body
-from ..core.rotations import attitude_to_euler313, quat_to_attitude_many
-from ..ephemeris import de421_constants, moon_libration_angles_raw, moon_orientation_raw
-from ..time import tdb_day_and_fraction
+from ..core.integrate_quaternion import integrate_quaternion
+from ..core.lunar_interior import make_interior_block
+from ..core.perturbers import pack_perturbers
+from ..core.rotations import (
+    attitude_to_euler313,
+    quat_to_attitude,
+    quat_to_attitude_many,
+)
+from ..ephemeris import (
+    de421_constants,
+    earth_from_moon_au,
+    moon_libration_angles_raw,
+    moon_orientation_raw,
+)
+from ..time import J2000_JD_TDB, tdb_day_and_fraction, time_from_tdb_days
+from .one_way import de421_orbit, sample_from_ephemeris, sample_relative_states
 from .chunked_run import integrate_to_outputs
 from .rebound_adapter import DEFAULT_BODIES, simulation_from_de421
 from .rigid_body import CoupledRigidBody
 
-__all__ = ["MOON_MODELS", "moon_figure", "moon_at_de421", "LibrationComparison", "compare_with_de421",
-           "ARCSEC_PER_RAD", "DEFAULT_TOLERANCE"]
+__all__ = [
+    "ARCSEC_PER_RAD",
+    "DEFAULT_TOLERANCE",
+    "MOON_MODELS",
+    "RIGID_MODELS",
+    "LibrationComparison",
+    "compare_interior_with_de421",
+    "compare_model_with_de421",
+    "compare_with_de421",
+    "core_angular_velocity",
+    "interior_model",
+    "moon_at_de421",
+    "moon_figure",
+]
 
-MOON_MODELS = ("rigid", "core-corrected")
+#: Models of the rigid route (REBOUND, :func:`moon_at_de421`).
+RIGID_MODELS = ("rigid", "core-corrected")
+#: Every model :func:`compare_model_with_de421` runs; "de421" is the mantle-and-core model.
+MOON_MODELS = ("de421",) + RIGID_MODELS
 ARCSEC_PER_RAD = 180.0 * 3600.0 / np.pi
 #: BS tolerance (eps_abs = eps_rel) for the lunar runs: the shared note measured 1e-13 for
 #: ephemeris-grade orbits; the state is O(1) (q, ω ≈ 0.23 rad/day, positions ≲ 40 au).
@@ -63,8 +99,8 @@ def moon_figure(moon_mass: float, model: str = "rigid", degree: int = 4) -> np.n
     ndarray
         ``gravity_field.make_body`` array: moments in Msun·au², reference radius AM in au.
     """
-    if model not in MOON_MODELS:
-        raise ValueError(f"model: expected one of {MOON_MODELS}, got {model!r}.")
+    if model not in RIGID_MODELS:
+        raise ValueError(f"model: expected one of {RIGID_MODELS}, got {model!r}.")
     if degree not in (2, 3, 4):
         raise ValueError(f"degree: expected 2, 3 or 4, got {degree!r}.")
     constants = de421_constants()
@@ -148,6 +184,8 @@ class LibrationComparison:
         3-1-3 libration angles (φ, θ, ψ), ICRF → mantle (rad; ψ unwrapped).
     wall_seconds : float
         Wall time of the integration only.
+    sampling_seconds : float
+        Wall time spent sampling DE421's orbits before the integration ("de421" model; 0 otherwise).
     """
 
     times: np.ndarray
@@ -156,6 +194,7 @@ class LibrationComparison:
     angles_model: np.ndarray
     angles_de421: np.ndarray
     wall_seconds: float
+    sampling_seconds: float = 0.0
 
     @property
     def max_difference_arcsec(self) -> float:
@@ -191,11 +230,19 @@ def compare_with_de421(moon: CoupledRigidBody, span_days: float, step_days: floa
     -------
     LibrationComparison
     """
-    start = moon.sim.t
-    count = int(np.floor(span_days / step_days + 1e-9)) + 1
-    times = start + step_days * np.arange(count)
+    times = _output_times(moon.sim.t, span_days, step_days)
     _, quaternions, wall = integrate_to_outputs(moon, times, lambda body: body.quaternion, 4, schedule=schedule,
                                                 resume=resume, settings=settings, progress=progress)
+    return _comparison(times, quaternions, wall)
+
+
+def _output_times(start, span_days, step_days):
+    count = int(np.floor(span_days / step_days + 1e-9)) + 1
+    return start + step_days * np.arange(count)
+
+
+def _comparison(times, quaternions, wall):
+    """The model's attitudes against DE421's at the same times."""
     days = np.round(times)
     reference, _ = moon_orientation_raw(days, times - days)
     # δq = conj(q_DE421) ⊗ q_model: the model frame seen from the DE421 frame (mantle axes).
@@ -213,3 +260,166 @@ def compare_with_de421(moon: CoupledRigidBody, span_days: float, step_days: floa
         angles_de421=angles_de421,
         wall_seconds=wall,
     )
+
+
+# ------------------------------------------------------------------------------------------------
+# DE421's own model: mantle + fluid core + tides, driven by DE421's orbits (one-way).
+
+#: Bodies torquing the lunar figure in the "de421" model. Earth first (it raises the tide and carries
+#: J2), the Sun second (it also acts on the distortion ΔI); the planets act on the undistorted figure.
+#: Mercury, Uranus, Neptune: (μ/r³) below 1e-9 of the Earth's, left out.
+INTERIOR_PERTURBERS = ("earth", "sun", "venus", "mars", "jupiter", "saturn")
+#: Relative interpolation error of the sampled DE421 positions. Measured: 1e-9, 1e-10 and 1e-12 give
+#: the same 5- and 20-year comparisons to 1e-5″; the sampling is the dominant cost (docs/coupling.md).
+INTERIOR_SAMPLE_TOLERANCE = 1e-9
+#: Interpolation error for the Sun and the planets: their torques on the Moon are ≤ 1/180 of the
+#: Earth's (μ/r³), so 1e-7 on them is ≤ 2e-9 of the total torque, the Earth's share at 1e-9. Measured:
+#: the 5-year comparison unchanged to 1e-5″, the sampling 1.7× faster.
+DISTANT_SAMPLE_TOLERANCE = 1e-7
+#: DOP853 local tolerance for the "de421" model; 1e-11 … 1e-13 agree to 1e-5″ over 5 years.
+INTERIOR_RTOL = 1e-12
+#: Lunar mean motion n (rad/day) in the rotational-distortion term: 2π per sidereal month
+#: (27.321582 d). It only sets the constant part of ΔI already contained in the published moments.
+LUNAR_MEAN_MOTION = 2.0 * np.pi / 27.321582
+
+
+def interior_model(start_day, end_day, perturbers=INTERIOR_PERTURBERS,
+                   sample_tolerance=INTERIOR_SAMPLE_TOLERANCE):
+    """The dynamics model array of DE421's lunar rotation model, orbits sampled from DE421.
+
+    Parameters
+    ----------
+    start_day, end_day : float
+        TDB days since J2000 the run will cover (the samples start one day earlier, for the tidal
+        delay τ_M).
+    perturbers : sequence of str
+        DE421 bodies torquing the figure; must start with ("earth", "sun").
+    sample_tolerance : float
+        Relative interpolation error of the perturber positions (``one_way`` module docstring).
+
+    Returns
+    -------
+    ndarray
+        [figure (DE421 total moments, degrees 2–4), sampled perturbers, interior block]; integrate
+        a 10-component state (q, ω, ω_c) with :func:`spinorbit.core.integrate_quaternion.integrate_quaternion`.
+    """
+    perturbers = tuple(p.lower() for p in perturbers)
+    if perturbers[:2] != ("earth", "sun"):
+        raise ValueError(f"perturbers: expected the Earth and the Sun first, got {perturbers!r}.")
+    constants = de421_constants()
+    gravitational_constant = constants.gm["sun"]  # G in (au, day, Msun): GM_Sun / M_Sun
+    # One grid per perturber: seen from the Moon the Earth's direction turns in a month, the Sun's
+    # and the planets' in a year or more, so their grids are much coarser than a shared one would be.
+    # The Earth (the finest grid) straight from DE421's geocentric Moon series.
+    start, end = time_from_tdb_days(start_day - 1.0), time_from_tdb_days(end_day + 1.0)
+
+    def earth(days):
+        whole = np.round(days)
+        position, velocity = earth_from_moon_au(whole, days - whole)
+        return np.concatenate([position, velocity], axis=1)[:, None, :]
+
+    sources = [sample_relative_states(earth, ("earth",), start, end, sample_tolerance).sources()[0]]
+    distant = max(sample_tolerance, DISTANT_SAMPLE_TOLERANCE)
+    sources += [sample_from_ephemeris(de421_orbit("moon"), start, end, (name,), tolerance=distant).sources()[0]
+                for name in perturbers[1:]]
+    figure = moon_figure(constants.gm["moon"] / gravitational_constant, "rigid", 4)
+    body = np.concatenate([figure, pack_perturbers(sources, base=MODEL_PERTURBERS)])
+    polar = figure[2]  # C_T, Msun·au²
+    interior = make_interior_block(
+        earth_row=MODEL_PERTURBERS + 1, gravitational_constant=gravitational_constant,
+        love_number=constants.moon_k2, time_delay=constants.moon_tidal_delay_days,
+        radius=constants.moon_radius_km / constants.au_km, mean_motion=LUNAR_MEAN_MOTION,
+        core_polar_moment=constants.moon_core_over_total_moment * polar,
+        core_flattening=constants.moon_core_oblateness,
+        friction=constants.moon_core_friction_per_day * polar,
+        earth_j2=constants.earth_j2, earth_radius=constants.earth_radius_km / constants.au_km,
+        distortion_rows=2)
+    return np.concatenate([body, interior])
+
+
+def _epoch_day():
+    return de421_constants().moon_epoch_jd_tdb - J2000_JD_TDB
+
+
+def _epoch_state():
+    """DE421's initial conditions at JDEPOC: (q, ω_mantle, ω_core on mantle axes)."""
+    constants = de421_constants()
+    epoch = _epoch_day()
+    whole = np.round(epoch)
+    quaternion, _ = moon_orientation_raw(whole, epoch - whole)
+    return np.concatenate([quaternion, constants.moon_omega_at_epoch, constants.core_omega_at_epoch])
+
+
+@functools.lru_cache(maxsize=8)
+def core_angular_velocity(day: float) -> tuple:
+    """The fluid core's angular velocity on DE421's mantle axes at ``day`` (rad/day).
+
+    DE421 publishes the core's state only at its epoch JDEPOC (1969-06-28, header OMGCX…OMGCZ).
+    Elsewhere it is carried by this model from JDEPOC (mantle and core from the header), and the
+    result is expressed on DE421's mantle axes at ``day`` (through ICRF), so a run that starts from
+    DE421's mantle there gets the core DE421 had, to this model's accuracy (0.001″-level).
+    """
+    epoch = _epoch_day()
+    state = _epoch_state()
+    if day == epoch:
+        return tuple(state[7:])
+    model = interior_model(min(epoch, day), max(epoch, day))
+    final = integrate_quaternion(state, epoch, np.array([day]), model, rtol=INTERIOR_RTOL)[-1]
+    to_icrf = quat_to_attitude(np.ascontiguousarray(final[:4])).T
+    whole = np.round(day)
+    reference, _ = moon_orientation_raw(whole, day - whole)
+    to_reference = quat_to_attitude(np.ascontiguousarray(reference))
+    return tuple(to_reference @ (to_icrf @ final[7:]))
+
+
+def compare_interior_with_de421(span_days: float, step_days: float = 1.0, start_day: float = 0.0,
+                                rtol: float = INTERIOR_RTOL, progress=None) -> LibrationComparison:
+    """Run DE421's lunar rotation model from ``start_day`` and compare with DE421's librations.
+
+    The mantle starts from DE421's librations at ``start_day`` (its header values at JDEPOC), the core
+    from :func:`core_angular_velocity`. ``wall_seconds`` is the integration alone; sampling DE421's
+    orbits is timed separately in ``sampling_seconds``.
+
+    Parameters
+    ----------
+    span_days, step_days : float
+        Span and comparison spacing (days, TDB).
+    start_day : float
+        TDB days since J2000 (default J2000.0).
+    rtol : float
+        DOP853 local tolerance.
+    progress : callable, optional
+        Called once with the number of output times when done (the run is one compiled call).
+
+    Returns
+    -------
+    LibrationComparison
+    """
+    times = _output_times(float(start_day), span_days, step_days)
+    whole = np.round(start_day)
+    quaternion, omega = moon_orientation_raw(whole, start_day - whole)
+    state = np.concatenate([quaternion, omega, core_angular_velocity(float(start_day))])
+    begin = _time.perf_counter()
+    model = interior_model(times[0], times[-1])
+    sampling = _time.perf_counter() - begin
+    begin = _time.perf_counter()
+    states = integrate_quaternion(state, times[0], times[1:], model, rtol=rtol)
+    wall = _time.perf_counter() - begin
+    if progress is not None:
+        progress(times.size)
+    comparison = _comparison(times, np.vstack([quaternion, states[:, :4]]), wall)
+    comparison.sampling_seconds = sampling
+    return comparison
+
+
+def compare_model_with_de421(model: str, span_days: float, step_days: float = 1.0, coupled: bool = True,
+                             progress=None) -> LibrationComparison:
+    """Any of :data:`MOON_MODELS` from J2000 against DE421 (the CLI's and the example's entry point).
+
+    ``coupled`` applies to the rigid models (REBOUND); "de421" is always driven by DE421's orbits.
+    """
+    if model not in MOON_MODELS:
+        raise ValueError(f"model: expected one of {MOON_MODELS}, got {model!r}.")
+    if model == "de421":
+        return compare_interior_with_de421(span_days, step_days, progress=progress)
+    return compare_with_de421(moon_at_de421(model=model, coupled=coupled), span_days, step_days, progress=progress)

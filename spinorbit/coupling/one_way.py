@@ -67,6 +67,7 @@ __all__ = [
     "SamplingError",
     "sample_from_ephemeris",
     "sample_from_rebound",
+    "sample_relative_states",
     "propagate_one_way",
     "de421_orbit",
     "rebound_orbit",
@@ -316,9 +317,6 @@ def sample_from_ephemeris(body_orbit, start, end, perturbers=DEFAULT_PERTURBERS,
         The tolerance could not be reached.
     """
     names = _perturber_names(perturbers)
-    start_day, end_day = _as_days_span(start, end)
-    _check_de421_span(start_day, end_day)
-    gm = np.array([de421_constants().gm[n] for n in names])
 
     def provider(days):
         body_r, body_v = (np.asarray(a, dtype=float) for a in body_orbit(days))
@@ -329,6 +327,32 @@ def sample_from_ephemeris(body_orbit, start, end, perturbers=DEFAULT_PERTURBERS,
             out[:, i, 3:] = v - body_v
         return out
 
+    return sample_relative_states(provider, names, start, end, tolerance)
+
+
+def sample_relative_states(provider, perturbers, start, end, tolerance=DEFAULT_SAMPLE_TOLERANCE):
+    """Sample DE421 perturbers given directly as states relative to the body (adaptive grid).
+
+    Parameters
+    ----------
+    provider : callable
+        ``provider(days) -> (n, k, 6)``: positions (au) and velocities (au/day) of the k perturbers
+        relative to the body at sorted TDB days since J2000. For the Earth seen from the Moon, e.g.,
+        minus DE421's geocentric Moon series (one series instead of four).
+    perturbers : sequence of str
+        The k DE421 names (their GMs are DE421's).
+    start, end : astropy.time.Time
+    tolerance : float
+        Relative interpolation error ε (module docstring).
+
+    Returns
+    -------
+    SampledPerturbers
+    """
+    names = _perturber_names(perturbers)
+    start_day, end_day = _as_days_span(start, end)
+    _check_de421_span(start_day, end_day)
+    gm = np.array([de421_constants().gm[n] for n in names])
     grid, states, error, passes, closest = _adaptive_samples(provider, start_day, end_day, tolerance)
     return SampledPerturbers(names, gm, grid, states, tolerance, error, passes,
                              {names[i]: c for i, c in closest.items()})

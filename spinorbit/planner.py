@@ -38,8 +38,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["SAFETY", "DROP_SHARE", "SURVEY_TOLERANCE", "ARCSEC_PER_RAD", "Decision", "PerturberEstimate",
-           "Plan", "max_torque_over_a", "attitude_sensitivity", "dropped_torque_bound", "initial_rtol"]
+__all__ = [
+    "ARCSEC_PER_RAD",
+    "DROP_SHARE",
+    "SAFETY",
+    "SURVEY_TOLERANCE",
+    "Decision",
+    "PerturberEstimate",
+    "Plan",
+    "attitude_sensitivity",
+    "dropped_torque_bound",
+    "initial_rtol",
+    "max_torque_over_a",
+]
 
 #: Factor on the linear-response bound (module docstring).
 SAFETY = 2.0
@@ -196,8 +207,8 @@ class Plan:
         title = "reference plan (skip=False: nothing skipped)" if self.full else "plan"
         lines = [f"{title}: route {self.route}, orbits from {self.orbit_source}, integrator {self.integrator}"
                  + (f" (rtol {self.rtol:.1e})" if self.rtol else ""),
-                 f"  tolerance {self.tolerance_rad * ARCSEC_PER_RAD:.4g} arcsec "
-                 f"({self.tolerance_rad:.3e} rad); left out: bound {self.dropped_bound_rad * ARCSEC_PER_RAD:.3g} arcsec"]
+                 (f"  tolerance {self.tolerance_rad * ARCSEC_PER_RAD:.4g} arcsec ({self.tolerance_rad:.3e} rad); "
+                  f"left out: bound {self.dropped_bound_rad * ARCSEC_PER_RAD:.3g} arcsec")]
         width = max(len(d.topic) for d in self.decisions) if self.decisions else 0
         for decision in self.decisions:
             lines.append(f"  -> {decision.topic.ljust(width)}  {decision.choice}")

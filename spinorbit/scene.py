@@ -41,12 +41,22 @@ from astropy.table import QTable
 from astropy.time import Time
 
 from .core.errors import SpinorbitError
-from .planner import (ARCSEC_PER_RAD, DROP_SHARE, SURVEY_TOLERANCE, Decision, PerturberEstimate, Plan,
-                      attitude_sensitivity, dropped_torque_bound, initial_rtol, max_torque_over_a)
+from .planner import (
+    ARCSEC_PER_RAD,
+    DROP_SHARE,
+    SURVEY_TOLERANCE,
+    Decision,
+    PerturberEstimate,
+    Plan,
+    attitude_sensitivity,
+    dropped_torque_bound,
+    initial_rtol,
+    max_torque_over_a,
+)
 from .state import RotationState
 from .time import tdb_days, time_from_tdb_days
 
-__all__ = ["Scene", "Orbit", "FixedPerturber", "SceneResult", "SceneError", "PlanError", "QUANTITIES"]
+__all__ = ["QUANTITIES", "FixedPerturber", "Orbit", "PlanError", "Scene", "SceneError", "SceneResult"]
 
 #: Quantities a scene can ask for.
 QUANTITIES = ("attitude", "omega", "periods")
@@ -264,10 +274,13 @@ class Scene:
 
     def _resolve(self, names):
         if self.orbit is not None and self.orbit.kind == "rebound":
-            from .coupling.rebound_adapter import body_index
+            from .coupling.rebound_adapter import MissingBodyError, body_index
 
             sim = self.orbit.simulation
-            return [sim.particles[body_index(sim, n)].name.lower() for n in names]
+            try:
+                return [sim.particles[body_index(sim, n)].name.lower() for n in names]
+            except MissingBodyError as error:
+                raise SceneError(f"perturbers: {error}") from None
         from .ephemeris import _resolve_body
 
         resolved = [_resolve_body(n) for n in names]  # UnknownBodyError names the known bodies
@@ -291,7 +304,7 @@ class Scene:
             decisions.append(Decision("orbits", f"{kind} positions, no N-body integration",
                                       f"the body's orbit is given ({kind}) and the perturbers are DE421 bodies"))
             return kind
-        from .ephemeris import KNOWN_BODIES, DE421_SPAN_JD_TDB
+        from .ephemeris import DE421_SPAN_JD_TDB, KNOWN_BODIES
         from .time import J2000_JD_TDB
 
         lo, hi = (jd - J2000_JD_TDB for jd in DE421_SPAN_JD_TDB)

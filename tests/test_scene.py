@@ -15,7 +15,11 @@ from astropy import units as u
 from astropy.time import Time
 
 from spinorbit import RigidBody, RotationState
-from spinorbit.asteroids import APOPHIS_2029, apophis_encounter_simulation, apophis_rotation_state
+from spinorbit.asteroids import (
+    APOPHIS_2029,
+    apophis_encounter_simulation,
+    apophis_rotation_state,
+)
 from spinorbit.coupling.rebound_adapter import MissingBodyError, simulation_from_de421
 from spinorbit.ephemeris import UnknownBodyError, de421_constants, moon_orientation
 from spinorbit.planner import ARCSEC_PER_RAD, Plan, attitude_sensitivity
@@ -204,7 +208,7 @@ def test_end_only_gives_one_row_equal_to_the_dense_run():
 
 def test_elements_asked_away_from_singular_sets_are_used_and_agree():
     times = EPOCH + np.linspace(2.0, 20.0, 3) * u.day
-    kwargs = dict(perturbers=("sun",), orbit=Orbit.ephemeris(circular_orbit()), tolerance=1 * u.arcsec)
+    kwargs = {"perturbers": ("sun",), "orbit": Orbit.ephemeris(circular_orbit()), "tolerance": 1 * u.arcsec}
     elements = Scene(sam_state(), EPOCH, times, integrator="elements", **kwargs)
     plan = elements.plan()
     assert plan.integrator == "elements"
@@ -222,7 +226,7 @@ def test_elements_asked_near_the_separatrix_fall_back_to_quaternions():
 
 def test_error_estimate_covers_the_difference_to_a_tight_reference():
     times = EPOCH + np.linspace(2.0, 20.0, 5) * u.day
-    kwargs = dict(perturbers=("sun", "jupiter"), orbit=Orbit.ephemeris(circular_orbit()))
+    kwargs = {"perturbers": ("sun", "jupiter"), "orbit": Orbit.ephemeris(circular_orbit())}
     loose = Scene(sam_state(), EPOCH, times, tolerance=10 * u.arcsec, **kwargs).run()
     tight = Scene(sam_state(), EPOCH, times, tolerance=1e-5 * u.arcsec, **kwargs)
     reference = tight.run(tight.plan(skip=False))
@@ -246,25 +250,25 @@ def test_plan_reads_like_explain():
 
 
 @pytest.mark.parametrize("change, message", [
-    (dict(state="not a state"), "RotationState"),
-    (dict(epoch="2020-01-01"), "scalar astropy Time"),
-    (dict(times=[1.0, 2.0]), "astropy Time"),
-    (dict(times=EPOCH - 1 * u.day), "after the epoch"),
-    (dict(times=EPOCH + [2.0, 1.0] * u.day), "strictly increasing"),
-    (dict(tolerance=1e-6), "angle Quantity"),
-    (dict(tolerance=1 * u.m), "angle Quantity"),
-    (dict(tolerance=1 * u.rad), "between 1e-12 rad and 0.1 rad"),
-    (dict(quantities=("attitude", "spin")), "quantities"),
-    (dict(integrator="rk4"), "integrator"),
-    (dict(orbit=None), "need the body's orbit"),
-    (dict(orbit="de421"), "Orbit.de421"),
-    (dict(perturbers=(3,)), "body names"),
-    (dict(perturbers=("sun", "sun")), "twice"),
-    (dict(sample_tolerance=1.0), "sample_tolerance"),
+    ({"state": "not a state"}, "RotationState"),
+    ({"epoch": "2020-01-01"}, "scalar astropy Time"),
+    ({"times": [1.0, 2.0]}, "astropy Time"),
+    ({"times": EPOCH - 1 * u.day}, "after the epoch"),
+    ({"times": EPOCH + [2.0, 1.0] * u.day}, "strictly increasing"),
+    ({"tolerance": 1e-6}, "angle Quantity"),
+    ({"tolerance": 1 * u.m}, "angle Quantity"),
+    ({"tolerance": 1 * u.rad}, "between 1e-12 rad and 0.1 rad"),
+    ({"quantities": ("attitude", "spin")}, "quantities"),
+    ({"integrator": "rk4"}, "integrator"),
+    ({"orbit": None}, "need the body's orbit"),
+    ({"orbit": "de421"}, "Orbit.de421"),
+    ({"perturbers": (3,)}, "body names"),
+    ({"perturbers": ("sun", "sun")}, "twice"),
+    ({"sample_tolerance": 1.0}, "sample_tolerance"),
 ])
 def test_bad_inputs_raise_scene_error_in_words(change, message):
-    kwargs = dict(state=sam_state(), epoch=EPOCH, times=EPOCH + 1 * u.day, perturbers=("sun",),
-                  orbit=Orbit.ephemeris(circular_orbit()), tolerance=1 * u.arcsec)
+    kwargs = {"state": sam_state(), "epoch": EPOCH, "times": EPOCH + 1 * u.day, "perturbers": ("sun",),
+                  "orbit": Orbit.ephemeris(circular_orbit()), "tolerance": 1 * u.arcsec}
     kwargs.update(change)
     with pytest.raises(SceneError, match=message):
         Scene(**kwargs)
@@ -277,6 +281,9 @@ def test_bad_names_raise_the_ephemeris_and_rebound_errors():
         Orbit.de421("vulcan")
     with pytest.raises(MissingBodyError):
         Orbit.rebound(simulation_from_de421(EPOCH), "Apophis")
+    with pytest.raises(SceneError, match="no particle named 'vulcan'"):
+        Scene(sam_state(), EPOCH, EPOCH + 1 * u.day, perturbers=("vulcan",),
+              orbit=Orbit.rebound(simulation_from_de421(EPOCH), "Moon"))
     with pytest.raises(SceneError, match="callable"):
         Orbit.ephemeris("not callable")
     with pytest.raises(SceneError, match="itself"):

@@ -108,8 +108,8 @@ def measure(repeat):
         full_plan = full_scene.plan(skip=False)
         full_scene.run(full_plan)  # warm-up: numba compilation, DE421 pages
         planned_scene.run(planned_scene.plan())
-        full_time, full = best_of(repeat, lambda: full_scene.run(full_plan))
-        planned_time, planned = best_of(repeat, lambda: planned_scene.run(planned_scene.plan()))
+        full_time, full = best_of(repeat, lambda s=full_scene, p=full_plan: s.run(p))
+        planned_time, planned = best_of(repeat, lambda s=planned_scene: s.run(s.plan()))
         n = len(planned.table)
         error = float(np.max(_angles(planned.table["quaternion"], full.table["quaternion"][-n:])))
         rows.append({"skip": skip, "description": description, "full": full_time, "planned": planned_time,

@@ -29,34 +29,16 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from _report import machine_line, write_section
 
-from spinorbit import RigidBody, RotationState
-from spinorbit.asteroids import (
-    APOPHIS_2029,
-    apophis_encounter_simulation,
-    apophis_rotation_state,
-)
+from spinorbit import RigidBody, RotationState, asteroids
 from spinorbit.coupling.rebound_adapter import simulation_from_de421
 from spinorbit.ephemeris import de421_constants, moon_orientation
 from spinorbit.scene import Orbit, Scene, _angles
 
 EPOCH = Time("2020-01-01", scale="tdb")
-GM_SUN = 2.9591220828559115e-4
-
-
-def circular_orbit(radius_au=2.5):
-    """Body on a circle about the barycentre (a user ephemeris; the same as tests/test_scene.py)."""
-    n = math.sqrt(GM_SUN / radius_au**3)
-
-    def orbit(days):
-        days = np.atleast_1d(np.asarray(days, dtype=float))
-        c, s = np.cos(n * days), np.sin(n * days)
-        zero = np.zeros_like(days)
-        return radius_au * np.stack([c, s, zero], 1), radius_au * n * np.stack([-s, c, zero], 1)
-
-    return orbit
 
 
 def sam_state():
+    """The Apophis-like short-axis state of tests/test_scene.py (moment ratios 0.61 : 0.965 : 1, 9 h spin)."""
     return RotationState.from_euler313(RigidBody([0.61, 0.965, 1.0]), 10 * u.deg, 40 * u.deg, 70 * u.deg,
                                        [5, 3, 40] * u.deg / u.hour)
 
@@ -67,15 +49,15 @@ def scenes():
     dense = EPOCH + np.linspace(0.1, 20.0, 200) * u.day
     out = []
     free = Scene(sam_state(), EPOCH, EPOCH + np.linspace(0.01, 2.0, 500) * u.day, perturbers=("sun", "jupiter"),
-                 orbit=Orbit.ephemeris(circular_orbit()), tolerance=60 * u.arcsec)
+                 orbit=Orbit.circular(2.5 * u.au), tolerance=60 * u.arcsec)
     out.append(("torque-free", "SAM body at 2.5 au, Sun + Jupiter, 2 d, 500 outputs, tolerance 60 arcsec",
                 free, free))
-    drop = Scene(sam_state(), EPOCH, dense, perturbers=planets, orbit=Orbit.ephemeris(circular_orbit()),
+    drop = Scene(sam_state(), EPOCH, dense, perturbers=planets, orbit=Orbit.circular(2.5 * u.au),
                  tolerance=1 * u.arcsec)
     out.append(("drop perturbers", "same body, Sun + 5 planets, 20 d, 200 outputs", drop, drop))
-    end = Scene(sam_state(), EPOCH, dense[-1], perturbers=("sun",), orbit=Orbit.ephemeris(circular_orbit()),
+    end = Scene(sam_state(), EPOCH, dense[-1], perturbers=("sun",), orbit=Orbit.circular(2.5 * u.au),
                 tolerance=1 * u.arcsec)
-    end_full = Scene(sam_state(), EPOCH, dense, perturbers=("sun",), orbit=Orbit.ephemeris(circular_orbit()),
+    end_full = Scene(sam_state(), EPOCH, dense, perturbers=("sun",), orbit=Orbit.circular(2.5 * u.au),
                      tolerance=1 * u.arcsec)
     out.append(("end only", "same body, Sun, 20 d: 1 output vs 200", end, end_full))
     q, omega = moon_orientation(EPOCH)
@@ -84,10 +66,10 @@ def scenes():
                   orbit=Orbit.rebound(simulation_from_de421(EPOCH), "Moon"), tolerance=1 * u.arcsec)
     out.append(("DE421 instead of N-body", "the Moon (degree 2), Earth + Sun, 10 d, given as a REBOUND particle",
                 known, known))
-    start = APOPHIS_2029.time_tdb - 1 * u.day
-    flyby = Scene(apophis_rotation_state(), start, start + np.linspace(0.02, 2.0, 100) * u.day,
+    start = asteroids.APOPHIS_2029.time_tdb - 1 * u.day
+    flyby = Scene(asteroids.apophis_rotation_state(), start, start + np.linspace(0.02, 2.0, 100) * u.day,
                   perturbers=("sun", "earth", "moon", "venus", "mars", "jupiter"),
-                  orbit=Orbit.rebound(apophis_encounter_simulation("published"), "Apophis"), tolerance=1 * u.arcsec)
+                  orbit=Orbit.rebound(asteroids.apophis_encounter_simulation("published"), "Apophis"), tolerance=1 * u.arcsec)
     out.append(("drop perturbers (N-body)", "Apophis 2029 flyby +-1 d, Sun, Earth, Moon + 3 planets (REBOUND)",
                 flyby, flyby))
     return out

@@ -106,6 +106,25 @@ class Orbit:
         return cls("ephemeris", str(name), function=function)
 
     @classmethod
+    def circular(cls, radius, name="circular"):
+        """A synthetic user ephemeris: a circle of ``radius`` (length Quantity) about the barycentre in
+        the ICRF xy plane, at the Keplerian rate of DE421's GM_Sun, starting on +x at J2000. For
+        scenes whose geometry should be simple (tests, benchmarks, tutorials)."""
+        from .ephemeris import de421_constants
+
+        if not isinstance(radius, u.Quantity) or radius.unit.physical_type != "length" or not radius.value > 0:
+            raise SceneError(f"Orbit.circular expects a positive length Quantity such as 2.5 * u.au; got {radius!r}.")
+        r = float(radius.to_value(u.au))
+        n = math.sqrt(de421_constants().gm["sun"] / r**3)
+
+        def orbit(days):
+            days = np.atleast_1d(np.asarray(days, dtype=float))
+            c, s, zero = np.cos(n * days), np.sin(n * days), np.zeros(days.shape)
+            return r * np.stack([c, s, zero], axis=1), r * n * np.stack([-s, c, zero], axis=1)
+
+        return cls("ephemeris", str(name), function=orbit)
+
+    @classmethod
     def rebound(cls, simulation, particle):
         """A particle of a REBOUND simulation (("AU", "day", "Msun") units, t in TDB days since J2000,
         ICRF); perturbers are particles of the same simulation."""

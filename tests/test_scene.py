@@ -6,7 +6,6 @@ perturbers, the orbits as given, nothing left out), actually run. Numbers in com
 on the shared 2-core machine when the tests were written.
 """
 
-import math
 
 import numpy as np
 import pytest
@@ -26,21 +25,6 @@ from spinorbit.planner import ARCSEC_PER_RAD, Plan, attitude_sensitivity
 from spinorbit.scene import FixedPerturber, Orbit, PlanError, Scene, SceneError, _angles  # noqa: F401
 
 EPOCH = Time("2020-01-01", scale="tdb")
-GM_SUN = 2.9591220828559115e-4  # au³/day² (DE421's, to the digits that matter here)
-
-
-def circular_orbit(radius_au=2.5):
-    """A user ephemeris: a circular heliocentric-like orbit about the barycentre in the ICRF xy plane."""
-    n = math.sqrt(GM_SUN / radius_au**3)
-
-    def orbit(days):
-        days = np.atleast_1d(np.asarray(days, dtype=float))
-        c, s = np.cos(n * days), np.sin(n * days)
-        zero = np.zeros_like(days)
-        return (radius_au * np.stack([c, s, zero], axis=1),
-                radius_au * n * np.stack([-s, c, zero], axis=1))
-
-    return orbit
 
 
 def sam_state():
@@ -73,7 +57,7 @@ def test_no_perturbers_is_the_exact_free_motion():
 def test_torque_free_route_taken_when_the_torques_are_below_tolerance_and_stays_within_it():
     # Body on a 2.5 au circle, Sun and Jupiter, 0.2 d: all torques bounded by 0.05 arcsec (measured).
     scene = Scene(sam_state(), EPOCH, EPOCH + np.linspace(0.05, 0.2, 4) * u.day, perturbers=("sun", "jupiter"),
-                  orbit=Orbit.ephemeris(circular_orbit()), tolerance=1 * u.arcsec)
+                  orbit=Orbit.circular(2.5 * u.au), tolerance=1 * u.arcsec)
     plan = scene.plan()
     assert plan.route == "torque-free", str(plan)
     assert "exact torque-free" in str(plan) and "arcsec" in str(plan)
@@ -89,7 +73,7 @@ def test_torque_free_route_not_taken_when_a_torque_exceeds_tolerance():
     # 60 d: the Sun's torque moves the attitude by ~4 arcsec (over 20 d only 0.7 arcsec, which the
     # conservative bound would also refuse to skip).
     scene = Scene(sam_state(), EPOCH, EPOCH + np.linspace(2.0, 60.0, 4) * u.day, perturbers=("sun", "jupiter"),
-                  orbit=Orbit.ephemeris(circular_orbit()), tolerance=1 * u.arcsec)
+                  orbit=Orbit.circular(2.5 * u.au), tolerance=1 * u.arcsec)
     plan = scene.plan()
     assert plan.route == "one-way" and "sun" in plan.kept
     # The skipped torques really matter here: the free motion is off by more than the tolerance.
@@ -104,7 +88,7 @@ def test_torque_free_route_not_taken_when_a_torque_exceeds_tolerance():
 
 def test_dropped_perturbers_stay_within_tolerance_of_the_full_run():
     scene = Scene(sam_state(), EPOCH, EPOCH + np.linspace(2.0, 20.0, 5) * u.day,
-                  perturbers=("sun", "jupiter", "venus", "mars", "saturn"), orbit=Orbit.ephemeris(circular_orbit()),
+                  perturbers=("sun", "jupiter", "venus", "mars", "saturn"), orbit=Orbit.circular(2.5 * u.au),
                   tolerance=1 * u.arcsec)
     plan = scene.plan()
     assert set(plan.dropped) == {"jupiter", "venus", "mars", "saturn"} and plan.kept == ("sun",)
@@ -118,7 +102,7 @@ def test_dropped_perturbers_stay_within_tolerance_of_the_full_run():
 def test_perturber_kept_when_its_bound_exceeds_the_tolerance_share():
     # Same scene, tolerance 1e-4 arcsec: Jupiter's bound (≈ 2e-3 arcsec) no longer fits.
     scene = Scene(sam_state(), EPOCH, EPOCH + np.linspace(2.0, 20.0, 5) * u.day, perturbers=("sun", "jupiter"),
-                  orbit=Orbit.ephemeris(circular_orbit()), tolerance=1e-4 * u.arcsec)
+                  orbit=Orbit.circular(2.5 * u.au), tolerance=1e-4 * u.arcsec)
     plan = scene.plan()
     assert "jupiter" in plan.kept, str(plan)
 
@@ -192,7 +176,7 @@ def test_unknown_orbit_keeps_the_rebound_run():
 
 def test_end_only_gives_one_row_equal_to_the_dense_run():
     times = EPOCH + np.linspace(2.0, 20.0, 5) * u.day
-    orbit = Orbit.ephemeris(circular_orbit())
+    orbit = Orbit.circular(2.5 * u.au)
     dense = Scene(sam_state(), EPOCH, times, perturbers=("sun",), orbit=orbit, tolerance=1 * u.arcsec)
     end = Scene(sam_state(), EPOCH, times[-1], perturbers=("sun",), orbit=orbit, tolerance=1 * u.arcsec)
     assert end.plan().end_only and not dense.plan().end_only
@@ -208,7 +192,7 @@ def test_end_only_gives_one_row_equal_to_the_dense_run():
 
 def test_elements_asked_away_from_singular_sets_are_used_and_agree():
     times = EPOCH + np.linspace(2.0, 20.0, 3) * u.day
-    kwargs = {"perturbers": ("sun",), "orbit": Orbit.ephemeris(circular_orbit()), "tolerance": 1 * u.arcsec}
+    kwargs = {"perturbers": ("sun",), "orbit": Orbit.circular(2.5 * u.au), "tolerance": 1 * u.arcsec}
     elements = Scene(sam_state(), EPOCH, times, integrator="elements", **kwargs)
     plan = elements.plan()
     assert plan.integrator == "elements"
@@ -218,7 +202,7 @@ def test_elements_asked_away_from_singular_sets_are_used_and_agree():
 
 def test_elements_asked_near_the_separatrix_fall_back_to_quaternions():
     near = RotationState(RigidBody([1.0, 2.0, 3.0]), [1, 0, 0, 0], [1e-3, 1.0, 1e-3])
-    scene = Scene(near, EPOCH, EPOCH + 5 * u.day, perturbers=("sun",), orbit=Orbit.ephemeris(circular_orbit()),
+    scene = Scene(near, EPOCH, EPOCH + 5 * u.day, perturbers=("sun",), orbit=Orbit.circular(2.5 * u.au),
                   tolerance=1e-3 * u.arcsec, integrator="elements")
     plan = scene.plan()
     assert plan.integrator == "quaternion" and "singular sets" in str(plan)
@@ -226,7 +210,7 @@ def test_elements_asked_near_the_separatrix_fall_back_to_quaternions():
 
 def test_error_estimate_covers_the_difference_to_a_tight_reference():
     times = EPOCH + np.linspace(2.0, 20.0, 5) * u.day
-    kwargs = {"perturbers": ("sun", "jupiter"), "orbit": Orbit.ephemeris(circular_orbit())}
+    kwargs = {"perturbers": ("sun", "jupiter"), "orbit": Orbit.circular(2.5 * u.au)}
     loose = Scene(sam_state(), EPOCH, times, tolerance=10 * u.arcsec, **kwargs).run()
     tight = Scene(sam_state(), EPOCH, times, tolerance=1e-5 * u.arcsec, **kwargs)
     reference = tight.run(tight.plan(skip=False))
@@ -237,7 +221,7 @@ def test_error_estimate_covers_the_difference_to_a_tight_reference():
 
 def test_plan_reads_like_explain():
     scene = Scene(sam_state(), EPOCH, EPOCH + np.linspace(2.0, 20.0, 5) * u.day, perturbers=("sun", "jupiter"),
-                  orbit=Orbit.ephemeris(circular_orbit()), tolerance=1 * u.arcsec)
+                  orbit=Orbit.circular(2.5 * u.au), tolerance=1 * u.arcsec)
     text = str(scene.plan())
     for words in ("perturber jupiter", "dropped", "because", "at most", "arcsec", "integrator", "coupling",
                   "one-way", "docs/performance.md"):
@@ -268,7 +252,7 @@ def test_plan_reads_like_explain():
 ])
 def test_bad_inputs_raise_scene_error_in_words(change, message):
     kwargs = {"state": sam_state(), "epoch": EPOCH, "times": EPOCH + 1 * u.day, "perturbers": ("sun",),
-                  "orbit": Orbit.ephemeris(circular_orbit()), "tolerance": 1 * u.arcsec}
+                  "orbit": Orbit.circular(2.5 * u.au), "tolerance": 1 * u.arcsec}
     kwargs.update(change)
     with pytest.raises(SceneError, match=message):
         Scene(**kwargs)
@@ -276,7 +260,7 @@ def test_bad_inputs_raise_scene_error_in_words(change, message):
 
 def test_bad_names_raise_the_ephemeris_and_rebound_errors():
     with pytest.raises(UnknownBodyError):
-        Scene(sam_state(), EPOCH, EPOCH + 1 * u.day, perturbers=("vulcan",), orbit=Orbit.ephemeris(circular_orbit()))
+        Scene(sam_state(), EPOCH, EPOCH + 1 * u.day, perturbers=("vulcan",), orbit=Orbit.circular(2.5 * u.au))
     with pytest.raises(UnknownBodyError):
         Orbit.de421("vulcan")
     with pytest.raises(MissingBodyError):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..cli import CommandError
-from ._common import Progress, atomic_output, check_output_path, quantity
+from ._common import Progress, atomic_output, quantity
 
 #: Most output times a command accepts (each row builds a RotationState for the periods).
 MAX_TIMES = 100_000
@@ -31,18 +31,6 @@ def add_scene_arguments(parser: argparse.ArgumentParser, span_default: str, pert
     files = parser.add_argument_group("output files")
     files.add_argument("--output", metavar="FILE.ecsv", help="write time, attitude, spin and periods as ECSV")
     files.add_argument("--plot", metavar="FILE.png", help="plot the periods and E/E0 (needs matplotlib)")
-
-
-def check_outputs(args) -> None:
-    """Fail before the run if an output cannot be written or matplotlib is missing."""
-    for option, path in (("--output", args.output), ("--plot", args.plot)):
-        if path is not None:
-            check_output_path(option, path)
-    if args.plot is not None:
-        try:
-            import matplotlib  # noqa: F401
-        except ImportError:
-            raise CommandError("--plot needs matplotlib; install it with: pip install 'spinorbit[plot]'") from None
 
 
 def span_and_times(args, start, max_days: float):
@@ -86,6 +74,19 @@ def run_scene(scene, args):
     finally:
         progress.close()
     return result
+
+
+def run_and_report(args, state, start, times, orbit, name: str, title: str, period_unit: str) -> int:
+    """Build the Scene from the shared options, run it (or print its plan), print the summary, write files."""
+    from ..scene import Scene
+
+    scene = Scene(state, start, times, perturbers=tuple(args.perturbers), orbit=orbit, tolerance=tolerance(args))
+    result = run_scene(scene, args)
+    if result is not None:
+        for line in summary(result, period_unit):
+            print(line)
+        write_outputs(args, result, name, title, period_unit)
+    return 0
 
 
 def summary(result, period_unit: str) -> list[str]:

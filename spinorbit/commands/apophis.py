@@ -4,14 +4,11 @@ from __future__ import annotations
 
 import argparse
 
+from ._common import check_outputs
 from ._scene_command import (
     add_scene_arguments,
-    check_outputs,
-    run_scene,
+    run_and_report,
     span_and_times,
-    summary,
-    tolerance,
-    write_outputs,
 )
 
 NAME = "apophis"
@@ -56,19 +53,12 @@ def run(args) -> int:
         apophis_encounter_simulation,
         apophis_rotation_state,
     )
-    from ..scene import Orbit, Scene
+    from ..scene import Orbit
 
     check_outputs(args)
     days = span_and_times(args, APOPHIS_2029.time_tdb, MAX_SPAN_DAYS)[0].to_value(u.day)
     start = APOPHIS_2029.time_tdb - 0.5 * days * u.day
     span, times = span_and_times(args, start, MAX_SPAN_DAYS)
-    sim = apophis_encounter_simulation(args.orbit)
-    scene = Scene(apophis_rotation_state(), start, times, perturbers=tuple(args.perturbers),
-                  orbit=Orbit.rebound(sim, "Apophis"), tolerance=tolerance(args))
-    result = run_scene(scene, args)
-    if result is None:
-        return 0
-    for line in summary(result, "h"):
-        print(line)
-    write_outputs(args, result, NAME, f"(99942) Apophis through the 2029 encounter, {span.value:g} {span.unit}", "h")
-    return 0
+    orbit = Orbit.rebound(apophis_encounter_simulation(args.orbit), "Apophis")
+    return run_and_report(args, apophis_rotation_state(), start, times, orbit, NAME,
+                          f"(99942) Apophis through the 2029 encounter, {span.value:g} {span.unit}", "h")

@@ -4,14 +4,11 @@ from __future__ import annotations
 
 import argparse
 
+from ._common import check_outputs
 from ._scene_command import (
     add_scene_arguments,
-    check_outputs,
-    run_scene,
+    run_and_report,
     span_and_times,
-    summary,
-    tolerance,
-    write_outputs,
 )
 
 NAME = "toutatis"
@@ -52,18 +49,11 @@ def run(args) -> int:
         encounter_simulation,
         toutatis_rotation_state,
     )
-    from ..scene import Orbit, Scene
+    from ..scene import Orbit
 
     check_outputs(args)
     start = TOUTATIS_EPOCH.tdb
     span, times = span_and_times(args, start, MAX_SPAN_DAYS)
-    sim = encounter_simulation(TOUTATIS_2004)
-    scene = Scene(toutatis_rotation_state(), start, times, perturbers=tuple(args.perturbers),
-                  orbit=Orbit.rebound(sim, "Toutatis"), tolerance=tolerance(args))
-    result = run_scene(scene, args)
-    if result is None:
-        return 0
-    for line in summary(result, "d"):
-        print(line)
-    write_outputs(args, result, NAME, f"(4179) Toutatis from 1992-11-09, {span.value:g} {span.unit}", "d")
-    return 0
+    orbit = Orbit.rebound(encounter_simulation(TOUTATIS_2004), "Toutatis")
+    return run_and_report(args, toutatis_rotation_state(), start, times, orbit, NAME,
+                          f"(4179) Toutatis from 1992-11-09, {span.value:g} {span.unit}", "d")

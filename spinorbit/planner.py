@@ -182,6 +182,9 @@ class Plan:
     full : bool
         True for the reference plan of ``Scene.plan(skip=False)``: nothing skipped.
     decisions : list of Decision
+    samples : SampledPerturbers or None
+        For a REBOUND orbit, the survey is taken at the run's sampling tolerance and kept here, so the
+        N-body run is paid once; the run uses its kept perturbers' columns.
     """
 
     route: str
@@ -197,6 +200,9 @@ class Plan:
     dropped_bound_rad: float
     full: bool
     decisions: list = field(default_factory=list)
+    #: Perturber samples at the run's tolerance taken while planning (REBOUND route: the N-body run is
+    #: then paid once), reused by the run for the kept perturbers.
+    samples: object = field(default=None, repr=False)
 
     @property
     def integration_share_rad(self):

@@ -381,7 +381,7 @@ class Scene:
         source = self._orbit_source(skip, decisions)
         kappa = attitude_sensitivity(self.state, span)
         momentum = np.linalg.norm(self.state.angular_momentum.value) / moments[0]
-        estimates = self._survey(source, kappa, momentum, moments)
+        estimates, samples = self._survey(source, kappa, momentum, moments, keep=skip)
         total = sum(e.bound_rad for e in estimates.values())
         names = list(estimates)
         survey_note = (f"bound = 2 [κ ∫(T-s)|N|/A ds + 2∫|N| ds/|L|], |N| ≤ 3μ(C-A)/2r³, κ = {kappa:.3g} "
@@ -424,7 +424,7 @@ class Scene:
                                   f"against a run at {CHECK_RTOL_FACTOR:g}× rtol)", reason))
         kept = tuple(n for n in names if n not in dropped)
         return Plan("one-way", source, kept, tuple(dropped), estimates, integrator, rtol, self.end_only,
-                    tolerance, kappa, used, not skip, decisions)
+                    tolerance, kappa, used, not skip, decisions, samples)
 
     def _shape_decision(self):
         body = self.state.body
@@ -438,12 +438,22 @@ class Scene:
         return Decision("closed form", f"elliptic free flow, {mode}",
                         "triaxial body: Jacobi functions and the secular pn of eq. (12)")
 
-    def _survey(self, source, kappa, momentum, moments):
-        """Per-perturber bounds (planner module docstring) from a loose survey of the distances."""
+    def _survey(self, source, kappa, momentum, moments, keep=True):
+        """Per-perturber bounds (planner module docstring) from a survey of the distances.
+
+        ``keep``: for a REBOUND orbit, survey at the run's tolerance and return the samples for the run
+        (the reference plan, ``keep=False``, keeps nothing, so a full run pays its own sampling).
+        """
         estimates = {}
         t_end = self.output_days[-1]
+        survey = None
         if self.named:
-            survey = self._sampler(source, self.named, SURVEY_TOLERANCE)
+            # With a REBOUND orbit every sampling pass is an N-body run, whose cost hardly depends on the
+            # tolerance (the pilot and the run dominate): survey at the run's tolerance and keep it.
+            # With an ephemeris, sampling costs per perturber: survey loosely, sample only the kept.
+            keep = keep and source == "rebound"
+            tolerance = self.sample_tolerance if keep else SURVEY_TOLERANCE
+            survey = self._sampler(source, self.named, tolerance)
             distances = np.linalg.norm(survey.states[:, :, :3], axis=2)
             for i, name in enumerate(survey.names):
                 n = max_torque_over_a(moments, survey.gm[i], distances[:, i])
@@ -455,7 +465,7 @@ class Scene:
             n = max_torque_over_a(moments, fixed.gm_au3_day2, np.array([r, r]))
             estimates[fixed.name] = PerturberEstimate(fixed.name, r, dropped_torque_bound(days, n, t_end, kappa,
                                                                                           momentum), True)
-        return estimates
+        return estimates, (survey if keep else None)
 
     def _coupling_decision(self):
         return Decision("coupling", "one-way (the rotation does not act on the orbits)",
@@ -541,7 +551,10 @@ class Scene:
 
         named = tuple(n for n in plan.kept if n in self.named)
         fixed = [fixed_source(p.gm_au3_day2, p.position_au) for p in self.fixed if p.name in plan.kept]
-        samples = self._sampler(plan.orbit_source, named, self.sample_tolerance) if named else None
+        if named and plan.samples is not None:
+            samples = _subset(plan.samples, named)
+        else:
+            samples = self._sampler(plan.orbit_source, named, self.sample_tolerance) if named else None
         if samples is None:
             samples = _NoSamples(self.epoch_day, self.output_days[-1])
         report(0.3)
@@ -567,6 +580,16 @@ class Scene:
         stats = {k: run.meta[k] for k in ("accepted", "rejected", "rhs_calls")}
         stats.update(rtol=rtol, samples=int(samples.days.size), passes=int(getattr(samples, "passes", 0)))
         return run, {"dropped": plan.dropped_bound_rad, "integration": integration, "sampling": sampling}, stats
+
+
+def _subset(samples, names):
+    """The columns of ``names`` of a SampledPerturbers (same grid, same error estimates per perturber)."""
+    from .coupling.one_way import SampledPerturbers
+
+    index = [samples.names.index(n) for n in names]
+    return SampledPerturbers(tuple(names), samples.gm[index], samples.days, samples.states[:, index],
+                             samples.tolerance, samples.midpoint_error[index], samples.passes,
+                             {n: samples.closest[n] for n in names if n in samples.closest})
 
 
 class _NoSamples:

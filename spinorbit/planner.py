@@ -21,8 +21,9 @@ propagates the state exactly (no integration) with ω kicked along each body axi
 with the degree-2 torque of a point mass μ at distance r bounded by its largest value over all
 attitudes, |N| ≤ (3μ / 2r³) (C − A) (the unit vector r̂ at 45° between the A and C axes maximises
 |r̂ × I r̂| = (C − A)/2). r(s) comes from a survey: the same adaptive sampler as the run
-(:mod:`spinorbit.coupling.one_way`), at the loose relative tolerance :data:`SURVEY_TOLERANCE`, which
-still tightens its grid around close encounters. SAFETY = 2 covers the trapezoid rule between survey
+(:mod:`spinorbit.coupling.one_way`), at the loose relative tolerance :data:`SURVEY_TOLERANCE` (with a
+REBOUND orbit at the run's own tolerance, and kept for the run), which still tightens its grid around
+close encounters. SAFETY = 2 covers the trapezoid rule between survey
 samples and the linearisation. ``tests/test_scene.py`` checks the bound against full runs: the
 measured effect of a dropped torque must stay below it.
 

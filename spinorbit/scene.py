@@ -468,11 +468,25 @@ class Scene:
         return estimates, (survey if keep else None)
 
     def _coupling_decision(self):
-        return Decision("coupling", "one-way (the rotation does not act on the orbits)",
-                        "the body enters the orbit model as a point mass (massless particle or ephemeris); "
-                        "its figure's force on the orbits is of relative size (C-A)/(M r²) ~ J2 (R/r)², "
-                        "≈ 1e-13 for a 300 m asteroid at 1 au (coupling/one_way.py); fully coupled runs: "
-                        "CoupledRigidBody / spinorbit moon")
+        """One-way, with the reason that fits the body: massless in the orbit model, or not estimated."""
+        massive = False
+        if self.orbit is not None and self.orbit.kind == "rebound":
+            from .coupling.rebound_adapter import body_index
+
+            sim = self.orbit.simulation
+            massive = sim.particles[body_index(sim, self.orbit.name)].m > 0
+        elif self.orbit is not None and self.orbit.kind == "de421":
+            massive = True
+        choice = "one-way (the rotation does not act on the orbits)"
+        if not massive:
+            return Decision("coupling", choice,
+                            "the body is massless in the orbit model (a test particle or a given ephemeris), so its "
+                            "figure cannot act on the orbits; for a real small body that force is of relative size "
+                            "(C-A)/(M r²) ~ J2 (R/r)², ≈ 1e-13 for a 300 m asteroid at 1 au (coupling/one_way.py)")
+        return Decision("coupling", choice + "; back-reaction NOT estimated",
+                        f"'{self.orbit.name}' has mass in the orbit model but a Scene knows only its moment ratios; "
+                        "for the Moon the back-reaction was measured at ≈ 0.1 arcsec over a year (docs/coupling.md: "
+                        "0.305 one-way vs 0.207 arcsec coupled): for that, run CoupledRigidBody or spinorbit moon")
 
     def _integrator_choice(self, skip):
         measured = ("quaternion DOP853 was the fastest spinorbit method at every measured precision "

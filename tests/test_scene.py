@@ -154,6 +154,7 @@ def test_known_orbit_uses_de421_instead_of_the_rebound_run():
     scene = moon_scene(Orbit.rebound(sim, "Moon"))
     plan = scene.plan()
     assert plan.orbit_source == "de421" and "instead of the REBOUND" in str(plan)
+    assert "back-reaction NOT estimated" in str(plan)  # the Moon has mass: no false claim of negligible
     full_plan = scene.plan(skip=False)
     assert full_plan.orbit_source == "rebound"
     measured = worst_difference(scene.run(plan), scene.run(full_plan))
@@ -167,6 +168,7 @@ def test_unknown_orbit_keeps_the_rebound_run():
                   orbit=Orbit.rebound(sim, "Apophis"), tolerance=1 * u.arcsec)
     plan = scene.plan()
     assert plan.orbit_source == "rebound" and "not a DE421 body" in str(plan)
+    assert "massless in the orbit model" in str(plan)
     assert "earth" in plan.kept and "moon" in plan.kept  # the flyby's torques are radians
 
 

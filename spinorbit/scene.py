@@ -366,8 +366,8 @@ class Scene:
         moments = self.state.body.principal_moments
         span = self.span_days
         if self.end_only:
-            decisions.append(Decision("outputs", "end only: one output time, no dense output, quantities once",
-                                      "a single output time was asked"))
+            decisions.append(Decision("outputs", "end only: one output time (the dense interpolant is formed for "
+                                      "the last step alone), quantities once", "a single output time was asked"))
         else:
             decisions.append(Decision("outputs", f"{self.output_days.size} output times (dense output)",
                                       "several output times were asked"))

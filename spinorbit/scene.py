@@ -20,7 +20,7 @@ Decisions, cheapest first:
    absolute moments and a mass; a plan that finds the back-reaction above tolerance is refused
    (:class:`PlanError`): fully coupled runs are :class:`spinorbit.coupling.rigid_body.CoupledRigidBody`
    and ``spinorbit moon``.
-5. **Outputs only at the end → one output time**, no dense output, quantities computed once.
+5. **Outputs only at the end → one output time**: the dense interpolant is formed for the last step alone, quantities computed once.
 6. **Integrator**: the quaternion DOP853 (non-singular everywhere), the fastest in every measured
    work-precision scene (``docs/performance.md``). The canonical-element integrator is used only when
    asked for and the state is away from its singular sets; otherwise the plan says why not.
@@ -188,8 +188,13 @@ class SceneResult:
         one at 10× its rtol; conservative), ``sampling`` (3ε × the kept torques' bound).
     plan : Plan
     wall_seconds : float
+        Wall time of :meth:`Scene.run` (it includes planning only when ``run`` planned itself).
     stats : dict
         Integrator and sampler statistics.
+
+    ``tolerance_met`` says whether the error estimate stayed within the scene's tolerance: it can
+    exceed it when the integration cannot reach it in double precision (rtol is tightened to 1e-13
+    at most) or when the kept torques' sampling share is large over long spans.
     """
 
     table: QTable
@@ -198,6 +203,11 @@ class SceneResult:
     plan: Plan
     wall_seconds: float
     stats: dict = field(default_factory=dict)
+
+    @property
+    def tolerance_met(self):
+        """True when the error estimate is within the plan's tolerance."""
+        return bool(self.error_estimate.to_value(u.rad) <= self.plan.tolerance_rad)
 
 
 def _as_angle(tolerance):
@@ -533,6 +543,7 @@ class Scene:
         total = sum(parts.values()) * u.rad
         table.meta["error_estimate_arcsec"] = float(total.to_value(u.arcsec))
         table.meta["route"] = plan.route
+        table.meta["tolerance_met"] = bool(total.to_value(u.rad) <= plan.tolerance_rad)
         return SceneResult(table, total.to(u.arcsec), parts_q, plan, _time.perf_counter() - clock, stats)
 
     def _times(self):

@@ -236,6 +236,15 @@ def test_error_estimate_covers_the_difference_to_a_tight_reference():
     assert loose.error_estimate <= 10 * u.arcsec
 
 
+def test_a_tolerance_out_of_reach_is_reported_not_hidden():
+    # 200 d at 1e-12 rad: even at rtol 1e-13 the integration estimate is ~1e-9 rad (measured 9.8e-10).
+    result = Scene(sam_state(), EPOCH, EPOCH + 200 * u.day, perturbers=("sun",), orbit=Orbit.circular(2.5 * u.au),
+                   tolerance=1e-12 * u.rad).run()
+    assert result.stats["rtol"] == 1e-13
+    assert not result.tolerance_met and result.table.meta["tolerance_met"] is False
+    assert result.error_estimate.to_value(u.rad) > 1e-12
+
+
 def test_plan_reads_like_explain():
     scene = Scene(sam_state(), EPOCH, EPOCH + np.linspace(2.0, 20.0, 5) * u.day, perturbers=("sun", "jupiter"),
                   orbit=Orbit.circular(2.5 * u.au), tolerance=1 * u.arcsec)

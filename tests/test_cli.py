@@ -294,6 +294,12 @@ def test_apophis_plan_drops_the_planets_and_says_why(capsys):
     assert "at most" in out and "arcsec" in out
 
 
+def test_no_skip_prints_the_reference_plan(capsys):
+    status = cli.main(["toutatis", "--plan", "--no-skip", "--span", "0.01", "d", "--tolerance", "100", "arcsec"])
+    out, _ = capsys.readouterr()
+    assert status == 0 and "reference plan" in out and "exact torque-free" not in out
+
+
 def test_toutatis_scene_end_only_and_plot(capsys, tmp_path):
     pytest.importorskip("matplotlib")
     path, png = tmp_path / "t.ecsv", tmp_path / "t.png"

@@ -56,9 +56,12 @@ def tolerance(args):
 
 def run_scene(scene, args):
     """Plan (or the reference plan with --no-skip), print it with --plan, else run with a progress bar."""
+    import sys
     import time
 
     clock = time.perf_counter()
+    if sys.stderr.isatty():  # planning samples the orbits (an N-body run): say so before the wait
+        print("planning (sampling the orbits) ...", file=sys.stderr, flush=True)
     plan = scene.plan(skip=not args.no_skip)
     args.plan_seconds = time.perf_counter() - clock
     if args.plan:

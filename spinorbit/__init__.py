@@ -4,6 +4,8 @@ The front door. Public names are listed here; everything else is an implementati
 
 - :class:`RigidBody` — principal moments and the axes that go with them.
 - :class:`RotationState` — attitude and spin; mode, periods, canonical elements, exact free motion.
+- :class:`Scene` — a run described declaratively (body, perturbers, orbit, times, tolerance); its
+  ``plan()`` says how it will run and why, ``run()`` does it (:mod:`spinorbit.scene`).
 - :mod:`spinorbit.special` — elliptic functions and integrals for every parameter m ≥ 0.
 - :mod:`spinorbit.core` — the plain-float core (paper-named maps ``andoyer_to_canonical`` and
   ``canonical_to_andoyer``).
@@ -20,6 +22,8 @@ _PUBLIC = {
     "CanonicalElements": ".state",
     "InvalidStateError": ".state",
     "SingularElementsError": ".core.errors",
+    "Scene": ".scene",
+    "Orbit": ".scene",
     "SpinorbitError": ".core.errors",
 }
 

@@ -191,7 +191,7 @@ def _cli(*args):
 @pytest.mark.slow
 def test_moon_cli_killed_and_resumed_ends_bit_for_bit(tmp_path):
     """A real interruption: SIGKILL after the first checkpoint, resume in a new process (~30 s)."""
-    span = ["--span", "20", "yr"]
+    span = ["--model", "core-corrected", "--span", "20", "yr"]
     full, resumed, checkpoint = tmp_path / "full.ecsv", tmp_path / "resumed.ecsv", tmp_path / "moon.ckpt"
     assert _cli(*span, "--output", str(full)).wait() == 0
     process = _cli(*span, "--output", str(resumed), "--checkpoint", str(checkpoint), "--checkpoint-every", "0.5")
@@ -211,7 +211,7 @@ def test_moon_cli_killed_and_resumed_ends_bit_for_bit(tmp_path):
 def test_moon_cli_ctrl_c_names_the_checkpoint_to_resume_from(tmp_path):
     checkpoint = tmp_path / "moon.ckpt"
     env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    process = subprocess.Popen([sys.executable, "-m", "spinorbit", "moon", "--span", "50", "yr", "--checkpoint",
+    process = subprocess.Popen([sys.executable, "-m", "spinorbit", "moon", "--model", "core-corrected", "--span", "50", "yr", "--checkpoint",
                                 str(checkpoint), "--checkpoint-every", "0.2"], cwd=ROOT, env=env,
                                stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     while not checkpoint.exists() and process.poll() is None:

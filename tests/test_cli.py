@@ -264,3 +264,68 @@ def test_worktree_first_on_path():
     # package under test here too.
     assert Path(cli.__file__).resolve().is_relative_to(ROOT)
     assert os.path.samefile(Path(torque_free.__file__).parents[2], ROOT)
+
+
+# ------------------------------------------------------------------------------------------------
+# The asteroid scenes (spinorbit apophis, spinorbit toutatis): short spans keep these fast.
+
+
+def test_apophis_scene_writes_ecsv_with_plan_and_error_estimate(capsys, tmp_path):
+    path = tmp_path / "apophis.ecsv"
+    status = cli.main(["apophis", "--span", "1", "d", "--n-times", "5", "--output", str(path)])
+    out, err = capsys.readouterr()
+    assert status == 0, err
+    assert "kept sun, earth, moon" in out and "error estimate" in out
+    table = Table.read(path)
+    assert len(table) == 5 and table["P_psi"].unit == u.h
+    assert table.meta["error_estimate_arcsec"] <= table.meta["tolerance_arcsec"]
+    # 7 h before perigee the published periods (263 h, 27.38 h) have moved by ~2 h; 12 h after it the
+    # encounter has changed P_psi by tens of hours (measured 264.8 h and ~160 h).
+    assert abs(table["P_psi"][0] - 263.0) < 5 and abs(table["P_phi"][0] - 27.38) < 1
+    assert abs(table["P_psi"][-1] - 263.0) > 20
+    assert "route one-way" in table.meta["plan"]
+
+
+def test_apophis_plan_drops_the_planets_and_says_why(capsys):
+    status = cli.main(["apophis", "--plan", "--span", "1", "d", "--perturbers", "sun", "earth", "moon", "jupiter"])
+    out, _ = capsys.readouterr()
+    assert status == 0
+    assert re.search(r"perturber jupiter\s+dropped", out) and re.search(r"perturber earth\s+kept", out)
+    assert "at most" in out and "arcsec" in out
+
+
+def test_no_skip_prints_the_reference_plan(capsys):
+    status = cli.main(["toutatis", "--plan", "--no-skip", "--span", "0.01", "d", "--tolerance", "100", "arcsec"])
+    out, _ = capsys.readouterr()
+    assert status == 0 and "reference plan" in out and "exact torque-free" not in out
+
+
+def test_toutatis_scene_end_only_and_plot(capsys, tmp_path):
+    pytest.importorskip("matplotlib")
+    path, png = tmp_path / "t.ecsv", tmp_path / "t.png"
+    status = cli.main(["toutatis", "--span", "2", "d", "--end-only", "--output", str(path), "--plot", str(png)])
+    out, err = capsys.readouterr()
+    assert status == 0, err
+    assert len(Table.read(path)) == 1
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "LAM" in out
+
+
+def test_toutatis_torque_free_when_the_tolerance_allows(capsys):
+    status = cli.main(["toutatis", "--plan", "--span", "0.01", "d", "--tolerance", "100", "arcsec"])
+    out, _ = capsys.readouterr()
+    assert status == 0 and "exact torque-free solution" in out
+
+
+@pytest.mark.parametrize("args, words", [
+    (["apophis", "--span", "-1", "d"], "--span expects a positive duration"),
+    (["apophis", "--span", "1", "kg"], "--span expects a time"),
+    (["toutatis", "--tolerance", "1", "m"], "--tolerance expects a angle"),
+    (["toutatis", "--perturbers", "vulcan"], "vulcan"),
+    (["toutatis", "--n-times", "1"], "--n-times expects between 2"),
+])
+def test_scene_commands_bad_input_in_words(capsys, args, words):
+    status = cli.main(args)
+    _, err = capsys.readouterr()
+    assert status == 2 and words in err and "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1

@@ -37,8 +37,11 @@ API_NAMES = {
     "ephemeris": ["barycentric_state", "moon_orientation", "moon_libration_angles", "de421_constants"],
     "rebound_adapter": ["simulation_from_de421", "install_extra_forces", "perturber_positions"],
     "cli": ["main", "CommandError", "add_arguments"],
+    "scene": ["Scene", "plan", "run", "Orbit", "FixedPerturber", "SceneResult", "SceneError", "Plan",
+              "attitude_sensitivity", "dropped_torque_bound"],
 }
-NARRATIVE_PAGES = ["index", "cli", "conventions", "theory", "design", "elliptic", "ephemeris", "performance"]
+NARRATIVE_PAGES = ["index", "cli", "conventions", "theory", "design", "elliptic", "ephemeris", "performance",
+                   "scenes", "tutorials", "validation"]
 
 
 def _source_files():

@@ -64,6 +64,18 @@ def check_output_path(option: str, path: str) -> None:
         raise CommandError(f"{option}: the directory '{directory}' is not writable; choose another path.")
 
 
+def check_outputs(args) -> None:
+    """Before a run: ``--output`` and ``--plot`` (when given) can be written, and ``--plot`` has matplotlib."""
+    for option, path in (("--output", args.output), ("--plot", args.plot)):
+        if path is not None:
+            check_output_path(option, path)
+    if args.plot is not None:
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            raise CommandError("--plot needs matplotlib; install it with: pip install 'spinorbit[plot]'") from None
+
+
 @contextlib.contextmanager
 def atomic_output(option: str, path: str):
     """Yield a temporary path next to ``path``; on success move it into place, on failure delete it.

@@ -8,7 +8,7 @@ import os
 import sys
 
 from ..cli import CommandError
-from ._common import Progress, atomic_output, check_output_path, quantity
+from ._common import Progress, atomic_output, check_outputs, quantity
 
 #: The models (spinorbit.coupling.moon.MOON_MODELS, repeated so that --help does not import REBOUND).
 MOON_MODELS = ("de421", "rigid", "core-corrected")
@@ -149,14 +149,7 @@ def run(args) -> int:
     """Run ``spinorbit moon``; return the exit status."""
     from ..coupling.moon import compare_model_with_de421, compare_with_de421, moon_at_de421
 
-    for option, path in (("--output", args.output), ("--plot", args.plot)):
-        if path is not None:
-            check_output_path(option, path)
-    if args.plot is not None:
-        try:
-            import matplotlib  # noqa: F401
-        except ImportError:
-            raise CommandError("--plot needs matplotlib; install it with: pip install 'spinorbit[plot]'") from None
+    check_outputs(args)
     span = quantity("--span", args.span, "d", "time", "1 yr")
     step = quantity("--step", args.step, "d", "time", "1 d").to_value("d")
     span_days = span.to_value("d")

@@ -513,7 +513,8 @@ def _from_core(body, y):
     return RotationState.from_matrix(body, attitude, p.T @ y[4:])
 
 
-def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=True):
+def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=True, integrator="quaternion",
+                      extra_sources=()):
     """Integrate the rotation of ``state`` under the sampled perturbers' torques.
 
     Parameters
@@ -532,6 +533,12 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
     periods : bool
         Also compute the instantaneous (osculating, torque-free) P_ψ, P_φ, mode and E/E0 of every
         output state.
+    integrator : {"quaternion", "elements"}
+        :func:`~spinorbit.core.integrate_quaternion.integrate_quaternion` (default; non-singular) or
+        :func:`~spinorbit.core.integrate_elements.integrate_elements` (canonical elements, paper
+        eq. 11; raises near the separatrix, spin about C and the reference pole).
+    extra_sources : sequence
+        More :mod:`spinorbit.core.perturbers` sources (e.g. ``fixed_source``) added to the sampled ones.
 
     Returns
     -------
@@ -553,9 +560,17 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
             f"the run spans TDB days [{min(t0, t_out.min()):.4f}, {max(t0, t_out.max()):.4f}] since J2000 but the "
             f"perturbers are sampled on [{lo:.4f}, {hi:.4f}]; sample a longer span."
         )
+    if integrator not in ("quaternion", "elements"):
+        raise ValueError(f"integrator: expected 'quaternion' or 'elements', got {integrator!r}.")
     body = state.body
-    model = make_model(body.principal_moments, samples.sources())
-    ys, stats = integrate_quaternion(_to_core(state), t0, t_out, model, rtol=rtol, return_stats=True)
+    model = make_model(body.principal_moments, [*samples.sources(), *extra_sources])
+    if integrator == "elements":
+        from ..core.integrate_elements import integrate_elements
+
+        ys, stats = integrate_elements(_to_core(state), t0, t_out, model, rtol=rtol, return_stats=True)
+        stats.pop("frame")
+    else:
+        ys, stats = integrate_quaternion(_to_core(state), t0, t_out, model, rtol=rtol, return_stats=True)
     rotation_states = [_from_core(body, y) for y in ys]
     table = QTable()
     table["time"] = time_from_tdb_days(t_out)
@@ -570,6 +585,7 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
         table["P_phi"] = [p[1].to_value(u.day) for p in pairs] * u.day
     table.meta.update(stats)
     table.meta["rtol"] = rtol
+    table.meta["integrator"] = integrator
     table.meta["sample_tolerance"] = samples.tolerance
     table.meta["sample_midpoint_error"] = dict(zip(samples.names, samples.midpoint_error.tolist()))
     table.meta["samples"] = int(samples.days.size)

@@ -209,6 +209,8 @@ MOON_CASES = [
     ("resume a missing file", ["--resume", "{tmp}/none.ckpt"], "expects an existing checkpoint file"),
     ("resume a truncated file", ["--resume", "{tmp}/bad.ckpt"], "is truncated"),
     ("resume another kind", ["--resume", "{tmp}/other.ckpt"], "needs a 'coupled-run' checkpoint"),
+    ("checkpoint with the de421 model", ["--model", "de421", "--checkpoint", "{tmp}/run.ckpt"],
+     "apply to the REBOUND-coupled models"),
 ]
 
 
@@ -219,7 +221,9 @@ def test_moon_cli_bad_input_is_one_line_exit_2_and_no_output(capsys, tmp_path, l
     before = sorted(tmp_path.iterdir())
     argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
     try:
-        status = cli.main(["moon", "--span", "2", "d", *argv, "--output", str(tmp_path / "out.ecsv")])
+        # --model first: checkpoints belong to the REBOUND-coupled models; a case may override it.
+        status = cli.main(["moon", "--model", "core-corrected", "--span", "2", "d", *argv,
+                           "--output", str(tmp_path / "out.ecsv")])
     except SystemExit as exit_info:  # argparse's own checks exit from inside parse_args
         status = exit_info.code
     err = capsys.readouterr().err
@@ -232,7 +236,7 @@ def test_moon_cli_bad_input_is_one_line_exit_2_and_no_output(capsys, tmp_path, l
 
 def test_moon_cli_refuses_to_resume_another_run(capsys, tmp_path):
     checkpoint = tmp_path / "run.ckpt"
-    base = ["moon", "--step", "1", "d", "--checkpoint-every", "1e-9"]
+    base = ["moon", "--model", "core-corrected", "--step", "1", "d", "--checkpoint-every", "1e-9"]
     assert cli.main([*base, "--span", "3", "d", "--checkpoint", str(checkpoint)]) == 0
     capsys.readouterr()
     assert cli.main([*base, "--span", "4", "d", "--resume", str(checkpoint)]) == 2

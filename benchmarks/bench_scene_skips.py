@@ -1,0 +1,139 @@
+"""What each of the scene planner's skips saves: the planned run against the full run of the same scene.
+
+For every scene: the wall time of ``Scene.run(scene.plan(skip=False))`` (the full run: every
+perturber, the orbits as given, the output asked for densely; the plan is built beforehand and not
+timed) against ``scene.plan()`` + ``scene.run(plan)`` (the planner's survey and sensitivity probe
+included), best of ``--repeat`` in the same process, and the attitude difference between the two
+(the error the skip made) next to the tolerance and the planned run's error estimate. Timings on a
+shared machine are noisy: the ratio of the two runs in the same process is what to read.
+
+Usage::
+
+    python benchmarks/bench_scene_skips.py            # writes the 'scene_skips' section of docs/performance.md
+    python benchmarks/bench_scene_skips.py --no-write # print only
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from astropy import units as u
+from astropy.time import Time
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from _report import machine_line, write_section
+
+from spinorbit import RigidBody, RotationState, asteroids
+from spinorbit.coupling.rebound_adapter import simulation_from_de421
+from spinorbit.ephemeris import de421_constants, moon_orientation
+from spinorbit.scene import Orbit, Scene, _angles
+
+EPOCH = Time("2020-01-01", scale="tdb")
+
+
+def sam_state():
+    """The Apophis-like short-axis state of tests/test_scene.py (moment ratios 0.61 : 0.965 : 1, 9 h spin)."""
+    return RotationState.from_euler313(RigidBody([0.61, 0.965, 1.0]), 10 * u.deg, 40 * u.deg, 70 * u.deg,
+                                       [5, 3, 40] * u.deg / u.hour)
+
+
+def scenes():
+    """(skip, description, planned scene, full scene)."""
+    planets = ("sun", "mercury", "venus", "mars", "jupiter", "saturn")
+    dense = EPOCH + np.linspace(0.1, 20.0, 200) * u.day
+    out = []
+    free = Scene(sam_state(), EPOCH, EPOCH + np.linspace(0.01, 2.0, 500) * u.day, perturbers=("sun", "jupiter"),
+                 orbit=Orbit.circular(2.5 * u.au), tolerance=60 * u.arcsec)
+    out.append(("torque-free", "SAM body at 2.5 au, Sun + Jupiter, 2 d, 500 outputs, tolerance 60 arcsec",
+                free, free))
+    drop = Scene(sam_state(), EPOCH, dense, perturbers=planets, orbit=Orbit.circular(2.5 * u.au),
+                 tolerance=1 * u.arcsec)
+    out.append(("drop perturbers", "same body, Sun + 5 planets, 20 d, 200 outputs", drop, drop))
+    end = Scene(sam_state(), EPOCH, dense[-1], perturbers=("sun",), orbit=Orbit.circular(2.5 * u.au),
+                tolerance=1 * u.arcsec)
+    end_full = Scene(sam_state(), EPOCH, dense, perturbers=("sun",), orbit=Orbit.circular(2.5 * u.au),
+                     tolerance=1 * u.arcsec)
+    out.append(("end only", "same body, Sun, 20 d: 1 output vs 200", end, end_full))
+    q, omega = moon_orientation(EPOCH)
+    moon = RotationState(RigidBody(list(de421_constants().moon_moments_over_mr2)), q, omega)
+    known = Scene(moon, EPOCH, EPOCH + np.linspace(0.5, 10.0, 20) * u.day, perturbers=("earth", "sun"),
+                  orbit=Orbit.rebound(simulation_from_de421(EPOCH), "Moon"), tolerance=1 * u.arcsec)
+    out.append(("DE421 instead of N-body", "the Moon (degree 2), Earth + Sun, 10 d, given as a REBOUND particle",
+                known, known))
+    start = asteroids.APOPHIS_2029.time_tdb - 1 * u.day
+    flyby = Scene(asteroids.apophis_rotation_state(), start, start + np.linspace(0.02, 2.0, 100) * u.day,
+                  perturbers=("sun", "earth", "moon", "venus", "mars", "jupiter"),
+                  orbit=Orbit.rebound(asteroids.apophis_encounter_simulation("published"), "Apophis"), tolerance=1 * u.arcsec)
+    out.append(("drop perturbers (N-body)", "Apophis 2029 flyby +-1 d, Sun, Earth, Moon + 3 planets (REBOUND)",
+                flyby, flyby))
+    return out
+
+
+def best_of(repeat, function):
+    best, value = math.inf, None
+    for _ in range(repeat):
+        clock = time.perf_counter()
+        value = function()
+        best = min(best, time.perf_counter() - clock)
+    return best, value
+
+
+def measure(repeat):
+    rows = []
+    for skip, description, planned_scene, full_scene in scenes():
+        full_plan = full_scene.plan(skip=False)
+        full_scene.run(full_plan)  # warm-up: numba compilation, DE421 pages
+        planned_scene.run(planned_scene.plan())
+        full_time, full = best_of(repeat, lambda s=full_scene, p=full_plan: s.run(p))
+        planned_time, planned = best_of(repeat, lambda s=planned_scene: s.run(s.plan()))
+        n = len(planned.table)
+        error = float(np.max(_angles(planned.table["quaternion"], full.table["quaternion"][-n:])))
+        rows.append({"skip": skip, "description": description, "full": full_time, "planned": planned_time,
+                         "error": error * 206264.80624709636, "estimate": planned.error_estimate.to_value(u.arcsec),
+                         "tolerance": planned.plan.tolerance_rad * 206264.80624709636, "route": planned.plan.route,
+                         "dropped": ", ".join(planned.plan.dropped) or "none", "source": planned.plan.orbit_source})
+        print(f"{skip:26s} full {full_time * 1e3:8.1f} ms  planned {planned_time * 1e3:8.1f} ms  "
+              f"x{full_time / planned_time:6.2f}  error {rows[-1]['error']:.2e} arcsec  "
+              f"estimate {rows[-1]['estimate']:.2e}  ({planned.plan.route}, dropped {rows[-1]['dropped']})")
+    return rows
+
+
+def markdown(rows, repeat):
+    lines = ["## What the scene planner's skips save (`benchmarks/bench_scene_skips.py`)", "",
+             machine_line(), "",
+             (f"Wall time of the full run (`Scene.run(scene.plan(skip=False))`, plan built beforehand) against the "
+             f"planned run (`scene.plan()` + `scene.run(plan)`, the planner's survey and sensitivity probe included), "
+             f"best of {repeat} in one process; error = largest attitude angle between the two runs' outputs "
+             "(the planned run's times), next to the tolerance and the planned run's own error estimate. Both runs "
+             "include the a posteriori integration check (a second run at 10× rtol)."), "",
+             ("| skip | scene | full (ms) | planned (ms) | full / planned | error (arcsec) | estimate (arcsec) "
+             "| tolerance (arcsec) | plan |"),
+             "|---|---|---:|---:|---:|---:|---:|---:|---|"]
+    for r in rows:
+        plan = f"{r['route']}, orbits {r['source']}, dropped {r['dropped']}"
+        lines.append(f"| {r['skip']} | {r['description']} | {r['full'] * 1e3:.1f} | {r['planned'] * 1e3:.1f} | "
+                     f"{r['full'] / r['planned']:.2f} | {r['error']:.2e} | {r['estimate']:.2e} | {r['tolerance']:g} "
+                     f"| {plan} |")
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--no-write", action="store_true", help="print only, do not touch docs/performance.md")
+    args = parser.parse_args(argv)
+    rows = measure(args.repeat)
+    text = markdown(rows, args.repeat)
+    print(text)
+    if not args.no_write:
+        print(f"wrote {write_section('scene_skips', text)}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,189 @@
+"""What the asteroid commands share: Scene options, the planned run with a progress bar, ECSV and PNG."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..cli import CommandError
+from ._common import Progress, atomic_output, quantity
+
+#: Most output times a command accepts (each row builds a RotationState for the periods).
+MAX_TIMES = 100_000
+
+
+def add_scene_arguments(parser: argparse.ArgumentParser, span_default: str, perturbers_default) -> None:
+    """Options common to the asteroid scene commands."""
+    run = parser.add_argument_group("scene")
+    run.add_argument("--span", nargs="+", default=span_default.split(), metavar="SPAN",
+                     help=f"how long to run, e.g. '4 d', '1 yr' (a number alone is days; default {span_default})")
+    run.add_argument("--n-times", type=int, default=200, metavar="N",
+                     help="number of evenly spaced output times (default 200)")
+    run.add_argument("--end-only", action="store_true",
+                     help="only the final state (the planner then asks for no dense output)")
+    run.add_argument("--tolerance", nargs="+", default=["1", "arcsec"], metavar="ANGLE",
+                     help="attitude tolerance of the whole run, e.g. '1 arcsec' (default), '1e-6 rad'")
+    run.add_argument("--perturbers", nargs="+", default=list(perturbers_default), metavar="BODY",
+                     help=f"bodies whose torque may act (default: {' '.join(perturbers_default)}); the planner "
+                     "drops those that cannot matter and says why")
+    run.add_argument("--plan", action="store_true", help="print the plan (decisions and reasons) and stop")
+    run.add_argument("--no-skip", action="store_true",
+                     help="run the reference plan: every perturber, the orbits as given, nothing skipped")
+    files = parser.add_argument_group("output files")
+    files.add_argument("--output", metavar="FILE.ecsv", help="write time, attitude, spin and periods as ECSV")
+    files.add_argument("--plot", metavar="FILE.png", help="plot the periods and E/E0 (needs matplotlib)")
+
+
+def span_and_times(args, start, max_days: float):
+    """(span Quantity, output Time(s)) from --span, --n-times and --end-only, starting at ``start``."""
+    import astropy.units as u
+    import numpy as np
+
+    span = quantity("--span", args.span, "d", "time", "4 d")
+    days = span.to_value(u.day)
+    if not 0 < days <= max_days:
+        raise CommandError(f"--span expects a positive duration up to {max_days:g} d; got {' '.join(args.span)}.")
+    if not 2 <= args.n_times <= MAX_TIMES:
+        raise CommandError(f"--n-times expects between 2 and {MAX_TIMES} output times; got {args.n_times}.")
+    if args.end_only:
+        return span, start + days * u.day
+    return span, start + np.linspace(days / args.n_times, days, args.n_times) * u.day
+
+
+def tolerance(args):
+    """The --tolerance angle."""
+    return quantity("--tolerance", args.tolerance, "arcsec", "angle", "1 arcsec")
+
+
+def run_scene(scene, args):
+    """Plan (or the reference plan with --no-skip), print it with --plan, else run with a progress bar."""
+    import sys
+    import time
+
+    clock = time.perf_counter()
+    if sys.stderr.isatty():  # planning samples the orbits (an N-body run): say so before the wait
+        print("planning (sampling the orbits) ...", file=sys.stderr, flush=True)
+    plan = scene.plan(skip=not args.no_skip)
+    args.plan_seconds = time.perf_counter() - clock
+    if args.plan:
+        print(plan)
+        return None
+    progress = Progress(100, "running")
+    done = [0]
+
+    def advance(fraction):
+        step = int(100 * fraction) - done[0]
+        if step > 0:
+            progress.advance(step)
+            done[0] += step
+
+    try:
+        result = scene.run(plan, progress=advance)
+    finally:
+        progress.close()
+    return result
+
+
+def run_and_report(args, state, start, times, orbit, name: str, title: str, period_unit: str) -> int:
+    """Build the Scene from the shared options, run it (or print its plan), print the summary, write files."""
+    from ..scene import Scene
+
+    scene = Scene(state, start, times, perturbers=tuple(args.perturbers), orbit=orbit, tolerance=tolerance(args))
+    result = run_scene(scene, args)
+    if result is not None:
+        for line in summary(result, period_unit, args.plan_seconds):
+            print(line)
+        write_outputs(args, result, name, title, period_unit)
+    return 0
+
+
+def summary(result, period_unit: str, plan_seconds: float = 0.0) -> list[str]:
+    """Lines: the plan in brief, the state before and after, the error estimate."""
+    import astropy.units as u
+
+    plan, table = result.plan, result.table
+    lines = [f"plan               {plan.route}, orbits from {plan.orbit_source}, integrator {plan.integrator}",
+             f"perturbers         kept {', '.join(plan.kept) or 'none'}; dropped {', '.join(plan.dropped) or 'none'}"]
+    if "P_psi" in table.colnames:
+        for label, row in (("first", table[0]), ("last", table[-1])):
+            lines.append(f"{label:5s} {row['time'].tdb.iso[:16]} TDB  {row['mode']:3s}  "
+                         f"P_psi = {row['P_psi'].to_value(period_unit):9.4f} {period_unit}  "
+                         f"P_phi = {row['P_phi'].to_value(period_unit):9.4f} {period_unit}  "
+                         f"E/E0 = {row['energy_ratio']:.5f}")
+    parts = ", ".join(f"{k} {v.to_value(u.arcsec):.2g}" for k, v in result.error_parts.items())
+    lines.append(f"wall time          {plan_seconds + result.wall_seconds:.2f} s (plan {plan_seconds:.2f} s, "
+                 f"run {result.wall_seconds:.2f} s)")
+    lines.append(f"error estimate     {result.error_estimate.to_value(u.arcsec):.3g} arcsec ({parts})")
+    if not result.tolerance_met:
+        lines.append(f"tolerance NOT met  the estimate exceeds the tolerance "
+                     f"{result.plan.tolerance_rad * 206264.80624709636:.3g} arcsec (long spans: the integration "
+                     "error of double precision grows with the number of rotations); loosen --tolerance or shorten --span")
+    return lines
+
+
+def ecsv_table(result, name: str, period_unit: str):
+    """The result as a plain astropy Table with units, for ECSV."""
+    import astropy.units as u
+    from astropy.table import Table
+
+    from .. import __version__
+
+    qtable = result.table
+    table = Table(meta={
+        "software": f"spinorbit {__version__} {name}",
+        "route": result.plan.route,
+        "orbits": result.plan.orbit_source,
+        "perturbers_kept": list(result.plan.kept),
+        "perturbers_dropped": list(result.plan.dropped),
+        "tolerance_arcsec": result.plan.tolerance_rad * 206264.80624709636,
+        "error_estimate_arcsec": float(result.error_estimate.to_value(u.arcsec)),
+        "tolerance_met": result.tolerance_met,
+        "plan": str(result.plan),
+        "conventions": "quaternion scalar first (w, x, y, z), body axes -> ICRF; omega in body axes",
+    })
+    table["time"] = qtable["time"].tdb
+    for i, axis in enumerate("wxyz"):
+        table[f"q_{axis}"] = qtable["quaternion"][:, i]
+    if "omega" in qtable.colnames:
+        for i, axis in enumerate("xyz"):
+            table[f"omega_{axis}"] = qtable["omega"][:, i].to(u.rad / u.day)
+    if "P_psi" in qtable.colnames:
+        table["mode"] = qtable["mode"]
+        table["P_psi"] = qtable["P_psi"].to(period_unit)
+        table["P_phi"] = qtable["P_phi"].to(period_unit)
+        table["energy_ratio"] = qtable["energy_ratio"]
+    return table
+
+
+def write_outputs(args, result, name: str, title: str, period_unit: str) -> None:
+    """ECSV and PNG, each atomically."""
+    if args.output is not None:
+        table = ecsv_table(result, name, period_unit)
+        with atomic_output("--output", args.output) as temporary:
+            table.write(temporary, format="ascii.ecsv", overwrite=True)
+        print(f"wrote              {args.output} ({len(table)} rows)")
+    if args.plot is not None:
+        with atomic_output("--plot", args.plot) as temporary:
+            plot(result, temporary, title, period_unit)
+        print(f"wrote              {args.plot}")
+
+
+def plot(result, path: str, title: str, period_unit: str) -> None:
+    """PNG: P_psi, P_phi and E/E0 against days from the first output."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    table = result.table
+    days = (table["time"] - table["time"][0]).to_value("d")
+    figure = Figure(figsize=(7, 6), layout="constrained")
+    FigureCanvasAgg(figure)
+    axes = figure.subplots(3, 1, sharex=True)
+    if "P_psi" in table.colnames:
+        axes[0].plot(days, table["P_psi"].to_value(period_unit))
+        axes[1].plot(days, table["P_phi"].to_value(period_unit), color="C1")
+        axes[2].plot(days, table["energy_ratio"], color="C2")
+    axes[0].set_ylabel(f"P_psi [{period_unit}]")
+    axes[1].set_ylabel(f"P_phi [{period_unit}]")
+    axes[2].set_ylabel("E/E0")
+    axes[2].set_xlabel(f"days from {table['time'][0].tdb.iso[:16]} TDB")
+    axes[0].set_title(title)
+    figure.savefig(path, format="png", dpi=100)

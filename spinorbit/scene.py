@@ -1,0 +1,641 @@
+"""A run described declaratively, planned cheapest-first within a tolerance, then carried out.
+
+A :class:`Scene` says *what* is wanted — one rotating body's state at an epoch, the perturbers that
+may torque it, where the orbits come from, the output times, the quantities and the attitude
+tolerance — and :meth:`Scene.plan` decides *how*, each decision with its reason in words and numbers
+(``print(scene.plan())``, like a query planner's EXPLAIN). :meth:`Scene.run` carries the plan out and
+returns the results with an error estimate. The bounds and the budget are in :mod:`spinorbit.planner`
+and ``docs/scenes.md``.
+
+Decisions, cheapest first:
+
+1. **No torque above the tolerance → the exact torque-free solution** (paper eq. 12), no sampling,
+   no integration.
+2. **Perturbers whose torque over the span cannot move the attitude by more than their share of the
+   tolerance → dropped**, with the bound that justified it.
+3. **Known orbits → ephemeris**: a body DE421 carries (even when handed over as a REBOUND particle)
+   and its perturbers are taken from DE421; a REBOUND (N-body) run only when the body's orbit is
+   known through the simulation alone.
+4. **Back-reaction → one-way coupling**: the rotation does not act on the orbits. The estimate needs
+   absolute moments and a mass; a plan that finds the back-reaction above tolerance is refused
+   (:class:`PlanError`): fully coupled runs are :class:`spinorbit.coupling.rigid_body.CoupledRigidBody`
+   and ``spinorbit moon``.
+5. **Outputs only at the end → one output time**: the dense interpolant is formed for the last step alone, quantities computed once.
+6. **Integrator**: the quaternion DOP853 (non-singular everywhere), the fastest in every measured
+   work-precision scene (``docs/performance.md``). The canonical-element integrator is used only when
+   asked for and the state is away from its singular sets; otherwise the plan says why not.
+
+Frames and units as in :mod:`spinorbit.coupling.one_way`: the state's attitude is relative to ICRF,
+times are astropy Times (TDB inside), distances au, GM au³/day².
+"""
+
+from __future__ import annotations
+
+import math
+import time as _time
+from dataclasses import dataclass, field
+
+import numpy as np
+from astropy import units as u
+from astropy.table import QTable
+from astropy.time import Time
+
+from .core.errors import SpinorbitError
+from .planner import (
+    ARCSEC_PER_RAD,
+    DROP_SHARE,
+    SURVEY_TOLERANCE,
+    Decision,
+    PerturberEstimate,
+    Plan,
+    attitude_sensitivity,
+    dropped_torque_bound,
+    initial_rtol,
+    max_torque_over_a,
+)
+from .state import RotationState
+from .time import tdb_days, time_from_tdb_days
+
+__all__ = ["QUANTITIES", "FixedPerturber", "Orbit", "PlanError", "Scene", "SceneError", "SceneResult"]
+
+#: Quantities a scene can ask for.
+QUANTITIES = ("attitude", "omega", "periods")
+#: Retries of the integration with a 100× tighter rtol when the a posteriori estimate misses its share.
+MAX_RTOL_RETRIES = 2
+#: Factor between the run's rtol and the check run's (error estimate = their difference).
+CHECK_RTOL_FACTOR = 10.0
+#: Near the singular sets of the canonical elements the planner refuses that integrator: 1 − m (or
+#: 1 − μ) and sin J below this many times the element integrator's own stop thresholds.
+SINGULAR_MARGIN = 100.0
+
+
+class SceneError(SpinorbitError, ValueError):
+    """A scene was described with inputs of the wrong kind or inconsistent with each other."""
+
+
+class PlanError(SpinorbitError, RuntimeError):
+    """No plan reaches the tolerance with the routes a Scene can run (the message says which to use)."""
+
+
+@dataclass(frozen=True)
+class Orbit:
+    """Where the rotating body's orbit (and its perturbers' positions) come from.
+
+    Build with :meth:`de421`, :meth:`ephemeris` or :meth:`rebound`.
+    """
+
+    kind: str
+    name: str
+    function: object = None
+    simulation: object = None
+
+    @classmethod
+    def de421(cls, name):
+        """A body DE421 carries (e.g. ``"moon"``); perturbers are DE421 bodies."""
+        from .ephemeris import _resolve_body
+
+        return cls("de421", _resolve_body(name))
+
+    @classmethod
+    def ephemeris(cls, function, name="body"):
+        """A user ephemeris ``function(days) -> (positions (n, 3) au, velocities (n, 3) au/day)``,
+        barycentric ICRF at TDB days since J2000; perturbers are DE421 bodies."""
+        if not callable(function):
+            raise SceneError(f"Orbit.ephemeris expects a callable days -> (positions, velocities); got "
+                             f"{type(function).__name__}.")
+        return cls("ephemeris", str(name), function=function)
+
+    @classmethod
+    def circular(cls, radius, name="circular"):
+        """A synthetic user ephemeris: a circle of ``radius`` (length Quantity) about the barycentre in
+        the ICRF xy plane, at the Keplerian rate of DE421's GM_Sun, starting on +x at J2000. For
+        scenes whose geometry should be simple (tests, benchmarks, tutorials)."""
+        from .ephemeris import de421_constants
+
+        if not isinstance(radius, u.Quantity) or radius.unit.physical_type != "length" or not radius.value > 0:
+            raise SceneError(f"Orbit.circular expects a positive length Quantity such as 2.5 * u.au; got {radius!r}.")
+        r = float(radius.to_value(u.au))
+        n = math.sqrt(de421_constants().gm["sun"] / r**3)
+
+        def orbit(days):
+            days = np.atleast_1d(np.asarray(days, dtype=float))
+            c, s, zero = np.cos(n * days), np.sin(n * days), np.zeros(days.shape)
+            return r * np.stack([c, s, zero], axis=1), r * n * np.stack([-s, c, zero], axis=1)
+
+        return cls("ephemeris", str(name), function=orbit)
+
+    @classmethod
+    def rebound(cls, simulation, particle):
+        """A particle of a REBOUND simulation (("AU", "day", "Msun") units, t in TDB days since J2000,
+        ICRF); perturbers are particles of the same simulation."""
+        from .coupling.rebound_adapter import body_index
+
+        body_index(simulation, particle)  # MissingBodyError now, not after a survey
+        return cls("rebound", str(particle), simulation=simulation)
+
+
+@dataclass(frozen=True)
+class FixedPerturber:
+    """A point mass at a fixed ICRF position relative to the body (a user position).
+
+    Parameters
+    ----------
+    name : str
+    gm : Quantity
+        G·M (any unit of length³/time²).
+    position : Quantity, shape (3,)
+        Relative to the body's centre, ICRF axes (any length unit).
+    """
+
+    name: str
+    gm: u.Quantity
+    position: u.Quantity
+
+    def __post_init__(self):
+        gm, position = self.gm, self.position
+        if not isinstance(gm, u.Quantity) or gm.unit.physical_type != (u.m**3 / u.s**2).physical_type:
+            raise SceneError(f"FixedPerturber {self.name!r}: gm expects a Quantity in length³/time² such as "
+                             f"3.986e14 m3/s2; got {gm!r}.")
+        if (not isinstance(position, u.Quantity) or position.unit.physical_type != "length"
+                or position.shape != (3,) or not np.all(np.isfinite(position.value)) or not np.any(position.value)):
+            raise SceneError(f"FixedPerturber {self.name!r}: position expects a finite, non-zero length "
+                             f"Quantity of shape (3,) such as [1, 0, 0] * u.au; got {position!r}.")
+
+    @property
+    def gm_au3_day2(self):
+        return float(self.gm.to_value(u.au**3 / u.day**2))
+
+    @property
+    def position_au(self):
+        return self.position.to_value(u.au).astype(float)
+
+
+@dataclass
+class SceneResult:
+    """What :meth:`Scene.run` returns.
+
+    Attributes
+    ----------
+    table : astropy.table.QTable
+        ``time`` (Time, TDB), ``quaternion`` (scalar first, user body axes → ICRF), ``omega``
+        (rad/day, user body axes), ``momentum_direction`` (ICRF); with "periods" asked: ``mode``,
+        ``energy_ratio``, ``P_psi``, ``P_phi``. Only the quantities asked for are filled in beyond
+        time and quaternion.
+    error_estimate : Quantity
+        Attitude error estimate (arcsec): the sum of ``error_parts``.
+    error_parts : dict of Quantity
+        ``dropped`` (bound of what the plan left out), ``integration`` (a posteriori: the run against
+        one at 10× its rtol; conservative), ``sampling`` (3ε × the kept torques' bound).
+    plan : Plan
+    wall_seconds : float
+        Wall time of :meth:`Scene.run` (it includes planning only when ``run`` planned itself).
+    stats : dict
+        Integrator and sampler statistics.
+
+    ``tolerance_met`` says whether the error estimate stayed within the scene's tolerance: it can
+    exceed it when the integration cannot reach it in double precision (rtol is tightened to 1e-13
+    at most) or when the kept torques' sampling share is large over long spans.
+    """
+
+    table: QTable
+    error_estimate: u.Quantity
+    error_parts: dict
+    plan: Plan
+    wall_seconds: float
+    stats: dict = field(default_factory=dict)
+
+    @property
+    def tolerance_met(self):
+        """True when the error estimate is within the plan's tolerance."""
+        return bool(self.error_estimate.to_value(u.rad) <= self.plan.tolerance_rad)
+
+
+def _as_angle(tolerance):
+    if not isinstance(tolerance, u.Quantity) or tolerance.unit.physical_type != "angle" or not tolerance.isscalar:
+        raise SceneError(f"tolerance expects an angle Quantity such as 1 * u.arcsec or 1e-6 * u.rad; got {tolerance!r}.")
+    value = float(tolerance.to_value(u.rad))
+    if not (math.isfinite(value) and 1e-12 <= value <= 0.1):
+        raise SceneError(f"tolerance expects an attitude angle between 1e-12 rad and 0.1 rad (2e-7 to 2e4 arcsec); "
+                         f"got {tolerance!r}.")
+    return value
+
+
+def _days(time):
+    whole, rest = tdb_days(time)
+    return np.atleast_1d(np.asarray(whole, dtype=float) + np.asarray(rest, dtype=float))
+
+
+class Scene:
+    """One rotating body, its perturbers, its orbit, output times, quantities and an attitude tolerance.
+
+    Parameters
+    ----------
+    state : spinorbit.RotationState
+        Attitude (relative to ICRF) and spin at ``epoch``.
+    epoch : astropy.time.Time
+        Time of ``state`` (scalar).
+    times : astropy.time.Time
+        Output times, strictly increasing, after ``epoch``; a scalar Time means "the end only".
+    perturbers : sequence of str or FixedPerturber
+        DE421 body names (``"sun"``, ``"earth"``, ``"jupiter"``…; particle names for a REBOUND orbit)
+        and/or :class:`FixedPerturber` s. Empty: torque-free.
+    orbit : Orbit, optional
+        Needed when any perturber is named.
+    tolerance : Quantity
+        Attitude tolerance (angle) of the whole run.
+    quantities : sequence of str
+        Among :data:`QUANTITIES`.
+    integrator : {"auto", "quaternion", "elements"}
+        "auto" lets the planner choose.
+    sample_tolerance : float
+        Relative interpolation error of the sampled perturbers in the run.
+
+    Raises
+    ------
+    SceneError
+        Inputs of the wrong kind, times not after the epoch, perturbers without an orbit, …
+    """
+
+    def __init__(self, state, epoch, times, perturbers=(), orbit=None, tolerance=1 * u.arcsec,
+                 quantities=QUANTITIES, integrator="auto", sample_tolerance=1e-10):
+        if not isinstance(state, RotationState):
+            raise SceneError(f"state expects a spinorbit.RotationState; got {type(state).__name__}.")
+        if not isinstance(epoch, Time) or not epoch.isscalar:
+            raise SceneError(f"epoch expects a scalar astropy Time; got {epoch!r}.")
+        if not isinstance(times, Time):
+            raise SceneError(f"times expects an astropy Time (scalar for the end only, or an array); got "
+                             f"{type(times).__name__}.")
+        self.state, self.epoch, self.times = state, epoch, times
+        self.end_only = times.isscalar or times.size == 1
+        self.epoch_day = float(_days(epoch)[0])
+        self.output_days = _days(times)
+        if not np.all(np.diff(self.output_days) > 0):
+            raise SceneError("times expects strictly increasing output times.")
+        if not self.output_days[0] > self.epoch_day:
+            raise SceneError(f"times expects output times after the epoch; the first is "
+                             f"{self.output_days[0] - self.epoch_day:+.6g} d from it. Give later times or an earlier epoch.")
+        self.tolerance_rad = _as_angle(tolerance)
+        unknown = [q for q in quantities if q not in QUANTITIES]
+        if unknown or not quantities:
+            raise SceneError(f"quantities expects some of {QUANTITIES}; got {tuple(quantities)!r}.")
+        self.quantities = tuple(quantities)
+        if integrator not in ("auto", "quaternion", "elements"):
+            raise SceneError(f"integrator expects 'auto', 'quaternion' or 'elements'; got {integrator!r}.")
+        self.integrator = integrator
+        if not (isinstance(sample_tolerance, float) and 1e-14 <= sample_tolerance < 1e-2):
+            raise SceneError(f"sample_tolerance expects a float in [1e-14, 1e-2); got {sample_tolerance!r}.")
+        self.sample_tolerance = sample_tolerance
+        if orbit is not None and not isinstance(orbit, Orbit):
+            raise SceneError(f"orbit expects a spinorbit.scene.Orbit (Orbit.de421, Orbit.ephemeris, Orbit.rebound); "
+                             f"got {type(orbit).__name__}.")
+        self.orbit = orbit
+        self.fixed = tuple(p for p in perturbers if isinstance(p, FixedPerturber))
+        named = [p for p in perturbers if not isinstance(p, FixedPerturber)]
+        bad = [p for p in named if not isinstance(p, str)]
+        if bad:
+            raise SceneError(f"perturbers expects body names (str) or FixedPerturber; got {bad[0]!r}.")
+        if named and orbit is None:
+            raise SceneError(f"perturbers {named} need the body's orbit: give orbit=Orbit.de421(...), "
+                             "Orbit.ephemeris(...) or Orbit.rebound(...).")
+        self.named = tuple(self._resolve(named))
+        if len(set(self.named)) != len(self.named):
+            raise SceneError(f"perturbers lists a body twice: {list(self.named)}.")
+
+    def _resolve(self, names):
+        if self.orbit is not None and self.orbit.kind == "rebound":
+            from .coupling.rebound_adapter import MissingBodyError, body_index
+
+            sim = self.orbit.simulation
+            try:
+                return [sim.particles[body_index(sim, n)].name.lower() for n in names]
+            except MissingBodyError as error:
+                raise SceneError(f"perturbers: {error}") from None
+        from .ephemeris import _resolve_body
+
+        resolved = [_resolve_body(n) for n in names]  # UnknownBodyError names the known bodies
+        if self.orbit is not None and self.orbit.name in resolved:
+            raise SceneError(f"perturbers includes the rotating body itself ({self.orbit.name!r}).")
+        return resolved
+
+    @property
+    def span_days(self):
+        """Days from the epoch to the last output time."""
+        return float(self.output_days[-1] - self.epoch_day)
+
+    # ------------------------------------------------------------------------------------------
+    # Planning
+
+    def _orbit_source(self, skip, decisions):
+        if not self.named:
+            return "none"
+        kind = self.orbit.kind
+        if kind != "rebound":
+            decisions.append(Decision("orbits", f"{kind} positions, no N-body integration",
+                                      f"the body's orbit is given ({kind}) and the perturbers are DE421 bodies"))
+            return kind
+        from .ephemeris import DE421_SPAN_JD_TDB, KNOWN_BODIES
+        from .time import J2000_JD_TDB
+
+        lo, hi = (jd - J2000_JD_TDB for jd in DE421_SPAN_JD_TDB)
+        inside = lo <= self.epoch_day and self.output_days[-1] <= hi
+        known = self.orbit.name.lower() in KNOWN_BODIES and all(n in KNOWN_BODIES for n in self.named)
+        if skip and known and inside:
+            decisions.append(Decision("orbits", "DE421 positions instead of the REBOUND (N-body) run",
+                                      f"'{self.orbit.name}' and every perturber are DE421 bodies and the span lies "
+                                      "inside DE421 (1900-2200): the ephemeris is the orbit the N-body run would "
+                                      "reproduce (to metres, docs/ephemeris.md)"))
+            return "de421"
+        why = ("skip=False (reference run)" if not skip else
+               f"'{self.orbit.name}' is not a DE421 body: its orbit is known only through the simulation"
+               if self.orbit.name.lower() not in KNOWN_BODIES else "a perturber or the span is outside DE421")
+        decisions.append(Decision("orbits", "REBOUND (N-body) run, perturbers from the same run", why))
+        return "rebound"
+
+    def _sampler(self, source, names, tolerance):
+        """Sample ``names`` relative to the body from ``source`` over the epoch…last-output span."""
+        from .coupling import one_way
+
+        start = time_from_tdb_days(self.epoch_day)
+        end = time_from_tdb_days(self.output_days[-1])
+        if source == "rebound":
+            return one_way.sample_from_rebound(self.orbit.simulation, self.orbit.name, start, end, names,
+                                               tolerance=tolerance)
+        orbit = (one_way.de421_orbit(self.orbit.name) if source == "de421" else self.orbit.function)
+        return one_way.sample_from_ephemeris(orbit, start, end, names, tolerance=tolerance)
+
+    def plan(self, skip=True):
+        """Decide how to run the scene; ``skip=False`` gives the reference plan (nothing skipped).
+
+        Returns
+        -------
+        Plan
+            ``print(plan)`` lists every decision with its reason.
+        """
+        decisions = []
+        tolerance = self.tolerance_rad
+        moments = self.state.body.principal_moments
+        span = self.span_days
+        if self.end_only:
+            decisions.append(Decision("outputs", "end only: one output time (the dense interpolant is formed for "
+                                      "the last step alone), quantities once", "a single output time was asked"))
+        else:
+            decisions.append(Decision("outputs", f"{self.output_days.size} output times (dense output)",
+                                      "several output times were asked"))
+        shape = self._shape_decision()
+        if not self.named and not self.fixed:
+            decisions.append(Decision("route", "exact torque-free solution, no integration",
+                                      "the scene has no perturbers: the torque is zero"))
+            decisions.append(shape)
+            return Plan("torque-free", "none", (), (), {}, "exact", None, self.end_only, tolerance, 1.0, 0.0,
+                        not skip, decisions)
+        source = self._orbit_source(skip, decisions)
+        kappa = attitude_sensitivity(self.state, span)
+        momentum = np.linalg.norm(self.state.angular_momentum.value) / moments[0]
+        estimates, samples = self._survey(source, kappa, momentum, moments, keep=skip)
+        total = sum(e.bound_rad for e in estimates.values())
+        names = list(estimates)
+        survey_note = (f"bound = 2 [κ ∫(T-s)|N|/A ds + 2∫|N| ds/|L|], |N| ≤ 3μ(C-A)/2r³, κ = {kappa:.3g} "
+                       f"(measured on the free motion), T = {span:.6g} d")
+        if skip and total <= tolerance:
+            decisions.append(Decision(
+                "route", "exact torque-free solution, no sampling, no integration",
+                f"all torques together move the attitude by at most {total * ARCSEC_PER_RAD:.3g} arcsec "
+                f"≤ tolerance {tolerance * ARCSEC_PER_RAD:.3g} arcsec ({survey_note})"))
+            decisions.append(shape)
+            for e in estimates.values():
+                e.kept = False
+            return Plan("torque-free", source, (), tuple(names), estimates, "exact", None, self.end_only,
+                        tolerance, kappa, total, False, decisions)
+        dropped, used = [], 0.0
+        if skip:
+            for name in sorted(names, key=lambda n: estimates[n].bound_rad):
+                if used + estimates[name].bound_rad <= DROP_SHARE * tolerance:
+                    used += estimates[name].bound_rad
+                    dropped.append(name)
+        for name in names:
+            e = estimates[name]
+            e.kept = name not in dropped
+            verdict = "dropped" if name in dropped else "kept"
+            why = (f"closest {e.closest_au:.4g} au: leaving it out moves the attitude by at most "
+                   f"{e.bound_rad * ARCSEC_PER_RAD:.3g} arcsec")
+            if name in dropped:
+                why += f" (all dropped together {used * ARCSEC_PER_RAD:.3g} arcsec ≤ {DROP_SHARE:g} × tolerance)"
+            elif skip:
+                why += f" > what is left of {DROP_SHARE:g} × tolerance"
+            else:
+                why = "skip=False (reference run); " + why
+            decisions.append(Decision(f"perturber {name}", verdict, why))
+        decisions.append(Decision("bound", "per-perturber estimate", survey_note))
+        decisions.append(self._coupling_decision())
+        integrator, reason = self._integrator_choice(skip)
+        share = tolerance - used
+        rtol = initial_rtol(share)
+        decisions.append(Decision("integrator", f"{integrator} DOP853, rtol {rtol:.1e} (checked a posteriori "
+                                  f"against a run at {CHECK_RTOL_FACTOR:g}× rtol)", reason))
+        kept = tuple(n for n in names if n not in dropped)
+        return Plan("one-way", source, kept, tuple(dropped), estimates, integrator, rtol, self.end_only,
+                    tolerance, kappa, used, not skip, decisions, samples)
+
+    def _shape_decision(self):
+        body = self.state.body
+        mode = self.state.mode
+        if mode == "permanent rotation":
+            return Decision("closed form", "uniform rotation (no elliptic functions)",
+                            "the spin is along a principal axis or the body is symmetric about it")
+        if body.is_axisymmetric:
+            return Decision("closed form", "regular precession (elliptic parameter m = 0)",
+                            "two principal moments are equal: sn, cn, dn reduce to sin, cos, 1")
+        return Decision("closed form", f"elliptic free flow, {mode}",
+                        "triaxial body: Jacobi functions and the secular pn of eq. (12)")
+
+    def _survey(self, source, kappa, momentum, moments, keep=True):
+        """Per-perturber bounds (planner module docstring) from a survey of the distances.
+
+        ``keep``: for a REBOUND orbit, survey at the run's tolerance and return the samples for the run
+        (the reference plan, ``keep=False``, keeps nothing, so a full run pays its own sampling).
+        """
+        estimates = {}
+        t_end = self.output_days[-1]
+        survey = None
+        if self.named:
+            # With a REBOUND orbit every sampling pass is an N-body run, whose cost hardly depends on the
+            # tolerance (the pilot and the run dominate): survey at the run's tolerance and keep it.
+            # With an ephemeris, sampling costs per perturber: survey loosely, sample only the kept.
+            keep = keep and source == "rebound"
+            tolerance = self.sample_tolerance if keep else SURVEY_TOLERANCE
+            survey = self._sampler(source, self.named, tolerance)
+            distances = np.linalg.norm(survey.states[:, :, :3], axis=2)
+            for i, name in enumerate(survey.names):
+                n = max_torque_over_a(moments, survey.gm[i], distances[:, i])
+                bound = dropped_torque_bound(survey.days, n, t_end, kappa, momentum)
+                estimates[name] = PerturberEstimate(name, float(distances[:, i].min()), bound, True)
+        days = np.array([self.epoch_day, t_end])
+        for fixed in self.fixed:
+            r = float(np.linalg.norm(fixed.position_au))
+            n = max_torque_over_a(moments, fixed.gm_au3_day2, np.array([r, r]))
+            estimates[fixed.name] = PerturberEstimate(fixed.name, r, dropped_torque_bound(days, n, t_end, kappa,
+                                                                                          momentum), True)
+        return estimates, (survey if keep else None)
+
+    def _coupling_decision(self):
+        """One-way, with the reason that fits the body: massless in the orbit model, or not estimated."""
+        massive = False
+        if self.orbit is not None and self.orbit.kind == "rebound":
+            from .coupling.rebound_adapter import body_index
+
+            sim = self.orbit.simulation
+            massive = sim.particles[body_index(sim, self.orbit.name)].m > 0
+        elif self.orbit is not None and self.orbit.kind == "de421":
+            massive = True
+        choice = "one-way (the rotation does not act on the orbits)"
+        if not massive:
+            return Decision("coupling", choice,
+                            "the body is massless in the orbit model (a test particle or a given ephemeris), so its "
+                            "figure cannot act on the orbits; for a real small body that force is of relative size "
+                            "(C-A)/(M r²) ~ J2 (R/r)², ≈ 1e-13 for a 300 m asteroid at 1 au (coupling/one_way.py)")
+        return Decision("coupling", choice + "; back-reaction NOT estimated",
+                        f"'{self.orbit.name}' has mass in the orbit model but a Scene knows only its moment ratios; "
+                        "for the Moon the back-reaction was measured at ≈ 0.1 arcsec over a year (docs/coupling.md: "
+                        "0.305 one-way vs 0.207 arcsec coupled): for that, run CoupledRigidBody or spinorbit moon")
+
+    def _integrator_choice(self, skip):
+        measured = ("quaternion DOP853 was the fastest spinorbit method at every measured precision "
+                    "(docs/performance.md, at 1e-10 rad: 13.7 ms vs elements 77.9 ms and SABA4 32.6 ms in scene (a)) "
+                    "and is non-singular everywhere")
+        if self.integrator != "elements":
+            return "quaternion", measured if skip else "skip=False (reference run): " + measured
+        from .core import canonical as _canonical
+        from .core.integrate_elements import MIN_SEPARATRIX_DISTANCE, MIN_SIN_J
+
+        mo, _, momentum, _ = self.state._motion()
+        separatrix = float(mo[_canonical.MO_PARAM_C]) if mo[_canonical.MO_MODE] != _canonical.MODE_UNIFORM else 0.0
+        sin_j = float(np.hypot(momentum[0], momentum[1]) / np.linalg.norm(momentum))
+        if abs(separatrix) < SINGULAR_MARGIN * MIN_SEPARATRIX_DISTANCE or sin_j < SINGULAR_MARGIN * MIN_SIN_J:
+            return "quaternion", (f"elements were asked but the state is near their singular sets (1 - m = "
+                                  f"{separatrix:.2g}, sin J = {sin_j:.2g}; limits {SINGULAR_MARGIN:g} × "
+                                  f"{MIN_SEPARATRIX_DISTANCE:g} and {SINGULAR_MARGIN:g} × {MIN_SIN_J:g}): "
+                                  "the non-singular quaternion integrator is used")
+        return "elements", (f"asked for; the state is away from the singular sets (1 - m = {separatrix:.2g}, "
+                            f"sin J = {sin_j:.2g})")
+
+    # ------------------------------------------------------------------------------------------
+    # Running
+
+    def run(self, plan=None, progress=None):
+        """Carry out ``plan`` (default: :meth:`plan`) and return a :class:`SceneResult`.
+
+        ``progress``, if given, is called with a fraction in [0, 1] as the run advances.
+        """
+        clock = _time.perf_counter()
+        plan = self.plan() if plan is None else plan
+        if not isinstance(plan, Plan):
+            raise SceneError(f"plan expects a spinorbit.planner.Plan from Scene.plan(); got {type(plan).__name__}.")
+        report = progress or (lambda fraction: None)
+        report(0.0)
+        if plan.route == "torque-free":
+            table = self._torque_free_table()
+            parts = {"dropped": plan.dropped_bound_rad, "integration": 0.0, "sampling": 0.0}
+            stats = {}
+        else:
+            table, parts, stats = self._one_way(plan, report)
+        report(1.0)
+        parts_q = {k: (v * u.rad).to(u.arcsec) for k, v in parts.items()}
+        total = sum(parts.values()) * u.rad
+        table.meta["error_estimate_arcsec"] = float(total.to_value(u.arcsec))
+        table.meta["route"] = plan.route
+        table.meta["tolerance_met"] = bool(total.to_value(u.rad) <= plan.tolerance_rad)
+        return SceneResult(table, total.to(u.arcsec), parts_q, plan, _time.perf_counter() - clock, stats)
+
+    def _times(self):
+        return time_from_tdb_days(self.output_days)
+
+    def _torque_free_table(self):
+        offsets = self.output_days - self.epoch_day
+        quaternions, omegas = self.state.propagate_torque_free(offsets)
+        states = [RotationState(self.state.body, q, w) for q, w in zip(quaternions, omegas.value)]
+        return self._table(states)
+
+    def _table(self, states):
+        table = QTable()
+        table["time"] = self._times()
+        table["quaternion"] = np.array([s.quaternion for s in states])
+        if "omega" in self.quantities:
+            table["omega"] = np.array([s.angular_velocity.to_value(u.rad / u.day) for s in states]) * (u.rad / u.day)
+        table["momentum_direction"] = np.array([s.angular_momentum_direction for s in states])
+        if "periods" in self.quantities:
+            table["mode"] = [s.mode for s in states]
+            table["energy_ratio"] = [s.energy_ratio for s in states]
+            pairs = [s.periods for s in states]
+            table["P_psi"] = [p[0].to_value(u.day) for p in pairs] * u.day
+            table["P_phi"] = [p[1].to_value(u.day) for p in pairs] * u.day
+        return table
+
+    def _one_way(self, plan, report):
+        from .core.perturbers import fixed_source
+        from .coupling.one_way import propagate_one_way
+
+        named = tuple(n for n in plan.kept if n in self.named)
+        fixed = [fixed_source(p.gm_au3_day2, p.position_au) for p in self.fixed if p.name in plan.kept]
+        if named and plan.samples is not None:
+            samples = _subset(plan.samples, named)
+        else:
+            samples = self._sampler(plan.orbit_source, named, self.sample_tolerance) if named else None
+        if samples is None:
+            samples = _NoSamples(self.epoch_day, self.output_days[-1])
+        report(0.3)
+        epoch = time_from_tdb_days(self.epoch_day)
+        times = self._times()
+        rtol = plan.rtol
+        share = max(plan.integration_share_rad, 0.0)
+        for attempt in range(MAX_RTOL_RETRIES + 1):
+            run = propagate_one_way(self.state, epoch, times, samples, rtol=rtol, periods="periods" in self.quantities,
+                                    integrator=plan.integrator, extra_sources=fixed)
+            check = propagate_one_way(self.state, epoch, times, samples, rtol=min(rtol * CHECK_RTOL_FACTOR, 1e-4),
+                                      periods=False, integrator=plan.integrator, extra_sources=fixed)
+            integration = float(np.max(_angles(run["quaternion"], check["quaternion"])))
+            report(0.3 + 0.7 * (attempt + 1) / (MAX_RTOL_RETRIES + 1))
+            if integration <= 0.5 * share or rtol <= 1e-13:
+                break
+            rtol = max(rtol / 100.0, 1e-13)
+        kept_bound = sum(plan.estimates[n].bound_rad for n in plan.kept)
+        sampling = 3.0 * self.sample_tolerance * kept_bound if named else 0.0
+        if "omega" not in self.quantities:
+            run.remove_column("omega")
+        run.meta["rtol"] = rtol
+        stats = {k: run.meta[k] for k in ("accepted", "rejected", "rhs_calls")}
+        stats.update(rtol=rtol, samples=int(samples.days.size), passes=int(getattr(samples, "passes", 0)))
+        return run, {"dropped": plan.dropped_bound_rad, "integration": integration, "sampling": sampling}, stats
+
+
+def _subset(samples, names):
+    """The columns of ``names`` of a SampledPerturbers (same grid, same error estimates per perturber)."""
+    from .coupling.one_way import SampledPerturbers
+
+    index = [samples.names.index(n) for n in names]
+    return SampledPerturbers(tuple(names), samples.gm[index], samples.days, samples.states[:, index],
+                             samples.tolerance, samples.midpoint_error[index], samples.passes,
+                             {n: samples.closest[n] for n in names if n in samples.closest})
+
+
+class _NoSamples:
+    """Stand-in for SampledPerturbers when only fixed perturbers are kept."""
+
+    names = ()
+    tolerance = 0.0
+    passes = 0
+    midpoint_error = np.zeros(0)
+
+    def __init__(self, start, end):
+        self.days = np.array([start, end])
+        self.span = (start, end)
+
+    def sources(self):
+        return []
+
+
+def _angles(q1, q2):
+    """Rotation angle (rad) between two attitude quaternion series (q and −q are one attitude)."""
+    from .core.rotations import rotation_angle_between_many
+
+    return rotation_angle_between_many(np.ascontiguousarray(np.atleast_2d(q1), dtype=float),
+                                       np.ascontiguousarray(np.atleast_2d(q2), dtype=float))

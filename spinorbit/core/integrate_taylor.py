@@ -57,11 +57,35 @@ import warnings
 import numpy as np
 
 from ._jit import jit
-from .dynamics import MODEL_PERTURBERS, STATE_SIZE, validate_sampled_span, validate_state
+from .dynamics import (
+    MODEL_PERTURBERS,
+    STATE_SIZE,
+    validate_sampled_span,
+    validate_state,
+)
 from .gravity_field import BODY_A, BODY_B, BODY_C, BODY_NMAX
-from .integrate_quaternion import IntegrationError, _validate_times, integrate_quaternion
-from .perturbers import (K_A, K_E, K_M0, K_MEAN_MOTION, K_MU, K_P, K_Q, K_ROOT, K_T0, KIND_FIXED, KIND_KEPLER,
-                         KIND_SAMPLED, PERTURBER_ROW, _find_interval, _kepler_perifocal)
+from .integrate_quaternion import (
+    IntegrationError,
+    _validate_times,
+    integrate_quaternion,
+)
+from .perturbers import (
+    K_A,
+    K_E,
+    K_M0,
+    K_MEAN_MOTION,
+    K_MU,
+    K_P,
+    K_Q,
+    K_ROOT,
+    K_T0,
+    KIND_FIXED,
+    KIND_KEPLER,
+    KIND_SAMPLED,
+    PERTURBER_ROW,
+    _find_interval,
+    _kepler_perifocal,
+)
 
 #: Highest Taylor order the kernel allocates for (tol ≥ 1e-16 with order_factor ≤ 1.8 needs < 40).
 MAX_ORDER = 48
@@ -354,7 +378,7 @@ def _normalize_quaternion(y):
 @jit
 def taylor_order(tol, order_factor):
     """Order p = ⌈(−ln tol / 2 + 1) · order_factor⌉ (heyoka's rule at order_factor = 1), 2 ≤ p ≤ MAX_ORDER."""
-    p = int(math.ceil((-math.log(tol) / 2.0 + 1.0) * order_factor))
+    p = int(math.ceil((-math.log(tol) / 2.0 + 1.0) * order_factor))  # noqa: RUF046 (numba int)
     return min(max(p, 2), MAX_ORDER)
 
 

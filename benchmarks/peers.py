@@ -143,15 +143,22 @@ def splitting_method(scheme, label, color, marker):
 SPLITTING_STEPS_PER_ROTATION = (4, 8, 16, 32, 64, 128, 256)
 
 
+def _prepare_call(integrate, scene, **kwargs):
+    """A run() calling ``integrate(y0, t0, t_out, model, **kwargs)``, after one short call that compiles
+    or loads the numba cache (its time is the preparation)."""
+
+    def run():
+        return integrate(scene.y0, scene.t0, scene.t_out, scene.model, **kwargs)
+
+    t = time.perf_counter()
+    integrate(scene.y0, scene.t0, scene.t_out[:1], scene.model, **kwargs)  # compile / cache load
+    return run, {"prepare_s": time.perf_counter() - t}
+
+
 def prepare_spinorbit_elements(scene, tol):
     from spinorbit.core.integrate_elements import integrate_elements
 
-    def run():
-        return integrate_elements(scene.y0, scene.t0, scene.t_out, scene.model, rtol=tol)
-
-    t = time.perf_counter()
-    integrate_elements(scene.y0, scene.t0, scene.t_out[:1], scene.model, rtol=tol)  # compile / cache load
-    return run, {"prepare_s": time.perf_counter() - t}
+    return _prepare_call(integrate_elements, scene, rtol=tol)
 
 
 # --------------------------------------------------------------------------- Taylor
@@ -159,12 +166,7 @@ def prepare_spinorbit_elements(scene, tol):
 def prepare_spinorbit_taylor(scene, tol):
     from spinorbit.core.integrate_taylor import integrate_taylor
 
-    def run():
-        return integrate_taylor(scene.y0, scene.t0, scene.t_out, scene.model, tol=tol)
-
-    t = time.perf_counter()
-    integrate_taylor(scene.y0, scene.t0, scene.t_out[:1], scene.model, tol=tol)  # compile / cache load
-    return run, {"prepare_s": time.perf_counter() - t}
+    return _prepare_call(integrate_taylor, scene, tol=tol)
 
 
 # --------------------------------------------------------------------------- scipy

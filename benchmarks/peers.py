@@ -18,6 +18,11 @@ entry to :data:`METHODS`.
 - ``spinorbit canonical elements (DOP853)``:
   :func:`spinorbit.core.integrate_elements.integrate_elements`, the canonical-element equations
   (paper eq. 11) with the same DOP853 tableau; same state layout in and out.
+- ``spinorbit Taylor (numba)``: :func:`spinorbit.core.integrate_taylor.integrate_taylor`, the adaptive
+  Taylor method on the same equations (tolerance = its tol, heyoka's order and step rule).
+- ``scipy DOP853, pure-Python RHS``: ``solve_ivp(method="DOP853")`` with a right-hand side written in
+  plain Python/numpy (:func:`python_rhs`: Kepler solve by Newton, MacCullagh torque), the baseline the
+  issue's ≥100× goal names; scene (a) only and two tolerances (≈1–3 s per run).
 - ``scipy-DOP853``: ``scipy.integrate.solve_ivp(method="DOP853")`` with the Python RHS
   :func:`spinorbit.core.dynamics.scipy_rhs` (which calls the same compiled RHS).
 - ``heyoka``: heyoka's Taylor integrator on the same equations, rebuilt as heyoka expressions:
@@ -30,8 +35,8 @@ entry to :data:`METHODS`.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -48,6 +53,7 @@ class Method:
     tolerances: tuple
     color: str = "k"
     marker: str = "o"
+    scenes: str = "abc"  # the scenes the method runs on
 
 
 # --------------------------------------------------------------------------- spinorbit
@@ -60,7 +66,7 @@ def prepare_spinorbit(scene, tol, hit_output_times=False):
                                     hit_output_times=hit_output_times)
 
     t = time.perf_counter()
-    _, stats = integrate_quaternion(scene.y0, scene.t0, scene.t_out[:1], scene.model, rtol=tol, atol=atol,
+    _, _stats = integrate_quaternion(scene.y0, scene.t0, scene.t_out[:1], scene.model, rtol=tol, atol=atol,
                                     return_stats=True)  # numba compile / cache load, excluded
     info = {"prepare_s": time.perf_counter() - t}
     return run, info
@@ -137,21 +143,89 @@ def splitting_method(scheme, label, color, marker):
 SPLITTING_STEPS_PER_ROTATION = (4, 8, 16, 32, 64, 128, 256)
 
 
+def _prepare_call(integrate, scene, **kwargs):
+    """A run() calling ``integrate(y0, t0, t_out, model, **kwargs)``, after one short call that compiles
+    or loads the numba cache (its time is the preparation)."""
+
+    def run():
+        return integrate(scene.y0, scene.t0, scene.t_out, scene.model, **kwargs)
+
+    t = time.perf_counter()
+    integrate(scene.y0, scene.t0, scene.t_out[:1], scene.model, **kwargs)  # compile / cache load
+    return run, {"prepare_s": time.perf_counter() - t}
+
+
 def prepare_spinorbit_elements(scene, tol):
     from spinorbit.core.integrate_elements import integrate_elements
 
-    def run():
-        return integrate_elements(scene.y0, scene.t0, scene.t_out, scene.model, rtol=tol)
+    return _prepare_call(integrate_elements, scene, rtol=tol)
 
-    t = time.perf_counter()
-    integrate_elements(scene.y0, scene.t0, scene.t_out[:1], scene.model, rtol=tol)  # compile / cache load
-    return run, {"prepare_s": time.perf_counter() - t}
+
+# --------------------------------------------------------------------------- Taylor
+
+def prepare_spinorbit_taylor(scene, tol):
+    from spinorbit.core.integrate_taylor import integrate_taylor
+
+    return _prepare_call(integrate_taylor, scene, tol=tol)
 
 
 # --------------------------------------------------------------------------- scipy
 
-def prepare_scipy(scene, tol):
-    fun = scipy_rhs(scene.model)
+def python_rhs(scene):
+    """``fun(t, y)`` in plain Python/numpy for elliptic Kepler perturbers: no numba, no spinorbit kernel.
+
+    Kepler's equation by Newton's method from E = M + e sin M (|ΔE| < 1e-15), position
+    a(cos E − e) P + a√(1−e²) sin E Q, body frame r_b = M(q)ᵀ r / |q|², MacCullagh torque
+    N = 3μ/R⁵ r_b × (I r_b), then the quaternion kinematics and Euler's equations.
+    """
+    import math
+
+    moments = np.array(scene.moments, dtype=float)
+    A, B, C = moments
+    orbits = []
+    for p in scene.perturbers:
+        if p.e >= 1.0:
+            raise ValueError("python_rhs: elliptic perturbers only (scene a)")
+        params = p.source().params
+        n = math.sqrt((p.mu_orbit or p.mu) / p.a**3)
+        orbits.append((p.mu, p.a, p.e, math.sqrt(1 - p.e**2), p.mean_anomaly, p.epoch, n, params[11:14].copy(),
+                       params[14:17].copy()))
+
+    def fun(t, y):
+        q0, q1, q2, q3, wx, wy, wz = y
+        nx = ny = nz = 0.0
+        inv = 1.0 / (q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
+        for mu, a, e, root, m0, epoch, n, P, Q in orbits:
+            m = m0 + n * (t - epoch)
+            E = m + e * math.sin(m)
+            for _ in range(50):
+                dE = (E - e * math.sin(E) - m) / (1.0 - e * math.cos(E))
+                E -= dE
+                if abs(dE) < 1e-15:
+                    break
+            r = a * (math.cos(E) - e) * P + a * root * math.sin(E) * Q
+            rx, ry, rz = r
+            bx = inv * ((q0 * q0 + q1 * q1 - q2 * q2 - q3 * q3) * rx + 2 * (q1 * q2 + q0 * q3) * ry + 2 * (q1 * q3 - q0 * q2) * rz)
+            by = inv * (2 * (q1 * q2 - q0 * q3) * rx + (q0 * q0 - q1 * q1 + q2 * q2 - q3 * q3) * ry + 2 * (q2 * q3 + q0 * q1) * rz)
+            bz = inv * (2 * (q1 * q3 + q0 * q2) * rx + 2 * (q2 * q3 - q0 * q1) * ry + (q0 * q0 - q1 * q1 - q2 * q2 + q3 * q3) * rz)
+            k = 3.0 * mu * (bx * bx + by * by + bz * bz) ** -2.5
+            nx += k * (C - B) * by * bz
+            ny += k * (A - C) * bz * bx
+            nz += k * (B - A) * bx * by
+        return np.array([0.5 * (-q1 * wx - q2 * wy - q3 * wz), 0.5 * (q0 * wx + q2 * wz - q3 * wy),
+                         0.5 * (q0 * wy - q1 * wz + q3 * wx), 0.5 * (q0 * wz + q1 * wy - q2 * wx),
+                         ((B - C) * wy * wz + nx) / A, ((C - A) * wz * wx + ny) / B, ((A - B) * wx * wy + nz) / C])
+
+    return fun
+
+
+def prepare_scipy_python(scene, tol):
+    """scipy DOP853 with :func:`python_rhs` (the issue's ≥100× baseline)."""
+    return prepare_scipy(scene, tol, fun=python_rhs(scene))
+
+
+def prepare_scipy(scene, tol, fun=None):
+    fun = scipy_rhs(scene.model) if fun is None else fun
     atol = default_atol(np.asarray(scene.y0, float), tol)
     fun(scene.t0, scene.y0)  # compile
 
@@ -222,7 +296,7 @@ def make_heyoka_integrator(scene, tol, fp_type=float, compact_mode=False):
     import heyoka as hy
 
     eqs, state = heyoka_system(scene, fp_type)
-    kwargs = dict(tol=fp_type(tol), compact_mode=compact_mode, time=fp_type(scene.t0))
+    kwargs = {"tol": fp_type(tol), "compact_mode": compact_mode, "time": fp_type(scene.t0)}
     if fp_type is not float:
         kwargs["fp_type"] = fp_type
     return hy.taylor_adaptive(eqs, state, **kwargs), state
@@ -268,8 +342,11 @@ METHODS = [
            (1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14), "tab:cyan", "D"),
     Method("spinorbit canonical elements (DOP853)", prepare_spinorbit_elements,
            (1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13), "tab:brown", "v"),
-    Method("heyoka Taylor", prepare_heyoka, (1e-8, 1e-10, 1e-12, 1e-14, 1e-15), "tab:red", "s"),
+    Method("spinorbit Taylor (numba)", prepare_spinorbit_taylor, (1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14, 1e-15),
+           "k", "d"),
+    Method("heyoka Taylor", prepare_heyoka, (1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14, 1e-15), "tab:red", "s"),
     Method("scipy DOP853 (Python RHS)", prepare_scipy, (1e-8, 1e-10, 1e-12, 1e-13), "tab:gray", "^"),
+    Method("scipy DOP853, pure-Python RHS", prepare_scipy_python, (1e-12, 1e-13), "0.5", "x", scenes="a"),
     splitting_method("strang", "Strang", "tab:olive", "<"),
     splitting_method("saba2", "SABA2", "tab:green", "P"),
     splitting_method("saba3", "SABA3", "tab:purple", "X"),

@@ -32,6 +32,8 @@ API_NAMES = {
                   "InvalidBodyError", "InvalidStateError", "SingularElementsError"],
     "special": ["ellipj", "am", "ellipk", "ellipf", "ellippi", "pn"],
     "core": ["andoyer_to_canonical", "canonical_to_andoyer"],
+    "integrators": ["integrate_taylor", "integrate_taylor_fixed_step", "taylor_series", "TaylorFallbackWarning",
+                    "integrate_elements_fixed_step"],
     "time": ["tdb_days", "tdb_day_and_fraction", "time_from_tdb_days", "J2000_JD_TDB"],
     "frames": ["icrf_to_ecliptic", "ecliptic_to_icrf", "body_to_icrf", "OBLIQUITY_J2000"],
     "ephemeris": ["barycentric_state", "moon_orientation", "moon_libration_angles", "de421_constants"],

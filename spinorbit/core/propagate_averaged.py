@@ -1,0 +1,404 @@
+"""Semi-analytic propagation of mean canonical elements, with hand-over to the full integrator.
+
+The mean equations (:mod:`spinorbit.core.averaged`) have no rotation time scale left: S and Z are
+constant, (H, h) and the slow phases move at the torque's rate, so they are stepped on the orbital
+time scale by a fixed-step 8th-order Runge–Kutta (the DOP853 tableau without error control; steps
+land on the output times). The osculating state is recovered at each output by the first-order
+short-period corrections (:mod:`spinorbit.core.short_period`).
+
+Validity (checked at every step, :func:`validity_code`); averaging is refused where:
+
+* **resonance** — a fast frequency Ω_jk = jω_s + kω_g (|j| ≤ 2, |k| ≤ 2, not both 0; ω_s the body
+  phase rate, ω_g the mean precession rate) is less than ``min_frequency_ratio`` times the fastest
+  angular rate |r × v|/r² of a perturber's direction. Synchronous rotation (ω_g ≈ n) and close
+  encounters (the perturber's direction sweeps as fast as the body turns) both land here, as do
+  internal near-commensurabilities jω_s + kω_g ≈ 0 (small divisors of the short-period terms).
+* **strong perturbation** — ε = Σ 3μ/r³ · (C − A)/(C Ω_min²) above ``max_perturbation``: the
+  torque's frequency² relative to the slowest fast frequency²; first-order theory errs by ~ε².
+* **separatrix** — 1 − m (or 1 − μ) below ``min_separatrix_distance``: the polhode period diverges.
+
+There the run hands over to :func:`spinorbit.core.integrate_quaternion.integrate_quaternion`
+(osculating state from the mean one), continues in chunks of ``handover_chunk`` until the check
+passes again, and hands back (mean elements from the osculating ones).
+"""
+
+import math
+
+import numpy as np
+
+from ._dop853_tableau import A as _A_FULL
+from ._dop853_tableau import B as _B_FULL
+from ._dop853_tableau import C as _C_FULL
+from ._dop853_tableau import N_STAGES
+from ._jit import jit
+from .averaged import (
+    degree2_mean_rhs,
+    fast_frequencies,
+    mean_constants,
+    moments_of,
+    torus_frequencies,
+    torus_mean_rhs,
+)
+from .canonical import MO_MODE, MO_PARAM_C, MODE_UNIFORM, inertia_constants, motion_from_elements
+from .dynamics import MODEL_PERTURBERS, validate_sampled_span, validate_state
+from .element_forces import attitude_and_momentum, inertial_quaternion, reduce_phase
+from .gravity_field import BODY_NMAX
+from .integrate_elements import elements_of_state, reference_frame_for
+from .integrate_quaternion import _validate_times, integrate_quaternion
+from .perturbers import K_E, K_MEAN_MOTION, KIND_KEPLER, PERTURBER_ROW, perturber_state
+from .short_period import mean_to_osculating, osculating_to_mean
+
+_A = np.ascontiguousarray(_A_FULL[:N_STAGES, :N_STAGES])
+_B = np.ascontiguousarray(_B_FULL)
+_C = np.ascontiguousarray(_C_FULL[:N_STAGES])
+
+#: Default validity thresholds (module docstring). 5: the first-order theory's neglected terms are
+#: ~ (n/Ω)²; Toutatis' slowest combination ω_s − ω_g is ~9× its perihelion rate, so 5 keeps it.
+MIN_FREQUENCY_RATIO = 5.0
+MAX_PERTURBATION = 0.05
+MIN_SEPARATRIX_DISTANCE = 1e-3
+
+# Right-hand-side choices of the mean equations.
+RHS_DEGREE2, RHS_DEGREE2_ORBIT_AVERAGED, RHS_QUADRATURE = 0, 1, 2
+#: Torus grid of the quadrature right-hand side (points in s, in z; z > degree 4).
+QUADRATURE_POINTS_S, QUADRATURE_POINTS_Z = 24, 9
+
+VALID, INVALID_RESONANCE, INVALID_PERTURBATION, INVALID_SEPARATRIX = 0, 1, 2, 3
+_WHY = {INVALID_RESONANCE: "resonance / fast perturber (a fast frequency is close to the perturber's rate)",
+        INVALID_PERTURBATION: "strong perturbation (ε above max_perturbation)",
+        INVALID_SEPARATRIX: "near the separatrix"}
+
+
+@jit
+def free_motion_numbers(elements, ic):
+    """(Ω_min, (C − A)/C, 1 − m, P) of the free motion of the elements' (S, Z): the slowest fast
+    frequency min |jω_s + kω_g| over |j|, |k| ≤ 2 (not both 0), the asymmetry, the separatrix
+    distance and the period of s. Constant along a mean run (S and Z are)."""
+    omega_s, omega_g = fast_frequencies(elements, ic)
+    omega_min = np.inf
+    for j in range(3):
+        for k in range(-2, 3):
+            if j == 0 and k <= 0:
+                continue
+            omega_min = min(omega_min, abs(j * omega_s + k * omega_g))
+    mo = motion_from_elements(abs(elements[0]), elements[1], ic)
+    sep = 0.0 if mo[MO_MODE] == MODE_UNIFORM else mo[MO_PARAM_C]
+    period, _, _ = torus_frequencies(elements[0], elements[1], ic)
+    return np.array([omega_min, ic[5] / ic[0], sep, period])  # (a − c)/a = 1 − A/C
+
+
+@jit
+def perturber_numbers(t, model):
+    """(fastest angular rate |r × v|/r² of a perturber's direction, Σ 3μ/r³) at time t."""
+    rate_max = 0.0
+    strength = 0.0
+    for p in range(int(model[MODEL_PERTURBERS])):
+        row = MODEL_PERTURBERS + 1 + p * PERTURBER_ROW
+        xv = perturber_state(t, model, row)
+        r2 = xv[0] ** 2 + xv[1] ** 2 + xv[2] ** 2
+        cx = xv[1] * xv[5] - xv[2] * xv[4]
+        cy = xv[2] * xv[3] - xv[0] * xv[5]
+        cz = xv[0] * xv[4] - xv[1] * xv[3]
+        rate_max = max(rate_max, math.sqrt(cx * cx + cy * cy + cz * cz) / r2)
+        strength += 3.0 * model[row + 1] / r2 ** 1.5
+    return rate_max, strength
+
+
+@jit
+def validity_numbers(t, model, free):
+    """(Ω_min/n_max, ε, 1 − m) at time t; ``free`` from :func:`free_motion_numbers`."""
+    rate_max, strength = perturber_numbers(t, model)
+    ratio = free[0] / rate_max if rate_max > 0.0 else np.inf
+    return ratio, strength * free[1] / (free[0] * free[0]), free[2]
+
+
+@jit
+def validity_code(t, model, free, thresholds):
+    """VALID or the INVALID_* reason; thresholds = (min ratio, max ε, min separatrix distance)."""
+    ratio, eps, sep = validity_numbers(t, model, free)
+    if not (sep >= thresholds[2]):
+        return INVALID_SEPARATRIX
+    if not (ratio >= thresholds[0]):
+        return INVALID_RESONANCE
+    if not (eps <= thresholds[1]):
+        return INVALID_PERTURBATION
+    return VALID
+
+
+@jit
+def _rhs(t, y, mc, model, frame, ic, kind, dy):
+    if kind == RHS_QUADRATURE:
+        torus_mean_rhs(t, y, model, frame, ic, QUADRATURE_POINTS_S, QUADRATURE_POINTS_Z, dy)
+    else:
+        degree2_mean_rhs(t, y, mc, model, frame, kind == RHS_DEGREE2_ORBIT_AVERAGED, dy)
+
+
+@jit
+def _rk8_step(t, y, h, mc, model, frame, ic, kind, k, tmp, y_new):
+    n = y.shape[0]
+    for s in range(N_STAGES):
+        for i in range(n):
+            tmp[i] = y[i]
+        for j in range(s):
+            a = _A[s, j] * h
+            if a != 0.0:
+                for i in range(n):
+                    tmp[i] += a * k[j, i]
+        _rhs(t + _C[s] * h, tmp, mc, model, frame, ic, kind, k[s])
+    for i in range(n):
+        y_new[i] = y[i]
+    for j in range(N_STAGES):
+        b = _B[j] * h
+        if b != 0.0:
+            for i in range(n):
+                y_new[i] += b * k[j, i]
+
+
+@jit
+def mean_elements_kernel(el0, t0, t_out, max_step, mc, model, frame, ic, kind, thresholds, free, out):
+    """Step the mean elements from (t0, el0) to each t_out[i] (rows of ``out``).
+
+    Returns (number of outputs written, time reached, elements there, INVALID_* code or VALID, steps).
+    The validity check (:func:`validity_code` with ``free`` = :func:`free_motion_numbers`) runs
+    before every step; on failure the run stops at that time.
+    """
+    y = el0.copy()
+    t = t0
+    k = np.empty((N_STAGES, 6))
+    tmp = np.empty(6)
+    y_new = np.empty(6)
+    steps = 0
+    for i in range(t_out.shape[0]):
+        t_start = t
+        span = t_out[i] - t
+        n = max(int(math.ceil(abs(span) / max_step)), 1) if span != 0.0 else 0
+        h = span / n if n > 0 else 0.0
+        for m in range(n):
+            code = validity_code(t, model, free, thresholds)
+            if code != VALID:
+                return i, t, y, code, steps
+            _rk8_step(t, y, h, mc, model, frame, ic, kind, k, tmp, y_new)
+            t = t_start + (m + 1) * h if m + 1 < n else t_out[i]
+            for c in range(6):
+                y[c] = y_new[c]
+            if abs(y[3]) > free[3]:  # s beyond one period: shift it back (same motion)
+                reduce_phase(y, ic)
+            steps += 1
+        for c in range(6):
+            out[i, c] = y[c]
+        reduce_phase(out[i], ic)  # outputs in one representation: |κ s| ≤ 2K
+    return t_out.shape[0], t, y, VALID, steps
+
+
+def averaging_frame(y0, model):
+    """Inertial → reference rotation for (H, h) over a long averaged run.
+
+    The mean angular momentum precesses on a cone about the first perturber's orbit normal n (the
+    doubly averaged motion), so its angle to n stays about constant. The reference z axis is n when
+    that angle is between 45° and 135°, else a unit vector perpendicular to n: either way sin I stays
+    ≥ ~0.7 over the cone, far from the singular set sin I = 0 of (H, h). Without an orbiting
+    perturber, :func:`spinorbit.core.integrate_elements.reference_frame_for`.
+    """
+    moments = moments_of(model)
+    if int(model[MODEL_PERTURBERS]) == 0:
+        return reference_frame_for(y0, moments)
+    row = MODEL_PERTURBERS + 1
+    xv = perturber_state(0.0, model, row)
+    normal = np.cross(xv[:3], xv[3:])
+    if not np.linalg.norm(normal) > 0.0:
+        return reference_frame_for(y0, moments)
+    normal /= np.linalg.norm(normal)
+    w, x, y, z = y0[:4] / np.linalg.norm(y0[:4])
+    rot = np.array([[w * w + x * x - y * y - z * z, 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                    [2 * (x * y + w * z), w * w - x * x + y * y - z * z, 2 * (y * z - w * x)],
+                    [2 * (x * z - w * y), 2 * (y * z + w * x), w * w - x * x - y * y + z * z]])
+    spin = rot @ (moments * y0[4:])
+    spin /= np.linalg.norm(spin)
+    if abs(spin @ normal) < math.sqrt(0.5):
+        axis = normal
+    else:
+        axis = np.cross(normal, spin)
+        axis /= np.linalg.norm(axis)
+    ex = np.cross([0.0, 0.0, 1.0], axis) if abs(axis[2]) < 0.9 else np.cross([1.0, 0.0, 0.0], axis)
+    ex /= np.linalg.norm(ex)
+    ey = np.cross(axis, ex)
+    return np.ascontiguousarray(np.array([ex, ey, axis]))
+
+
+def state_of_elements(elements, frame, moments):
+    """(q, ω) (7,) of signed elements referred to ``frame``."""
+    ic = inertia_constants(*moments)
+    attitude, momentum = attitude_and_momentum(np.ascontiguousarray(elements, dtype=float), ic)
+    q = inertial_quaternion(attitude, frame)
+    return np.concatenate([q, momentum / moments])
+
+
+class AveragedResult:
+    """Output of :func:`propagate_averaged`.
+
+    Attributes
+    ----------
+    t : (n,) ndarray
+        Output times.
+    mean_elements : (n, 6) ndarray
+        Mean signed (S, Z, H, s, z, h) in the reference ``frame`` (s reduced to one period).
+    states : (n, 7) ndarray or None
+        Osculating (q, ω) from mean + short-period corrections (or the full integrator's state inside
+        a hand-over), when ``osculating=True``.
+    segments : list of (t_start, t_end, kind, reason)
+        kind "averaged" or "full"; reason the validity failure that started a "full" segment.
+    frame : (3, 3) ndarray
+        Inertial → reference rotation of H, h.
+    steps : int
+        Steps of the mean equations.
+    """
+
+    def __init__(self, t, mean_elements, states, segments, frame, steps):
+        self.t, self.mean_elements, self.states = t, mean_elements, states
+        self.segments, self.frame, self.steps = segments, frame, steps
+
+
+def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False, quadrature=None,
+                       osculating=False, hand_over=True, min_frequency_ratio=MIN_FREQUENCY_RATIO,
+                       max_perturbation=MAX_PERTURBATION, min_separatrix_distance=MIN_SEPARATRIX_DISTANCE,
+                       handover_chunk=None, rtol=1e-12, frame=None, mean0=None):
+    """Propagate the rotation through mean canonical elements (averaged over the free rotation).
+
+    Parameters
+    ----------
+    y0 : array_like (7,)
+        Osculating initial (q, ω), as for :func:`spinorbit.core.integrate_quaternion.integrate_quaternion`.
+    t0 : float
+        Initial time (model unit).
+    t_out : array_like (n,)
+        Output times, strictly monotone away from t0.
+    model : ndarray
+        :func:`spinorbit.core.dynamics.make_model`.
+    max_step : float, optional
+        Largest step of the mean equations (time unit). Default: 1/64 of 2π over the fastest
+        angular rate of a perturber's direction (at perihelion for an elliptic Kepler orbit, at t0
+        otherwise), or the span/64 when orbit-averaged.
+    orbit_averaged : bool
+        Average over each perturber's Keplerian orbit as well (doubly averaged; elliptic Kepler
+        perturbers only, others are used at their instantaneous position).
+    quadrature : bool, optional
+        Mean right-hand side by torus quadrature of eq. (11) (any force function, degrees 2–4;
+        ~10³ force evaluations per call). Default: the degree-2 closed form when the figure has
+        degree 2 only, else quadrature.
+    osculating : bool
+        Also return osculating states (short-period corrections at every output).
+    hand_over : bool
+        Hand over to the full integrator where averaging is invalid (else raise ValueError there).
+    min_frequency_ratio, max_perturbation, min_separatrix_distance : float
+        Validity thresholds (module docstring).
+    handover_chunk : float, optional
+        Length of the full-integration chunks between validity checks (default 20 × the longest
+        fast period).
+    rtol : float
+        Tolerance of the full integrator in hand-overs.
+    frame : (3, 3) ndarray, optional
+        Inertial → reference rotation of H, h (default :func:`averaging_frame`).
+    mean0 : array_like (6,), optional
+        Mean initial elements in ``frame`` (skips the osculating → mean conversion of y0).
+
+    Returns
+    -------
+    AveragedResult
+    """
+    y0 = validate_state(y0)
+    t0 = float(t0)
+    t_out = _validate_times(t0, t_out)
+    model = np.ascontiguousarray(model, dtype=float)
+    validate_sampled_span(model, t0, t_out)
+    moments = moments_of(model)
+    ic = inertia_constants(*moments)
+    if frame is None:
+        frame = averaging_frame(y0, model)
+    frame = np.ascontiguousarray(frame, dtype=float)
+    if quadrature is None:
+        quadrature = model[BODY_NMAX] > 2
+    if quadrature and orbit_averaged:
+        raise ValueError("orbit_averaged=True needs the degree-2 closed form; pass quadrature=False "
+                         "(or drop orbit_averaged for a figure of degree 3–4).")
+    kind = RHS_QUADRATURE if quadrature else (RHS_DEGREE2_ORBIT_AVERAGED if orbit_averaged else RHS_DEGREE2)
+    thresholds = np.array([min_frequency_ratio, max_perturbation, min_separatrix_distance])
+    if mean0 is None:
+        mean = osculating_to_mean(t0, elements_of_state(y0, model, frame), model, frame, ic)
+    else:
+        mean = np.array(mean0, dtype=float)
+    span = abs(t_out[-1] - t0)
+    if max_step is None:
+        max_step = _default_step(model, t0, span, orbit_averaged)
+    omega_s, omega_g = fast_frequencies(mean, ic)
+    if handover_chunk is None:
+        handover_chunk = 20.0 * 2.0 * math.pi / min(abs(omega_s), abs(omega_g))
+    direction = 1.0 if t_out[-1] > t0 else -1.0
+    out_mean = np.full((t_out.size, 6), np.nan)
+    out_state = np.full((t_out.size, 7), np.nan) if osculating else None
+    segments = []
+    t = t0
+    done = 0
+    steps = 0
+    while done < t_out.size:
+        mc = mean_constants(mean[0], mean[1], ic, moments)
+        written, t_stop, y_stop, code, n_steps = mean_elements_kernel(
+            mean, t, t_out[done:], float(max_step), mc, model, frame, ic, kind, thresholds,
+            free_motion_numbers(mean, ic),
+            out_mean[done:])
+        steps += n_steps
+        if osculating:
+            for i in range(done, done + written):
+                osc = mean_to_osculating(t_out[i], out_mean[i], model, frame, ic)
+                out_state[i] = state_of_elements(osc, frame, moments)
+        segments.append((t, float(t_stop) if code != VALID else float(t_out[-1]), "averaged", ""))
+        done += written
+        if code == VALID:
+            break
+        if not hand_over:
+            raise ValueError(f"averaging is invalid at t = {t_stop!r}: {_WHY[code]}; allow hand_over=True "
+                             "or integrate this stretch with integrate_quaternion.")
+        # Full integration in chunks until the averaged theory is valid again.
+        t = float(t_stop)
+        osc = mean_to_osculating(t, y_stop, model, frame, ic)
+        y = state_of_elements(osc, frame, moments)
+        reason = _WHY[code]
+        while True:
+            t_next = t + direction * handover_chunk
+            pending = t_out[done:]
+            inside = pending[(pending - t_next) * direction < 0]
+            grid = np.concatenate([inside, [t_next]])
+            ys = integrate_quaternion(y, t, grid, model, rtol=rtol)
+            for i, yi in enumerate(ys[:-1]):
+                el = elements_of_state(yi, model, frame)
+                out_mean[done + i] = osculating_to_mean(float(inside[i]), el, model, frame, ic)
+                if osculating:
+                    out_state[done + i] = yi
+            done += inside.size
+            segments.append((t, float(t_next) if done < t_out.size else float(t_out[-1]), "full", reason))
+            t, y = float(t_next), ys[-1]
+            if done >= t_out.size:
+                break
+            el = elements_of_state(y, model, frame)
+            if validity_code(t, model, free_motion_numbers(el, ic), thresholds) == VALID:
+                mean = osculating_to_mean(t, el, model, frame, ic)
+                break
+    return AveragedResult(t_out, out_mean, out_state, segments, frame, steps)
+
+
+def _default_step(model, t0, span, orbit_averaged):
+    if orbit_averaged:
+        return span / 64.0
+    periods = []
+    for p in range(int(model[MODEL_PERTURBERS])):
+        row = MODEL_PERTURBERS + 1 + p * PERTURBER_ROW
+        par = row + 2
+        if model[row] == KIND_KEPLER and model[par + K_E] < 1.0:
+            # the perihelion angular rate n (1 + e)²/(1 − e²)^{3/2}: the fastest on the orbit
+            ecc = model[par + K_E]
+            rate = model[par + K_MEAN_MOTION] * (1 + ecc) ** 2 / (1 - ecc * ecc) ** 1.5
+        else:
+            xv = perturber_state(t0, model, row)
+            rate = np.linalg.norm(np.cross(xv[:3], xv[3:])) / float(xv[:3] @ xv[:3])
+        if rate > 0.0:
+            periods.append(2.0 * math.pi / rate)
+    return min(periods) / 64.0 if periods else span / 64.0

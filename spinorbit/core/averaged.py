@@ -54,7 +54,15 @@ from .dynamics import MODEL_PERTURBERS
 from .element_forces import elements_rhs_into, force_function_of_elements
 from .elliptic import MK_K_HI, MK_K_LO, NK_COMPLETE
 from .gravity_field import BODY_A, BODY_B, BODY_C
-from .perturbers import K_A, K_E, K_P, K_Q, KIND_KEPLER, PERTURBER_ROW, perturber_position_xyz
+from .perturbers import (
+    K_A,
+    K_E,
+    K_P,
+    K_Q,
+    KIND_KEPLER,
+    PERTURBER_ROW,
+    perturber_position_xyz,
+)
 
 #: Points per period of s of the polhode quadrature. The integrand m̂ᵀ I m̂ is analytic in s; the
 #: trapezoidal rule's error falls like the nome q^N (q ≈ 0.01–0.2 away from the separatrix), so 64

@@ -26,10 +26,10 @@ import math
 
 import numpy as np
 
+from ._dop853_tableau import N_STAGES
 from ._dop853_tableau import A as _A_FULL
 from ._dop853_tableau import B as _B_FULL
 from ._dop853_tableau import C as _C_FULL
-from ._dop853_tableau import N_STAGES
 from ._jit import jit
 from .averaged import (
     degree2_mean_rhs,
@@ -39,7 +39,13 @@ from .averaged import (
     torus_frequencies,
     torus_mean_rhs,
 )
-from .canonical import MO_MODE, MO_PARAM_C, MODE_UNIFORM, inertia_constants, motion_from_elements
+from .canonical import (
+    MO_MODE,
+    MO_PARAM_C,
+    MODE_UNIFORM,
+    inertia_constants,
+    motion_from_elements,
+)
 from .dynamics import MODEL_PERTURBERS, validate_sampled_span, validate_state
 from .element_forces import attitude_and_momentum, inertial_quaternion, reduce_phase
 from .gravity_field import BODY_NMAX
@@ -171,7 +177,7 @@ def mean_elements_kernel(el0, t0, t_out, max_step, mc, model, frame, ic, kind, t
     for i in range(t_out.shape[0]):
         t_start = t
         span = t_out[i] - t
-        n = max(int(math.ceil(abs(span) / max_step)), 1) if span != 0.0 else 0
+        n = max(math.ceil(abs(span) / max_step), 1) if span != 0.0 else 0
         h = span / n if n > 0 else 0.0
         for m in range(n):
             code = validity_code(t, model, free, thresholds)

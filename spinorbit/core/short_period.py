@@ -26,7 +26,11 @@ import numpy as np
 
 from ._jit import jit
 from .averaged import torus_frequencies
-from .canonical import elliptic_constants, motion_from_elements, state_from_elements_motion
+from .canonical import (
+    elliptic_constants,
+    motion_from_elements,
+    state_from_elements_motion,
+)
 from .dynamics import force_function_and_torque_xyz
 from .element_forces import inertial_quaternion, reduce_phase, working_elements
 

@@ -19,7 +19,8 @@ Validity (checked at every step, :func:`validity_code`); averaging is refused wh
 
 There the run hands over to :func:`spinorbit.core.integrate_quaternion.integrate_quaternion`
 (osculating state from the mean one), continues in chunks of ``handover_chunk`` until the check
-passes again, and hands back (mean elements from the osculating ones).
+passes again, and hands back (mean elements from the osculating ones). A hand-over that starts at
+the initial time continues from the given osculating state itself, not from a reconstruction.
 """
 
 import math
@@ -51,8 +52,16 @@ from .element_forces import attitude_and_momentum, inertial_quaternion, reduce_p
 from .gravity_field import BODY_NMAX
 from .integrate_elements import elements_of_state, reference_frame_for
 from .integrate_quaternion import _validate_times, integrate_quaternion
-from .perturbers import K_E, K_MEAN_MOTION, KIND_KEPLER, PERTURBER_ROW, perturber_state
+from .perturbers import PERTURBER_ROW, perturber_state
 from .short_period import mean_to_osculating, osculating_to_mean
+
+#: Steps of the mean equations per 2π/n, n the fastest angular rate of a perturber's direction at
+#: the step's start. Apophis-like scene over 1000 orbits (fixed steps, for the record): 16 per orbit
+#: leave 3e-9 rad against 256 per orbit, 32 per orbit 9e-11 rad.
+STEPS_PER_TURN = 24.0
+#: Largest step as a fraction of the radial time r/|ṙ| of a perturber: on a near-radial approach
+#: (a flyby) the rate n grows like 1/r², which the n-limit alone would step over.
+RADIAL_STEP_FRACTION = 0.1
 
 _A = np.ascontiguousarray(_A_FULL[:N_STAGES, :N_STAGES])
 _B = np.ascontiguousarray(_B_FULL)
@@ -95,9 +104,11 @@ def free_motion_numbers(elements, ic):
 
 @jit
 def perturber_numbers(t, model):
-    """(fastest angular rate |r × v|/r² of a perturber's direction, Σ 3μ/r³) at time t."""
+    """(fastest angular rate |r × v|/r² of a perturber's direction, Σ 3μ/r³, shortest radial time
+    r/|ṙ|) at time t."""
     rate_max = 0.0
     strength = 0.0
+    radial_time = np.inf
     for p in range(int(model[MODEL_PERTURBERS])):
         row = MODEL_PERTURBERS + 1 + p * PERTURBER_ROW
         xv = perturber_state(t, model, row)
@@ -107,13 +118,16 @@ def perturber_numbers(t, model):
         cz = xv[0] * xv[4] - xv[1] * xv[3]
         rate_max = max(rate_max, math.sqrt(cx * cx + cy * cy + cz * cz) / r2)
         strength += 3.0 * model[row + 1] / r2 ** 1.5
-    return rate_max, strength
+        r_dot = abs(xv[0] * xv[3] + xv[1] * xv[4] + xv[2] * xv[5])  # r·v = r ṙ
+        if r_dot > 0.0:
+            radial_time = min(radial_time, r2 / r_dot)
+    return rate_max, strength, radial_time
 
 
 @jit
 def validity_numbers(t, model, free):
     """(Ω_min/n_max, ε, 1 − m) at time t; ``free`` from :func:`free_motion_numbers`."""
-    rate_max, strength = perturber_numbers(t, model)
+    rate_max, strength, _ = perturber_numbers(t, model)
     ratio = free[0] / rate_max if rate_max > 0.0 else np.inf
     return ratio, strength * free[1] / (free[0] * free[0]), free[2]
 
@@ -121,7 +135,15 @@ def validity_numbers(t, model, free):
 @jit
 def validity_code(t, model, free, thresholds):
     """VALID or the INVALID_* reason; thresholds = (min ratio, max ε, min separatrix distance)."""
-    ratio, eps, sep = validity_numbers(t, model, free)
+    rate_max, strength, _ = perturber_numbers(t, model)
+    return _validity_from_numbers(rate_max, strength, free, thresholds)
+
+
+@jit
+def _validity_from_numbers(rate_max, strength, free, thresholds):
+    ratio = free[0] / rate_max if rate_max > 0.0 else np.inf
+    eps = strength * free[1] / (free[0] * free[0])
+    sep = free[2]
     if not (sep >= thresholds[2]):
         return INVALID_SEPARATRIX
     if not (ratio >= thresholds[0]):
@@ -161,12 +183,17 @@ def _rk8_step(t, y, h, mc, model, frame, ic, kind, k, tmp, y_new):
 
 
 @jit
-def mean_elements_kernel(el0, t0, t_out, max_step, mc, model, frame, ic, kind, thresholds, free, out):
+def mean_elements_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, model, frame, ic, kind, thresholds, free,
+                         out):
     """Step the mean elements from (t0, el0) to each t_out[i] (rows of ``out``).
 
+    The step is the smallest of ``max_step``, 2π/(steps_per_turn · n) with n the fastest angular
+    rate of a perturber's direction at the step's start, RADIAL_STEP_FRACTION · r/|ṙ| (so a flyby is
+    approached in steps that shrink with the distance, and its start is not stepped over), and the
+    distance to the next output. The validity check (:func:`validity_code` with
+    ``free`` = :func:`free_motion_numbers`) runs before every step; on failure the run stops there.
+
     Returns (number of outputs written, time reached, elements there, INVALID_* code or VALID, steps).
-    The validity check (:func:`validity_code` with ``free`` = :func:`free_motion_numbers`) runs
-    before every step; on failure the run stops at that time.
     """
     y = el0.copy()
     t = t0
@@ -175,16 +202,25 @@ def mean_elements_kernel(el0, t0, t_out, max_step, mc, model, frame, ic, kind, t
     y_new = np.empty(6)
     steps = 0
     for i in range(t_out.shape[0]):
-        t_start = t
-        span = t_out[i] - t
-        n = max(math.ceil(abs(span) / max_step), 1) if span != 0.0 else 0
-        h = span / n if n > 0 else 0.0
-        for m in range(n):
-            code = validity_code(t, model, free, thresholds)
+        target = t_out[i]
+        direction = 1.0 if target > t else -1.0
+        while t != target:
+            rate, strength, radial_time = perturber_numbers(t, model)
+            code = _validity_from_numbers(rate, strength, free, thresholds)
             if code != VALID:
                 return i, t, y, code, steps
-            _rk8_step(t, y, h, mc, model, frame, ic, kind, k, tmp, y_new)
-            t = t_start + (m + 1) * h if m + 1 < n else t_out[i]
+            h = max_step
+            if rate > 0.0 and steps_per_turn > 0.0:
+                h = min(h, 2.0 * math.pi / (steps_per_turn * rate), RADIAL_STEP_FRACTION * radial_time)
+            remaining = abs(target - t)
+            # Land on the output: take it in one step if within 1 % of a full step, else never
+            # leave a sliver shorter than half a step.
+            if remaining <= 1.01 * h:
+                h = remaining
+            elif remaining < 1.5 * h:
+                h = 0.5 * remaining
+            _rk8_step(t, y, direction * h, mc, model, frame, ic, kind, k, tmp, y_new)
+            t = target if h == remaining else t + direction * h
             for c in range(6):
                 y[c] = y_new[c]
             if abs(y[3]) > free[3]:  # s beyond one period: shift it back (same motion)
@@ -281,9 +317,9 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
     model : ndarray
         :func:`spinorbit.core.dynamics.make_model`.
     max_step : float, optional
-        Largest step of the mean equations (time unit). Default: 1/24 of 2π over the fastest
-        angular rate of a perturber's direction (at perihelion for an elliptic Kepler orbit, at t0
-        otherwise), or the span/64 when orbit-averaged.
+        Largest step of the mean equations (time unit); the step is also at most
+        2π/(STEPS_PER_TURN · n), n the perturbers' fastest angular rate at the step's start (not
+        when orbit-averaged). Default: the span (span/64 when orbit-averaged).
     orbit_averaged : bool
         Average over each perturber's Keplerian orbit as well (doubly averaged; elliptic Kepler
         perturbers only, others are used at their instantaneous position).
@@ -298,8 +334,8 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
     min_frequency_ratio, max_perturbation, min_separatrix_distance : float
         Validity thresholds (module docstring).
     handover_chunk : float, optional
-        Length of the full-integration chunks between validity checks (default 20 × the longest
-        fast period).
+        Length of the full-integration chunks between validity checks (default: the longer of the
+        two fundamental periods 2π/ω_s, 2π/ω_g of the free motion; a check costs one conversion).
     rtol : float
         Tolerance of the full integrator in hand-overs.
     frame : (3, 3) ndarray, optional
@@ -334,21 +370,24 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
         mean = np.array(mean0, dtype=float)
     span = abs(t_out[-1] - t0)
     if max_step is None:
-        max_step = _default_step(model, t0, span, orbit_averaged)
+        max_step = span / 64.0 if orbit_averaged else span
+    # Orbit-averaged: the right-hand side has no orbital time scale left; only max_step limits.
+    steps_per_turn = 0.0 if orbit_averaged else STEPS_PER_TURN
     omega_s, omega_g = fast_frequencies(mean, ic)
     if handover_chunk is None:
-        handover_chunk = 20.0 * 2.0 * math.pi / min(abs(omega_s), abs(omega_g))
+        handover_chunk = 2.0 * math.pi / min(abs(omega_s), abs(omega_g))
     direction = 1.0 if t_out[-1] > t0 else -1.0
     out_mean = np.full((t_out.size, 6), np.nan)
     out_state = np.full((t_out.size, 7), np.nan) if osculating else None
     segments = []
     t = t0
+    exact = y0  # the last osculating state known without short-period reconstruction, at time t
     done = 0
     steps = 0
     while done < t_out.size:
         mc = mean_constants(mean[0], mean[1], ic, moments)
         written, t_stop, y_stop, code, n_steps = mean_elements_kernel(
-            mean, t, t_out[done:], float(max_step), mc, model, frame, ic, kind, thresholds,
+            mean, t, t_out[done:], float(max_step), steps_per_turn, mc, model, frame, ic, kind, thresholds,
             free_motion_numbers(mean, ic),
             out_mean[done:])
         steps += n_steps
@@ -364,9 +403,11 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
             raise ValueError(f"averaging is invalid at t = {t_stop!r}: {_WHY[code]}; allow hand_over=True "
                              "or integrate this stretch with integrate_quaternion.")
         # Full integration in chunks until the averaged theory is valid again.
-        t = float(t_stop)
-        osc = mean_to_osculating(t, y_stop, model, frame, ic)
-        y = state_of_elements(osc, frame, moments)
+        if float(t_stop) == t:
+            y = exact  # invalid where the segment starts: continue from the exact state
+        else:
+            t = float(t_stop)
+            y = state_of_elements(mean_to_osculating(t, y_stop, model, frame, ic), frame, moments)
         reason = _WHY[code]
         while True:
             t_next = t + direction * handover_chunk
@@ -387,30 +428,6 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
             el = elements_of_state(y, model, frame)
             if validity_code(t, model, free_motion_numbers(el, ic), thresholds) == VALID:
                 mean = osculating_to_mean(t, el, model, frame, ic)
+                exact = y
                 break
     return AveragedResult(t_out, out_mean, out_state, segments, frame, steps)
-
-
-#: Default steps of the mean equations per 2π/(fastest angular rate of a perturber). Apophis-like
-#: scene over 1000 orbits (rate at perihelion ≈ 1.5 n): 16 per orbit leave 3e-9 rad against 256
-#: per orbit, 32 per orbit 9e-11 rad; 24 here ≈ 36 per orbit.
-STEPS_PER_FAST_PERIOD = 24.0
-
-
-def _default_step(model, t0, span, orbit_averaged):
-    if orbit_averaged:
-        return span / 64.0
-    periods = []
-    for p in range(int(model[MODEL_PERTURBERS])):
-        row = MODEL_PERTURBERS + 1 + p * PERTURBER_ROW
-        par = row + 2
-        if model[row] == KIND_KEPLER and model[par + K_E] < 1.0:
-            # the perihelion angular rate n (1 + e)²/(1 − e²)^{3/2}: the fastest on the orbit
-            ecc = model[par + K_E]
-            rate = model[par + K_MEAN_MOTION] * (1 + ecc) ** 2 / (1 - ecc * ecc) ** 1.5
-        else:
-            xv = perturber_state(t0, model, row)
-            rate = np.linalg.norm(np.cross(xv[:3], xv[3:])) / float(xv[:3] @ xv[:3])
-        if rate > 0.0:
-            periods.append(2.0 * math.pi / rate)
-    return min(periods) / STEPS_PER_FAST_PERIOD if periods else span / STEPS_PER_FAST_PERIOD

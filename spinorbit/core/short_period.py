@@ -15,9 +15,11 @@ the c_jk from a 2-D FFT of U sampled on the torus grid (:func:`torus_u_grid`). T
 elements are x_osc = x_mean + {x, W}: ΔS = ∂W/∂s, ΔZ = ∂W/∂z, ΔH = ∂W/∂h, Δs = −∂W/∂S,
 Δz = −∂W/∂Z, Δh = −∂W/∂H. ∂W/∂s = (U − ⟨U⟩)/(aS) and ∂W/∂z are spectral; the momentum partials are
 central differences of W at fixed (s, z, h). U also moves with time t through the perturbers (orbital time scale, rate n ≪ Ω); the
-homological equation is then a S ∂W/∂s + ∂W/∂t = U − ⟨U⟩, solved to first order in n/Ω:
-Ŵ_jk = c_jk/(iΩ_jk) − ċ_jk/(iΩ_jk)² (without the second term the corrections keep an error ∝ the
-torque × n/Ω, measured as a first-order slope). Small divisors Ω_jk → 0 are the internal and spin–orbit resonances that
+homological equation is then a S ∂W/∂s + ∂W/∂t = U − ⟨U⟩, solved to second order in n/Ω:
+Ŵ_jk = c_jk/(iΩ_jk) − ċ_jk/(iΩ_jk)² + c̈_jk/(iΩ_jk)³ (without the ċ term the corrections keep an
+error ∝ the torque × n/Ω, measured as a first-order slope; the c̈ term removes the next one, which
+at perihelion of the Toutatis-like orbit, n/Ω ≈ 1/9, left mean momenta off by ~1e-7 Z and hence a
+precession-phase drift). Small divisors Ω_jk → 0 are the internal and spin–orbit resonances that
 :mod:`spinorbit.core.propagate_averaged` refuses.
 """
 
@@ -42,22 +44,30 @@ from .gravity_field import BODY_NMAX
 #: Degrees 3–4 (|k| ≤ 4): 64 × 16.
 GRID_DEGREE2 = (32, 8)
 GRID_DEGREE4 = (64, 16)
-#: Time step of ∂U/∂t, as a fraction of the fastest period of the free motion.
-TIME_DIFFERENCE_FRACTION = 1e-2
+#: Relative size (to the largest harmonic of U − ⟨U⟩) below which a harmonic is rounding noise.
+HARMONIC_NOISE = 1e-11
+#: Highest time derivative of U kept in W (1: ċ, 2: ċ and c̈).
+TIME_DERIVATIVE_ORDER = 2
+#: Time step of ∂U/∂t, as a fraction of the fastest period of the free motion. The truncation error
+#: of the differences is ~ (n δt)² ≈ 1e-5 relative; 1e-2 was measured worse (the second difference
+#: then amplifies the grid's rounding: round trips of 2e-7 instead of 3e-9 at 100× the solar torque).
+TIME_DIFFERENCE_FRACTION = 0.1
 #: Relative step (of Z) of the central differences of W in S, Z, H; absolute step (rad) in h.
 W_DIFFERENCE_STEP = 1e-5
 
 
 @jit
-def torus_u_grid(t, elements, model, frame, ic, n_s, n_psi):
-    """U (energy) on the (s_w, ψ) grid s_w = P j/n_s, ψ = 2π k/n_psi at the elements' (S, Z, H, h)."""
+def torus_u_grid(times, elements, model, frame, ic, n_s, n_psi):
+    """U (energy) on the (s_w, ψ) grid s_w = P j/n_s, ψ = 2π k/n_psi at the elements' (S, Z, H, h),
+    at each of ``times``: shape (len(times), n_s, n_psi). The attitude of each grid point is built
+    once for all times."""
     period, nu, _ = torus_frequencies(elements[0], elements[1], ic)
     work, flip = working_elements(elements)
     # The motion and elliptic constants of (S, Z) once for the whole grid (they cost as much as the
     # rest of a backward map).
     mo = motion_from_elements(work[0], work[1], ic)
     mk, pk = elliptic_constants(mo)
-    out = np.empty((n_s, n_psi))
+    out = np.empty((times.shape[0], n_s, n_psi))
     for j in range(n_s):
         s_w = period * j / n_s
         work[3] = s_w
@@ -65,28 +75,35 @@ def torus_u_grid(t, elements, model, frame, ic, n_s, n_psi):
             work[4] = 2.0 * math.pi * k / n_psi - nu * s_w
             attitude, _ = state_from_elements_motion(work, flip, mo, mk, pk)
             q = inertial_quaternion(attitude, frame)
-            out[j, k] = force_function_and_torque_xyz(t, q[0], q[1], q[2], q[3], model)[0]
+            for i in range(times.shape[0]):
+                out[i, j, k] = force_function_and_torque_xyz(times[i], q[0], q[1], q[2], q[3], model)[0]
     return out
 
 
 def _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi):
     """(Ŵ, jω + kν per unit s_w, k, ν, mean U) of W's Fourier series at the elements' momenta."""
     period, nu, s_rate = torus_frequencies(elements[0], elements[1], ic)
-    # ∂U/∂t through the perturbers' motion: central difference over a small fraction of the
-    # fastest torus period (the grid varies on the orbital time scale, so the truncation error is
-    # ~ (n δt)² and rounding ~ ε U/δt, both far below the term).
+    # ∂U/∂t and ∂²U/∂t² through the perturbers' motion: central differences over a fraction of the
+    # fastest torus period (the grid varies on the orbital time scale).
     omega_fast = max(2.0 * math.pi / period, abs(nu)) * s_rate
     dt = TIME_DIFFERENCE_FRACTION * 2.0 * math.pi / omega_fast
-    grids = [torus_u_grid(t + shift, elements, model, frame, ic, n_s, n_psi) for shift in (0.0, dt, -dt)]
+    grids = torus_u_grid(np.array([t, t + dt, t - dt]), elements, model, frame, ic, n_s, n_psi)
     coeff, c_plus, c_minus = (np.fft.fft2(g) / (n_s * n_psi) for g in grids)
     c_dot = (c_plus - c_minus) / (2.0 * dt)
+    c_ddot = (c_plus - 2.0 * coeff + c_minus) / (dt * dt)
     j = np.fft.fftfreq(n_s, 1.0 / n_s)[:, None]
     k = np.fft.fftfreq(n_psi, 1.0 / n_psi)[None, :]
     rate = j * (2.0 * math.pi / period) + k * nu  # d(phase)/d s_w
     mean_u = coeff[0, 0].real
+    # Harmonics at the rounding level of the grid are dropped: with a small divisor Ω_jk (some
+    # jω + kν is always close to 0 on a large grid) their noise, divided by Ω³ in the c̈ term, would
+    # dominate the corrections.
+    coeff[0, 0] = 0.0
+    significant = np.abs(coeff) > HARMONIC_NOISE * np.abs(coeff).max()
     with np.errstate(divide="ignore", invalid="ignore"):
         i_omega = 1j * s_rate * rate
-        w_hat = np.where((j == 0) & (k == 0), 0.0, coeff / i_omega - c_dot / i_omega**2)
+        w_hat = np.where(~significant, 0.0, coeff / i_omega - c_dot / i_omega**2
+                         + (c_ddot / i_omega**3 if TIME_DERIVATIVE_ORDER > 1 else 0.0))
     return w_hat, rate, k, nu, mean_u
 
 

@@ -22,8 +22,9 @@ propagator's; when even heyoka's loosest tolerance is more accurate, the ratio u
 and is marked "≥".
 
 Torque family: the Apophis-like scene with the solar torque × 1, 10, 100, 1000 over 100 orbits
-(the orbit unchanged). × 1000 (ε ≈ 2.5) is refused by the validity check and handed over to the full
-integrator; the error slopes are measured on × 1 … × 100.
+(the orbit unchanged), propagated averaged throughout (the ε limit lifted) to measure the theory's
+own error; the default validity check hands × 100 and × 1000 (ε ≈ 0.25, 2.5) over to the full
+integrator, which is recorded. The error slopes are measured on × 1 … × 100.
 
 Regime map (span × accuracy): for each span N (orbits) and accuracy δ, a method is feasible if its
 measured mean-quantity error at N is ≤ δ; its CPU is the measured 1000-orbit CPU × N/1000 (both
@@ -192,19 +193,22 @@ def torque_family(base, orbits, log):
         t_out = output_times(scene, orbits, count=5)
         _, ref_ys = heyoka_run(scene, REFERENCE_TOL, t_out)
         ref = mean_of_states(scene, ref_ys, t_out, frame, ic)
-        propagate_averaged(scene.y0, scene.t0, t_out[:1], scene.model, frame=frame)
-        cpu, res = time_averaged(scene, t_out, frame)
+        # The theory's own error: the ε limit of the validity check is lifted here (× 100 and × 1000
+        # exceed it); what the default check does is recorded alongside.
+        default = propagate_averaged(scene.y0, scene.t0, t_out, scene.model, frame=frame)
+        kinds = sorted({seg[2] for seg in default.segments})
+        propagate_averaged(scene.y0, scene.t0, t_out[:1], scene.model, frame=frame, max_perturbation=np.inf)
+        cpu, res = time_averaged(scene, t_out, frame, max_perturbation=np.inf)
         err = errors(res.mean_elements, ref, ic)
-        kinds = sorted({seg[2] for seg in res.segments})
         out.append({"scale": scale, "err": err, "cpu": cpu, "kinds": kinds})
-        log(f"[torque × {scale:g}] {'+'.join(kinds)}: momenta {err[:, :3].max():.2e}, z,h "
+        log(f"[torque × {scale:g}] default run: {'+'.join(kinds)}; averaged throughout: momenta {err[:, :3].max():.2e}, z,h "
             f"{err[:, 4:6].max():.2e}, θ {err[:, 3].max():.2e}, periods {err[:, 6:].max():.2e}, {cpu * 1e3:.1f} ms")
     return out
 
 
 def slopes(family):
-    """log-log slopes of the error maxima against the torque scale, over the scales that stayed averaged."""
-    fam = [f for f in family if f["kinds"] == ["averaged"]]
+    """log-log slopes of the error maxima against the torque scale, × 1 … × 100 (ε ≤ 0.25)."""
+    fam = [f for f in family if f["scale"] <= 100.0]
     x = np.log10([f["scale"] for f in fam])
     result = {}
     for label, cols in (("momenta", [0, 1, 2]), ("slow angles z, h", [4, 5]), ("body phase θ", [3]),
@@ -317,7 +321,9 @@ def main(argv=None):
                             f"{slow_error(study['rows'][name]['err']).max():.1e}).")
         text.append("")
     text += ["### Torque family (Apophis-like, solar torque scaled, 100 orbits)", "",
-             "| torque | run | momenta /Z | z, h (rad) | θ (rad) | periods rel | CPU |", "|---|---|---|---|---|---|---|"]
+             ("Averaged throughout (the ε limit of the validity check lifted, to measure the theory's own "
+              "error); the column 'default' says what the default check does."), "",
+             "| torque | default | momenta /Z | z, h (rad) | θ (rad) | periods rel | CPU |", "|---|---|---|---|---|---|---|"]
     for f in family:
         e = f["err"]
         text.append(f"| × {f['scale']:g} | {'+'.join(f['kinds'])} | {e[:, :3].max():.1e} | {e[:, 4:6].max():.1e} | "

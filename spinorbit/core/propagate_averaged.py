@@ -52,15 +52,16 @@ from .element_forces import attitude_and_momentum, inertial_quaternion, reduce_p
 from .gravity_field import BODY_NMAX
 from .integrate_elements import elements_of_state, reference_frame_for
 from .integrate_quaternion import _validate_times, integrate_quaternion
-from .perturbers import PERTURBER_ROW, perturber_state
+from .perturbers import K_E, KIND_KEPLER, PERTURBER_ROW, perturber_state
 from .short_period import mean_to_osculating, osculating_to_mean
 
 #: Steps of the mean equations per 2π/n, n the fastest angular rate of a perturber's direction at
-#: the step's start. Apophis-like scene over 1000 orbits (fixed steps, for the record): 16 per orbit
-#: leave 3e-9 rad against 256 per orbit, 32 per orbit 9e-11 rad.
-STEPS_PER_TURN = 24.0
-#: Largest step as a fraction of the radial time r/|ṙ| of a perturber: on a near-radial approach
-#: (a flyby) the rate n grows like 1/r², which the n-limit alone would step over.
+#: the step's start. Measured over 1000 orbits against 96 per turn: Apophis-like 12 → 7e-9, 16 →
+#: 7e-10, 24 → 8e-11 (rad or /Z, slow quantities); Toutatis-like (e = 0.63) 12 → 2e-5, 16 → 2e-6,
+#: 24 → 4e-8. The averaging itself errs by more over such spans (docs/averaged.md).
+STEPS_PER_TURN = 16.0
+#: Largest step as a fraction of the radial time r/|ṙ| of a perturber not on an elliptic orbit: on a
+#: near-radial approach (a flyby) the rate n grows like 1/r², which the n-limit alone would step over.
 RADIAL_STEP_FRACTION = 0.1
 
 _A = np.ascontiguousarray(_A_FULL[:N_STAGES, :N_STAGES])
@@ -105,7 +106,7 @@ def free_motion_numbers(elements, ic):
 @jit
 def perturber_numbers(t, model):
     """(fastest angular rate |r × v|/r² of a perturber's direction, Σ 3μ/r³, shortest radial time
-    r/|ṙ|) at time t."""
+    r/|ṙ| of a perturber not on an elliptic Kepler orbit) at time t."""
     rate_max = 0.0
     strength = 0.0
     radial_time = np.inf
@@ -119,7 +120,8 @@ def perturber_numbers(t, model):
         rate_max = max(rate_max, math.sqrt(cx * cx + cy * cy + cz * cz) / r2)
         strength += 3.0 * model[row + 1] / r2 ** 1.5
         r_dot = abs(xv[0] * xv[3] + xv[1] * xv[4] + xv[2] * xv[5])  # r·v = r ṙ
-        if r_dot > 0.0:
+        bound = model[row] == KIND_KEPLER and model[row + 2 + K_E] < 1.0
+        if r_dot > 0.0 and not bound:  # elliptic orbits: the angular-rate limit is enough
             radial_time = min(radial_time, r2 / r_dot)
     return rate_max, strength, radial_time
 

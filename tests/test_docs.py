@@ -37,6 +37,8 @@ API_NAMES = {
     "ephemeris": ["barycentric_state", "moon_orientation", "moon_libration_angles", "de421_constants"],
     "rebound_adapter": ["simulation_from_de421", "install_extra_forces", "perturber_positions"],
     "cli": ["main", "CommandError", "add_arguments"],
+    "averaged": ["propagate_averaged", "osculating_to_mean", "mean_to_osculating", "polhode_mean_inertia",
+                 "torus_mean_rhs", "validity_code"],
 }
 NARRATIVE_PAGES = ["index", "cli", "conventions", "theory", "design", "elliptic", "ephemeris", "performance"]
 

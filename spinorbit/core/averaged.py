@@ -151,11 +151,21 @@ def degree2_mean_partials(t, elements, mc, model, frame, orbit_averaged):
     orbit_averaged: also average over each perturber's Keplerian orbit (elliptic KIND_KEPLER rows
     only; others are used at their instantaneous position).
     """
+    du = np.zeros(4)
+    u = degree2_mean_partials_into(t, elements, mc, model, frame, orbit_averaged, du)
+    return u, du
+
+
+@jit
+def degree2_mean_partials_into(t, elements, mc, model, frame, orbit_averaged, du):
+    """:func:`degree2_mean_partials` writing ∂⟨U⟩/∂(S, Z, H, h) into du (4,), returning ⟨U⟩; no
+    allocation (the mean equations' inner call)."""
     big_z, big_h, h = elements[1], elements[2], elements[5]
     q, q_s, q_z, trace = mc[MC_Q], mc[MC_DQ_DS], mc[MC_DQ_DZ], mc[MC_TRACE]
     alpha, alpha_s, alpha_z = 0.5 * (trace - q), -0.5 * q_s, -0.5 * q_z
     beta, beta_s, beta_z = 0.5 * (3.0 * q - trace), 1.5 * q_s, 1.5 * q_z
-    du = np.zeros(4)
+    for i in range(4):
+        du[i] = 0.0
     u = 0.0
     for k in range(int(model[MODEL_PERTURBERS])):
         row = MODEL_PERTURBERS + 1 + k * PERTURBER_ROW
@@ -185,13 +195,15 @@ def degree2_mean_partials(t, elements, mc, model, frame, orbit_averaged):
 @jit
 def degree2_mean_rhs(t, elements, mc, model, frame, orbit_averaged, dy):
     """Mean eq. (11) with the closed-form degree-2 ⟨U⟩: writes d(S, Z, H, s, z, h)/dt into dy."""
-    _, du = degree2_mean_partials(t, elements, mc, model, frame, orbit_averaged)
+    du = dy[2:6]  # scratch: the four partials, written before the rates that overwrite them
+    degree2_mean_partials_into(t, elements, mc, model, frame, orbit_averaged, du)
+    d_s, d_z, d_h_big, d_h = du[0], du[1], du[2], du[3]
     dy[0] = 0.0
     dy[1] = 0.0
-    dy[2] = du[3]
-    dy[3] = mc[MC_A] * elements[0] - du[0]
-    dy[4] = -du[1]
-    dy[5] = -du[2]
+    dy[2] = d_h
+    dy[3] = mc[MC_A] * elements[0] - d_s
+    dy[4] = -d_z
+    dy[5] = -d_h_big
 
 
 @jit

@@ -58,8 +58,9 @@ from .short_period import mean_to_osculating, osculating_to_mean
 #: Steps of the mean equations per 2π/n, n the fastest angular rate of a perturber's direction at
 #: the step's start. Measured over 1000 orbits against 96 per turn: Apophis-like 12 → 7e-9, 16 →
 #: 7e-10, 24 → 8e-11 (rad or /Z, slow quantities); Toutatis-like (e = 0.63) 12 → 2e-5, 16 → 2e-6,
-#: 24 → 4e-8. The averaging itself errs by more over such spans (docs/averaged.md).
-STEPS_PER_TURN = 16.0
+#: 24 → 4e-8. The averaging itself errs by 1e-4 (Apophis-like) and 4e-2 (Toutatis-like) over that
+#: span (docs/averaged.md), so 12 leaves the stepping error ≥ 1000× below it.
+STEPS_PER_TURN = 12.0
 #: Largest step as a fraction of the radial time r/|ṙ| of a perturber not on an elliptic orbit: on a
 #: near-radial approach (a flyby) the rate n grows like 1/r², which the n-limit alone would step over.
 RADIAL_STEP_FRACTION = 0.1

@@ -88,9 +88,10 @@ _WHY = {INVALID_RESONANCE: "resonance / fast perturber (a fast frequency is clos
 
 @jit
 def free_motion_numbers(elements, ic):
-    """(Ω_min, (C − A)/C, 1 − m, P) of the free motion of the elements' (S, Z): the slowest fast
+    """(Ω_min, (C − A)/C, 1 − m, P, Δg) of the free motion of the elements' (S, Z): the slowest fast
     frequency min |jω_s + kω_g| over |j|, |k| ≤ 2 (not both 0), the asymmetry, the separatrix
-    distance and the period of s. Constant along a mean run (S and Z are)."""
+    distance, the period of s and the advance of g over it. Constant along a mean run (S and Z
+    are)."""
     omega_s, omega_g = fast_frequencies(elements, ic)
     omega_min = np.inf
     for j in range(3):
@@ -100,8 +101,8 @@ def free_motion_numbers(elements, ic):
             omega_min = min(omega_min, abs(j * omega_s + k * omega_g))
     mo = motion_from_elements(abs(elements[0]), elements[1], ic)
     sep = 0.0 if mo[MO_MODE] == MODE_UNIFORM else mo[MO_PARAM_C]
-    period, _, _ = torus_frequencies(elements[0], elements[1], ic)
-    return np.array([omega_min, ic[5] / ic[0], sep, period])  # (a − c)/a = 1 − A/C
+    period, nu, _ = torus_frequencies(elements[0], elements[1], ic)
+    return np.array([omega_min, ic[5] / ic[0], sep, period, nu * period])  # (a − c)/a = 1 − A/C
 
 
 @jit
@@ -186,6 +187,18 @@ def _rk8_step(t, y, h, mc, model, frame, ic, kind, k, tmp, y_new):
 
 
 @jit
+def _shift_phase(y, period, advance_g):
+    """:func:`spinorbit.core.element_forces.reduce_phase` with the period P and advance Δg of the
+    (constant) mean S, Z supplied: whole periods out of the working s, Δg each into z."""
+    sign = 1.0 if y[0] >= 0.0 else -1.0
+    periods = np.rint(sign * y[3] / period)
+    if periods != 0.0:
+        y[3] -= sign * periods * period
+        z = y[4] + periods * advance_g
+        y[4] = z - 2.0 * math.pi * np.rint(z / (2.0 * math.pi))
+
+
+@jit
 def mean_elements_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, model, frame, ic, kind, thresholds, free,
                          out):
     """Step the mean elements from (t0, el0) to each t_out[i] (rows of ``out``).
@@ -226,8 +239,7 @@ def mean_elements_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, model, fr
             t = target if h == remaining else t + direction * h
             for c in range(6):
                 y[c] = y_new[c]
-            if abs(y[3]) > free[3]:  # s beyond one period: shift it back (same motion)
-                reduce_phase(y, ic)
+            _shift_phase(y, free[3], free[4])
             steps += 1
         for c in range(6):
             out[i, c] = y[c]

@@ -41,6 +41,8 @@ API_NAMES = {
     "cli": ["main", "CommandError", "add_arguments"],
     "scene": ["Scene", "plan", "run", "Orbit", "FixedPerturber", "SceneResult", "SceneError", "Plan",
               "attitude_sensitivity", "dropped_torque_bound"],
+    "averaged": ["propagate_averaged", "osculating_to_mean", "mean_to_osculating", "polhode_mean_inertia",
+                 "torus_mean_rhs", "validity_code"],
 }
 NARRATIVE_PAGES = ["index", "cli", "conventions", "theory", "design", "elliptic", "ephemeris", "performance",
                    "scenes", "tutorials", "validation"]

@@ -1,0 +1,448 @@
+"""Semi-analytic propagation of mean canonical elements, with hand-over to the full integrator.
+
+The mean equations (:mod:`spinorbit.core.averaged`) have no rotation time scale left: S and Z are
+constant, (H, h) and the slow phases move at the torque's rate, so they are stepped on the orbital
+time scale by a fixed-step 8th-order Runge–Kutta (the DOP853 tableau without error control; steps
+land on the output times). The osculating state is recovered at each output by the first-order
+short-period corrections (:mod:`spinorbit.core.short_period`).
+
+Validity (checked at every step, :func:`validity_code`); averaging is refused where:
+
+* **resonance** — a fast frequency Ω_jk = jω_s + kω_g (|j| ≤ 2, |k| ≤ 2, not both 0; ω_s the body
+  phase rate, ω_g the mean precession rate) is less than ``min_frequency_ratio`` times the fastest
+  angular rate |r × v|/r² of a perturber's direction. Synchronous rotation (ω_g ≈ n) and close
+  encounters (the perturber's direction sweeps as fast as the body turns) both land here, as do
+  internal near-commensurabilities jω_s + kω_g ≈ 0 (small divisors of the short-period terms).
+* **strong perturbation** — ε = Σ 3μ/r³ · (C − A)/(C Ω_min²) above ``max_perturbation``: the
+  torque's frequency² relative to the slowest fast frequency²; first-order theory errs by ~ε².
+* **separatrix** — 1 − m (or 1 − μ) below ``min_separatrix_distance``: the polhode period diverges.
+
+There the run hands over to :func:`spinorbit.core.integrate_quaternion.integrate_quaternion`
+(osculating state from the mean one), continues in chunks of ``handover_chunk`` until the check
+passes again, and hands back (mean elements from the osculating ones). A hand-over that starts at
+the initial time continues from the given osculating state itself, not from a reconstruction.
+"""
+
+import math
+
+import numpy as np
+
+from ._dop853_tableau import N_STAGES
+from ._dop853_tableau import A as _A_FULL
+from ._dop853_tableau import B as _B_FULL
+from ._dop853_tableau import C as _C_FULL
+from ._jit import jit
+from .averaged import (
+    degree2_mean_rhs,
+    fast_frequencies,
+    mean_constants,
+    moments_of,
+    torus_frequencies,
+    torus_mean_rhs,
+)
+from .canonical import (
+    MO_MODE,
+    MO_PARAM_C,
+    MODE_UNIFORM,
+    inertia_constants,
+    motion_from_elements,
+)
+from .dynamics import MODEL_PERTURBERS, validate_sampled_span, validate_state
+from .element_forces import attitude_and_momentum, inertial_quaternion, reduce_phase
+from .gravity_field import BODY_NMAX
+from .integrate_elements import elements_of_state, reference_frame_for
+from .integrate_quaternion import _validate_times, integrate_quaternion
+from .perturbers import K_E, KIND_KEPLER, PERTURBER_ROW, perturber_state
+from .short_period import mean_to_osculating, osculating_to_mean
+
+#: Steps of the mean equations per 2π/n, n the fastest angular rate of a perturber's direction at
+#: the step's start. Measured over 1000 orbits against 96 per turn: Apophis-like 12 → 7e-9, 16 →
+#: 7e-10, 24 → 8e-11 (rad or /Z, slow quantities); Toutatis-like (e = 0.63) 12 → 2e-5, 16 → 2e-6,
+#: 24 → 4e-8. The averaging itself errs by 1e-4 (Apophis-like) and 4e-2 (Toutatis-like) over that
+#: span (docs/averaged.md), so 12 leaves the stepping error ≥ 1000× below it.
+STEPS_PER_TURN = 12.0
+#: Largest step as a fraction of the radial time r/|ṙ| of a perturber not on an elliptic orbit: on a
+#: near-radial approach (a flyby) the rate n grows like 1/r², which the n-limit alone would step over.
+RADIAL_STEP_FRACTION = 0.1
+
+_A = np.ascontiguousarray(_A_FULL[:N_STAGES, :N_STAGES])
+_B = np.ascontiguousarray(_B_FULL)
+_C = np.ascontiguousarray(_C_FULL[:N_STAGES])
+
+#: Default validity thresholds (module docstring). 5: the first-order theory's neglected terms are
+#: ~ (n/Ω)²; Toutatis' slowest combination ω_s − ω_g is ~9× its perihelion rate, so 5 keeps it.
+MIN_FREQUENCY_RATIO = 5.0
+MAX_PERTURBATION = 0.05
+MIN_SEPARATRIX_DISTANCE = 1e-3
+
+# Right-hand-side choices of the mean equations.
+RHS_DEGREE2, RHS_DEGREE2_ORBIT_AVERAGED, RHS_QUADRATURE = 0, 1, 2
+#: Torus grid of the quadrature right-hand side (points in s, in z; z > degree 4).
+QUADRATURE_POINTS_S, QUADRATURE_POINTS_Z = 24, 9
+
+VALID, INVALID_RESONANCE, INVALID_PERTURBATION, INVALID_SEPARATRIX = 0, 1, 2, 3
+_WHY = {INVALID_RESONANCE: "resonance / fast perturber (a fast frequency is close to the perturber's rate)",
+        INVALID_PERTURBATION: "strong perturbation (ε above max_perturbation)",
+        INVALID_SEPARATRIX: "near the separatrix"}
+
+
+@jit
+def free_motion_numbers(elements, ic):
+    """(Ω_min, (C − A)/C, 1 − m, P, Δg) of the free motion of the elements' (S, Z): the slowest fast
+    frequency min |jω_s + kω_g| over |j|, |k| ≤ 2 (not both 0), the asymmetry, the separatrix
+    distance, the period of s and the advance of g over it. Constant along a mean run (S and Z
+    are)."""
+    omega_s, omega_g = fast_frequencies(elements, ic)
+    omega_min = np.inf
+    for j in range(3):
+        for k in range(-2, 3):
+            if j == 0 and k <= 0:
+                continue
+            omega_min = min(omega_min, abs(j * omega_s + k * omega_g))
+    mo = motion_from_elements(abs(elements[0]), elements[1], ic)
+    sep = 0.0 if mo[MO_MODE] == MODE_UNIFORM else mo[MO_PARAM_C]
+    period, nu, _ = torus_frequencies(elements[0], elements[1], ic)
+    return np.array([omega_min, ic[5] / ic[0], sep, period, nu * period])  # (a − c)/a = 1 − A/C
+
+
+@jit
+def perturber_numbers(t, model):
+    """(fastest angular rate |r × v|/r² of a perturber's direction, Σ 3μ/r³, shortest radial time
+    r/|ṙ| of a perturber not on an elliptic Kepler orbit) at time t."""
+    rate_max = 0.0
+    strength = 0.0
+    radial_time = np.inf
+    for p in range(int(model[MODEL_PERTURBERS])):
+        row = MODEL_PERTURBERS + 1 + p * PERTURBER_ROW
+        xv = perturber_state(t, model, row)
+        r2 = xv[0] ** 2 + xv[1] ** 2 + xv[2] ** 2
+        cx = xv[1] * xv[5] - xv[2] * xv[4]
+        cy = xv[2] * xv[3] - xv[0] * xv[5]
+        cz = xv[0] * xv[4] - xv[1] * xv[3]
+        rate_max = max(rate_max, math.sqrt(cx * cx + cy * cy + cz * cz) / r2)
+        strength += 3.0 * model[row + 1] / r2 ** 1.5
+        r_dot = abs(xv[0] * xv[3] + xv[1] * xv[4] + xv[2] * xv[5])  # r·v = r ṙ
+        bound = model[row] == KIND_KEPLER and model[row + 2 + K_E] < 1.0
+        if r_dot > 0.0 and not bound:  # elliptic orbits: the angular-rate limit is enough
+            radial_time = min(radial_time, r2 / r_dot)
+    return rate_max, strength, radial_time
+
+
+@jit
+def validity_numbers(t, model, free):
+    """(Ω_min/n_max, ε, 1 − m) at time t; ``free`` from :func:`free_motion_numbers`."""
+    rate_max, strength, _ = perturber_numbers(t, model)
+    ratio = free[0] / rate_max if rate_max > 0.0 else np.inf
+    return ratio, strength * free[1] / (free[0] * free[0]), free[2]
+
+
+@jit
+def validity_code(t, model, free, thresholds):
+    """VALID or the INVALID_* reason; thresholds = (min ratio, max ε, min separatrix distance)."""
+    rate_max, strength, _ = perturber_numbers(t, model)
+    return _validity_from_numbers(rate_max, strength, free, thresholds)
+
+
+@jit
+def _validity_from_numbers(rate_max, strength, free, thresholds):
+    ratio = free[0] / rate_max if rate_max > 0.0 else np.inf
+    eps = strength * free[1] / (free[0] * free[0])
+    sep = free[2]
+    if not (sep >= thresholds[2]):
+        return INVALID_SEPARATRIX
+    if not (ratio >= thresholds[0]):
+        return INVALID_RESONANCE
+    if not (eps <= thresholds[1]):
+        return INVALID_PERTURBATION
+    return VALID
+
+
+@jit
+def _rhs(t, y, mc, model, frame, ic, kind, dy):
+    if kind == RHS_QUADRATURE:
+        torus_mean_rhs(t, y, model, frame, ic, QUADRATURE_POINTS_S, QUADRATURE_POINTS_Z, dy)
+    else:
+        degree2_mean_rhs(t, y, mc, model, frame, kind == RHS_DEGREE2_ORBIT_AVERAGED, dy)
+
+
+@jit
+def _rk8_step(t, y, h, mc, model, frame, ic, kind, k, tmp, y_new):
+    n = y.shape[0]
+    for s in range(N_STAGES):
+        for i in range(n):
+            tmp[i] = y[i]
+        for j in range(s):
+            a = _A[s, j] * h
+            if a != 0.0:
+                for i in range(n):
+                    tmp[i] += a * k[j, i]
+        _rhs(t + _C[s] * h, tmp, mc, model, frame, ic, kind, k[s])
+    for i in range(n):
+        y_new[i] = y[i]
+    for j in range(N_STAGES):
+        b = _B[j] * h
+        if b != 0.0:
+            for i in range(n):
+                y_new[i] += b * k[j, i]
+
+
+@jit
+def _shift_phase(y, period, advance_g):
+    """:func:`spinorbit.core.element_forces.reduce_phase` with the period P and advance Δg of the
+    (constant) mean S, Z supplied: whole periods out of the working s, Δg each into z."""
+    sign = 1.0 if y[0] >= 0.0 else -1.0
+    periods = np.rint(sign * y[3] / period)
+    if periods != 0.0:
+        y[3] -= sign * periods * period
+        z = y[4] + periods * advance_g
+        y[4] = z - 2.0 * math.pi * np.rint(z / (2.0 * math.pi))
+
+
+@jit
+def mean_elements_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, model, frame, ic, kind, thresholds, free,
+                         out):
+    """Step the mean elements from (t0, el0) to each t_out[i] (rows of ``out``).
+
+    The step is the smallest of ``max_step``, 2π/(steps_per_turn · n) with n the fastest angular
+    rate of a perturber's direction at the step's start, RADIAL_STEP_FRACTION · r/|ṙ| (so a flyby is
+    approached in steps that shrink with the distance, and its start is not stepped over), and the
+    distance to the next output. The validity check (:func:`validity_code` with
+    ``free`` = :func:`free_motion_numbers`) runs before every step; on failure the run stops there.
+
+    Returns (number of outputs written, time reached, elements there, INVALID_* code or VALID, steps).
+    """
+    y = el0.copy()
+    t = t0
+    k = np.empty((N_STAGES, 6))
+    tmp = np.empty(6)
+    y_new = np.empty(6)
+    steps = 0
+    for i in range(t_out.shape[0]):
+        target = t_out[i]
+        direction = 1.0 if target > t else -1.0
+        while t != target:
+            rate, strength, radial_time = perturber_numbers(t, model)
+            code = _validity_from_numbers(rate, strength, free, thresholds)
+            if code != VALID:
+                return i, t, y, code, steps
+            h = max_step
+            if rate > 0.0 and steps_per_turn > 0.0:
+                h = min(h, 2.0 * math.pi / (steps_per_turn * rate), RADIAL_STEP_FRACTION * radial_time)
+            remaining = abs(target - t)
+            # Land on the output: take it in one step if within 1 % of a full step, else never
+            # leave a sliver shorter than half a step.
+            if remaining <= 1.01 * h:
+                h = remaining
+            elif remaining < 1.5 * h:
+                h = 0.5 * remaining
+            _rk8_step(t, y, direction * h, mc, model, frame, ic, kind, k, tmp, y_new)
+            t = target if h == remaining else t + direction * h
+            for c in range(6):
+                y[c] = y_new[c]
+            _shift_phase(y, free[3], free[4])
+            steps += 1
+        for c in range(6):
+            out[i, c] = y[c]
+        reduce_phase(out[i], ic)  # outputs in one representation: |κ s| ≤ 2K
+    return t_out.shape[0], t, y, VALID, steps
+
+
+def averaging_frame(y0, model):
+    """Inertial → reference rotation for (H, h) over a long averaged run.
+
+    The mean angular momentum precesses on a cone about the first perturber's orbit normal n (the
+    doubly averaged motion), so its angle to n stays about constant. The reference z axis is n when
+    that angle is between 45° and 135°, else a unit vector perpendicular to n: either way sin I stays
+    ≥ ~0.7 over the cone, far from the singular set sin I = 0 of (H, h). Without an orbiting
+    perturber, :func:`spinorbit.core.integrate_elements.reference_frame_for`.
+    """
+    moments = moments_of(model)
+    if int(model[MODEL_PERTURBERS]) == 0:
+        return reference_frame_for(y0, moments)
+    row = MODEL_PERTURBERS + 1
+    xv = perturber_state(0.0, model, row)
+    normal = np.cross(xv[:3], xv[3:])
+    if not np.linalg.norm(normal) > 0.0:
+        return reference_frame_for(y0, moments)
+    normal /= np.linalg.norm(normal)
+    w, x, y, z = y0[:4] / np.linalg.norm(y0[:4])
+    rot = np.array([[w * w + x * x - y * y - z * z, 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                    [2 * (x * y + w * z), w * w - x * x + y * y - z * z, 2 * (y * z - w * x)],
+                    [2 * (x * z - w * y), 2 * (y * z + w * x), w * w - x * x - y * y + z * z]])
+    spin = rot @ (moments * y0[4:])
+    spin /= np.linalg.norm(spin)
+    if abs(spin @ normal) < math.sqrt(0.5):
+        axis = normal
+    else:
+        axis = np.cross(normal, spin)
+        axis /= np.linalg.norm(axis)
+    ex = np.cross([0.0, 0.0, 1.0], axis) if abs(axis[2]) < 0.9 else np.cross([1.0, 0.0, 0.0], axis)
+    ex /= np.linalg.norm(ex)
+    ey = np.cross(axis, ex)
+    return np.ascontiguousarray(np.array([ex, ey, axis]))
+
+
+def state_of_elements(elements, frame, moments):
+    """(q, ω) (7,) of signed elements referred to ``frame``."""
+    ic = inertia_constants(*moments)
+    attitude, momentum = attitude_and_momentum(np.ascontiguousarray(elements, dtype=float), ic)
+    q = inertial_quaternion(attitude, frame)
+    return np.concatenate([q, momentum / moments])
+
+
+class AveragedResult:
+    """Output of :func:`propagate_averaged`.
+
+    Attributes
+    ----------
+    t : (n,) ndarray
+        Output times.
+    mean_elements : (n, 6) ndarray
+        Mean signed (S, Z, H, s, z, h) in the reference ``frame`` (s reduced to one period).
+    states : (n, 7) ndarray or None
+        Osculating (q, ω) from mean + short-period corrections (or the full integrator's state inside
+        a hand-over), when ``osculating=True``.
+    segments : list of (t_start, t_end, kind, reason)
+        kind "averaged" or "full"; reason the validity failure that started a "full" segment.
+    frame : (3, 3) ndarray
+        Inertial → reference rotation of H, h.
+    steps : int
+        Steps of the mean equations.
+    """
+
+    def __init__(self, t, mean_elements, states, segments, frame, steps):
+        self.t, self.mean_elements, self.states = t, mean_elements, states
+        self.segments, self.frame, self.steps = segments, frame, steps
+
+
+def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False, quadrature=None,
+                       osculating=False, hand_over=True, min_frequency_ratio=MIN_FREQUENCY_RATIO,
+                       max_perturbation=MAX_PERTURBATION, min_separatrix_distance=MIN_SEPARATRIX_DISTANCE,
+                       handover_chunk=None, rtol=1e-12, frame=None, mean0=None):
+    """Propagate the rotation through mean canonical elements (averaged over the free rotation).
+
+    Parameters
+    ----------
+    y0 : array_like (7,)
+        Osculating initial (q, ω), as for :func:`spinorbit.core.integrate_quaternion.integrate_quaternion`.
+    t0 : float
+        Initial time (model unit).
+    t_out : array_like (n,)
+        Output times, strictly monotone away from t0.
+    model : ndarray
+        :func:`spinorbit.core.dynamics.make_model`.
+    max_step : float, optional
+        Largest step of the mean equations (time unit); the step is also at most
+        2π/(STEPS_PER_TURN · n), n the perturbers' fastest angular rate at the step's start (not
+        when orbit-averaged). Default: the span (span/64 when orbit-averaged).
+    orbit_averaged : bool
+        Average over each perturber's Keplerian orbit as well (doubly averaged; elliptic Kepler
+        perturbers only, others are used at their instantaneous position).
+    quadrature : bool, optional
+        Mean right-hand side by torus quadrature of eq. (11) (any force function, degrees 2–4;
+        ~10³ force evaluations per call). Default: the degree-2 closed form when the figure has
+        degree 2 only, else quadrature.
+    osculating : bool
+        Also return osculating states (short-period corrections at every output).
+    hand_over : bool
+        Hand over to the full integrator where averaging is invalid (else raise ValueError there).
+    min_frequency_ratio, max_perturbation, min_separatrix_distance : float
+        Validity thresholds (module docstring).
+    handover_chunk : float, optional
+        Length of the full-integration chunks between validity checks (default: the longer of the
+        two fundamental periods 2π/ω_s, 2π/ω_g of the free motion; a check costs one conversion).
+    rtol : float
+        Tolerance of the full integrator in hand-overs.
+    frame : (3, 3) ndarray, optional
+        Inertial → reference rotation of H, h (default :func:`averaging_frame`).
+    mean0 : array_like (6,), optional
+        Mean initial elements in ``frame`` (skips the osculating → mean conversion of y0).
+
+    Returns
+    -------
+    AveragedResult
+    """
+    y0 = validate_state(y0)
+    t0 = float(t0)
+    t_out = _validate_times(t0, t_out)
+    model = np.ascontiguousarray(model, dtype=float)
+    validate_sampled_span(model, t0, t_out)
+    moments = moments_of(model)
+    ic = inertia_constants(*moments)
+    if frame is None:
+        frame = averaging_frame(y0, model)
+    frame = np.ascontiguousarray(frame, dtype=float)
+    if quadrature is None:
+        quadrature = model[BODY_NMAX] > 2
+    if quadrature and orbit_averaged:
+        raise ValueError("orbit_averaged=True needs the degree-2 closed form; pass quadrature=False "
+                         "(or drop orbit_averaged for a figure of degree 3–4).")
+    kind = RHS_QUADRATURE if quadrature else (RHS_DEGREE2_ORBIT_AVERAGED if orbit_averaged else RHS_DEGREE2)
+    thresholds = np.array([min_frequency_ratio, max_perturbation, min_separatrix_distance])
+    if mean0 is None:
+        mean = osculating_to_mean(t0, elements_of_state(y0, model, frame), model, frame, ic)
+    else:
+        mean = np.array(mean0, dtype=float)
+    span = abs(t_out[-1] - t0)
+    if max_step is None:
+        max_step = span / 64.0 if orbit_averaged else span
+    # Orbit-averaged: the right-hand side has no orbital time scale left; only max_step limits.
+    steps_per_turn = 0.0 if orbit_averaged else STEPS_PER_TURN
+    omega_s, omega_g = fast_frequencies(mean, ic)
+    if handover_chunk is None:
+        handover_chunk = 2.0 * math.pi / min(abs(omega_s), abs(omega_g))
+    direction = 1.0 if t_out[-1] > t0 else -1.0
+    out_mean = np.full((t_out.size, 6), np.nan)
+    out_state = np.full((t_out.size, 7), np.nan) if osculating else None
+    segments = []
+    t = t0
+    exact = y0  # the last osculating state known without short-period reconstruction, at time t
+    done = 0
+    steps = 0
+    while done < t_out.size:
+        mc = mean_constants(mean[0], mean[1], ic, moments)
+        written, t_stop, y_stop, code, n_steps = mean_elements_kernel(
+            mean, t, t_out[done:], float(max_step), steps_per_turn, mc, model, frame, ic, kind, thresholds,
+            free_motion_numbers(mean, ic),
+            out_mean[done:])
+        steps += n_steps
+        if osculating:
+            for i in range(done, done + written):
+                osc = mean_to_osculating(t_out[i], out_mean[i], model, frame, ic)
+                out_state[i] = state_of_elements(osc, frame, moments)
+        segments.append((t, float(t_stop) if code != VALID else float(t_out[-1]), "averaged", ""))
+        done += written
+        if code == VALID:
+            break
+        if not hand_over:
+            raise ValueError(f"averaging is invalid at t = {t_stop!r}: {_WHY[code]}; allow hand_over=True "
+                             "or integrate this stretch with integrate_quaternion.")
+        # Full integration in chunks until the averaged theory is valid again.
+        if float(t_stop) == t:
+            y = exact  # invalid where the segment starts: continue from the exact state
+        else:
+            t = float(t_stop)
+            y = state_of_elements(mean_to_osculating(t, y_stop, model, frame, ic), frame, moments)
+        reason = _WHY[code]
+        while True:
+            t_next = t + direction * handover_chunk
+            pending = t_out[done:]
+            inside = pending[(pending - t_next) * direction < 0]
+            grid = np.concatenate([inside, [t_next]])
+            ys = integrate_quaternion(y, t, grid, model, rtol=rtol)
+            for i, yi in enumerate(ys[:-1]):
+                el = elements_of_state(yi, model, frame)
+                out_mean[done + i] = osculating_to_mean(float(inside[i]), el, model, frame, ic)
+                if osculating:
+                    out_state[done + i] = yi
+            done += inside.size
+            segments.append((t, float(t_next) if done < t_out.size else float(t_out[-1]), "full", reason))
+            t, y = float(t_next), ys[-1]
+            if done >= t_out.size:
+                break
+            el = elements_of_state(y, model, frame)
+            if validity_code(t, model, free_motion_numbers(el, ic), thresholds) == VALID:
+                mean = osculating_to_mean(t, el, model, frame, ic)
+                exact = y
+                break
+    return AveragedResult(t_out, out_mean, out_state, segments, frame, steps)

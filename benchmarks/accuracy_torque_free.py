@@ -9,7 +9,6 @@ plus heyoka-vs-mpmath, which is the long-double reference's own error.
 
 from __future__ import annotations
 
-import math
 import sys
 from pathlib import Path
 

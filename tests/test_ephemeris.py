@@ -20,7 +20,6 @@ from spinorbit.ephemeris import (
     barycentric_state_km,
     de421_constants,
     moon_libration_angles,
-    moon_orientation,
     moon_orientation_raw,
 )
 

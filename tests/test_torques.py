@@ -36,7 +36,7 @@ from spinorbit.core.perturbers import (
     solve_kepler_elliptic,
     solve_kepler_hyperbolic,
 )
-from spinorbit.core.rotations import quat_multiply, quat_normalize
+from spinorbit.core.rotations import quat_normalize
 
 # Central differences with step h have truncation error ~h²·U''' and rounding ~ε·U/h; h = 1e-5 of
 # the length scale balances them at ~1e-10 relative.

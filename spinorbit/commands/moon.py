@@ -8,7 +8,7 @@ import os
 import sys
 
 from ..cli import CommandError
-from ._common import Progress, atomic_output, check_outputs, quantity
+from ._common import Progress, atomic_output, check_output_path, check_outputs, quantity
 
 #: The models (spinorbit.coupling.moon.MOON_MODELS, repeated so that --help does not import REBOUND).
 MOON_MODELS = ("de421", "rigid", "core-corrected")

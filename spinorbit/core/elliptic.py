@@ -47,7 +47,6 @@ from spinorbit.core.ddouble import (
     dd_div as _dd_div,
     dd_mul as _dd_mul,
     dd_sqrt as _dd_sqrt,
-    quick_two_sum as _quick_two_sum,
     split as _split,
     two_prod as _two_prod,
     two_sum as _two_sum,

@@ -80,32 +80,24 @@ def k_above_one(rng, n):
 def f_below_one(rng, n):
     m, mc = _parameters_below_one(rng, n)
     phi = rng.choice([-1.0, 1.0], n) * _log_uniform(rng, 1e-3, 1e6, n)
-    errors = []
-    for p, a, b in zip(phi, m, mc):
-        exact = mp.ellipf(mp.mpf(p), ref.exact_parameter(a, b))
-        errors.append(ref.relative_error(special.ellipf(p, a, mc=b), exact))
-    return max(errors)
+    return max(ref.relative_error(special.ellipf(p, a, mc=b), mp.ellipf(mp.mpf(p), ref.exact_parameter(a, b)))
+               for p, a, b in zip(phi, m, mc))
 
 
 def pi_negative_characteristic(rng, n):
     m, mc = _parameters_below_one(rng, n)
     f = _log_uniform(rng, 1e-6, 1e30, n)
     phi = rng.uniform(-1.5, 1.5, n)
-    errors = []
-    for p, a, b, g in zip(phi, m, mc, f):
-        exact = ref.ellippi(-mp.mpf(g), p, ref.exact_parameter(a, b))
-        errors.append(ref.relative_error(special.ellippi(-g, p, a, mc=b), exact))
-    return max(errors)
+    return max(ref.relative_error(special.ellippi(-g, p, a, mc=b), ref.ellippi(-mp.mpf(g), p, ref.exact_parameter(a, b)))
+               for p, a, b, g in zip(phi, m, mc, f))
 
 
 def pi_n_equal_m(rng, n):
     m, mc = _parameters_below_one(rng, n)
     phi = rng.uniform(-1.5, 1.5, n)
-    errors = []
-    for p, a, b in zip(phi, m, mc):
-        mm = ref.exact_parameter(a, b)
-        errors.append(ref.relative_error(special.ellippi(a, p, a, mc=b), ref.ellippi(mm, p, mm)))
-    return max(errors)
+    exact_m = [ref.exact_parameter(a, b) for a, b in zip(m, mc)]
+    return max(ref.relative_error(special.ellippi(a, p, a, mc=b), ref.ellippi(mm, p, mm))
+               for p, a, b, mm in zip(phi, m, mc, exact_m))
 
 
 def pn_negative_characteristic(rng, n):
@@ -114,19 +106,15 @@ def pn_negative_characteristic(rng, n):
     m, mc = np.concatenate([m, m2]), np.concatenate([mc, mc2])
     f = _log_uniform(rng, 1e-6, 1e6, n)
     u = rng.choice([-1.0, 1.0], n) * _log_uniform(rng, 1e-3, 1e6, n)
-    errors = []
-    for x, g, a, b in zip(u, f, m, mc):
-        errors.append(ref.relative_error(special.pn(x, -g, a, mc=b), ref.pn(x, -mp.mpf(g), a, b)))
-    return max(errors)
+    return max(ref.relative_error(special.pn(x, -g, a, mc=b), ref.pn(x, -mp.mpf(g), a, b))
+               for x, g, a, b in zip(u, f, m, mc))
 
 
 def pn_n_equal_m(rng, n):
     m, mc = _parameters_below_one(rng, n)
     u = rng.uniform(-20.0, 20.0, n)
-    errors = []
-    for x, a, b in zip(u, m, mc):
-        errors.append(ref.relative_error(special.pn(x, a, a, mc=b), ref.pn(x, ref.exact_parameter(a, b), a, b)))
-    return max(errors)
+    return max(ref.relative_error(special.pn(x, a, a, mc=b), ref.pn(x, ref.exact_parameter(a, b), a, b))
+               for x, a, b in zip(u, m, mc))
 
 
 REGIONS = (

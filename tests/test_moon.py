@@ -141,3 +141,13 @@ def test_long_span_attitude_against_de421(model, years):
     step = 5.0 if years == 5 else 10.0
     comparison = compare_with_de421(moon_at_de421(model=model), years * ONE_YEAR_DAYS, step)
     assert comparison.max_difference_arcsec < LONG_SPAN_BOUNDS_ARCSEC[(model, years)]
+
+
+def test_checkpoints_are_refused_for_the_de421_model(tmp_path):
+    """The one entry point dispatches checkpoints to the coupled models only; de421 says so at once."""
+    from spinorbit.checkpoint import CheckpointSchedule
+    from spinorbit.coupling.moon import compare_model_with_de421
+
+    with pytest.raises(ValueError, match="checkpoints apply to the REBOUND-coupled models"):
+        compare_model_with_de421("de421", 2.0, schedule=CheckpointSchedule(str(tmp_path / "run.ckpt")))
+    assert not (tmp_path / "run.ckpt").exists()

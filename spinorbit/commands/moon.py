@@ -147,7 +147,7 @@ def _checkpoint_schedule(args, span_days: float, step_days: float):
 
 def run(args) -> int:
     """Run ``spinorbit moon``; return the exit status."""
-    from ..coupling.moon import compare_model_with_de421, compare_with_de421, moon_at_de421
+    from ..coupling.moon import compare_model_with_de421
 
     check_outputs(args)
     span = quantity("--span", args.span, "d", "time", "1 yr")
@@ -170,12 +170,9 @@ def run(args) -> int:
         done[0] = n
 
     try:
-        if args.model == "de421":
-            comparison = compare_model_with_de421(args.model, span_days, step, progress=advance)
-        else:
-            moon = moon_at_de421(model=args.model, coupled=not args.one_way)
-            comparison = compare_with_de421(moon, span_days, step, progress=advance, schedule=schedule,
-                                            resume=args.resume, settings=settings)
+        comparison = compare_model_with_de421(args.model, span_days, step, coupled=not args.one_way,
+                                              progress=advance, schedule=schedule, resume=args.resume,
+                                              settings=settings)
     except KeyboardInterrupt:
         if schedule is not None and os.path.exists(schedule.path):
             print(f"{args._prog}: the last checkpoint is '{schedule.path}'; continue with the same options and "

@@ -413,13 +413,19 @@ def compare_interior_with_de421(span_days: float, step_days: float = 1.0, start_
 
 
 def compare_model_with_de421(model: str, span_days: float, step_days: float = 1.0, coupled: bool = True,
-                             progress=None) -> LibrationComparison:
+                             progress=None, schedule=None, resume=None, settings=None) -> LibrationComparison:
     """Any of :data:`MOON_MODELS` from J2000 against DE421 (the CLI's and the example's entry point).
 
     ``coupled`` applies to the rigid models (REBOUND); "de421" is always driven by DE421's orbits.
+    ``schedule``, ``resume`` and ``settings`` (checkpoints, as in :func:`compare_with_de421`) apply to
+    the rigid models only: the "de421" model runs at ≈ 0.1 s per simulated year and has none.
     """
     if model not in MOON_MODELS:
         raise ValueError(f"model: expected one of {MOON_MODELS}, got {model!r}.")
     if model == "de421":
+        if schedule is not None or resume is not None:
+            raise ValueError("checkpoints apply to the REBOUND-coupled models ('rigid', 'core-corrected'); "
+                             "the 'de421' model needs none: drop schedule/resume.")
         return compare_interior_with_de421(span_days, step_days, progress=progress)
-    return compare_with_de421(moon_at_de421(model=model, coupled=coupled), span_days, step_days, progress=progress)
+    return compare_with_de421(moon_at_de421(model=model, coupled=coupled), span_days, step_days, progress=progress,
+                              schedule=schedule, resume=resume, settings=settings)

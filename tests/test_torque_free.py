@@ -28,8 +28,13 @@ from spinorbit.core.torque_free import (
 from spinorbit.core.rotations import quat_to_attitude
 
 # Goal of the long-span work: attitude error after 1e4 rotation periods (rad). Measured against
-# heyoka long double: 8e-14 (HLW), 2e-13 (Apophis-like), which is heyoka's own drift (its energy
-# random-walks at ~1e-18; the body momentum of this package matches mpmath to 6e-28 there).
+# heyoka long double, the difference is heyoka's own drift (its energy random-walks at ~1e-18; the
+# body momentum of this package matches mpmath to 6e-28 there), and that drift depends on heyoka's
+# version: 8e-14 (HLW) and 2e-13 (Apophis-like) with the heyoka of 2026-11, 2.8e-14 and 3.7e-12 with
+# heyoka 7.13.2 (heyoka vs mpmath; this package vs mpmath: 2.1e-16 and 3.3e-16 at the same times).
+# So the heyoka comparison allows the goal plus the reference's own error, measured against the
+# 40-digit solution in the same test (triangle inequality), rather than a number that holds for one
+# heyoka release only.
 LONG_SPAN_TOLERANCE = 1e-12  # rad
 LONG_SPAN_PERIODS = 1.0e4
 # Near the separatrix (m_c = 1e-3) heyoka's long-double reference cannot reach 1e-12 at 1e4 periods:
@@ -121,7 +126,12 @@ def test_long_span_against_heyoka_long_double(case):
     q, m = torque_free_states(q0, momentum, *moments, times)
     error = rotation_angle(q_ref, q)
     tolerance = HEYOKA_NEAR_SEPARATRIX_BOUND if "separatrix" in case else LONG_SPAN_TOLERANCE
-    assert error.max() < tolerance, error
+    # heyoka's own error at these times, against the 40-digit solution: ≤ 1e-10 rad is what a
+    # long-double reference is expected to reach here (measured 7.9e-12 at most), so a broken
+    # reference still fails the test instead of widening it without limit.
+    reference_error = rotation_angle(exact_states(q0, momentum, moments, times)[0], q_ref)
+    assert reference_error.max() < HEYOKA_NEAR_SEPARATRIX_BOUND, reference_error
+    assert np.all(error < tolerance + reference_error), (error, reference_error)
 
 
 @pytest.mark.validation

@@ -356,13 +356,17 @@ class RotationState:
         attitude_user = p.T @ attitude_ref @ elements.reference
         return cls.from_matrix(body, attitude_user, (p.T @ momentum) / body._values)
 
-    def propagate_torque_free(self, dt) -> tuple[np.ndarray, u.Quantity]:
+    def propagate_torque_free(self, dt, closed_forms=True) -> tuple[np.ndarray, u.Quantity]:
         """Exact torque-free motion (paper eq. 12) at times ``dt`` after this state.
 
         Parameters
         ----------
         dt : Quantity or array_like
             Time offsets (days if plain floats), scalar or 1-D.
+        closed_forms : bool
+            True (default): a body with two exactly equal moments takes the regular precession in
+            closed form (``spinorbit.core.regular_precession``, trig only); False: the elliptic flow
+            at parameter 0 (same result to ~1e-15 rad, for comparisons).
 
         Returns
         -------
@@ -378,7 +382,8 @@ class RotationState:
         attitude, momentum = self._principal()
         p = self._body._to_principal
         principal_q, principal_m = _torque_free.torque_free_states(
-            _rotations.attitude_to_quat(attitude), momentum, *self._body.principal_moments, times
+            _rotations.attitude_to_quat(attitude), momentum, *self._body.principal_moments, times,
+            closed_forms=closed_forms,
         )
         # v_inertial = M(q_p) v_principal = M(q_p) P v_user, so q_user = q_p ⊗ q(P).
         p0, p1, p2, p3 = _rotations.matrix_to_quat(np.ascontiguousarray(p))

@@ -18,11 +18,9 @@ from hypothesis import strategies as st
 from spinorbit import RigidBody, RotationState
 from spinorbit.body import InvalidBodyError
 from spinorbit.core import SingularElementsError, canonical_to_andoyer
-from spinorbit.core.canonical import elements_from_state, inertia_constants, state_from_elements, symmetric_gap_resolved
-from spinorbit.core.rotations import attitude_to_quat, euler313_to_attitude
+from spinorbit.core.canonical import inertia_constants, symmetric_gap_resolved
+from spinorbit.core.rotations import euler313_to_attitude
 from spinorbit.state import ANDOYER_G_RANGE, InvalidStateError
-
-from .test_phase_space_floor import ROUND_TRIP_FLOORS, one_ulp_floor, state_distance
 
 #: Any float, including NaN, ±inf, subnormals and ±1e308.
 wild = st.floats(allow_nan=True, allow_infinity=True)
@@ -118,6 +116,8 @@ def test_canonical_elements_round_trip_or_singular(moments, q, omega):
 # elliptic argument is ∝ √gap (gap = d − c for B = C, a − d for A = B), which the backward map must
 # take from S and Z. Found by the fuzzing above: (1, 1, 0.5) with ω_z = 1e-100 gave finite elements
 # (s = 4e100) that mapped back to a non-finite attitude; (724, 1, 724), ω = (0, 3e-4, 709) too.
+# Just above the resolution the round trip is the elements' conditioning, ε d / gap, within the floor
+# of the map: the "B = C, spin … from the B–C plane" cases of tests/stress/test_phase_space_floor.py.
 UNRESOLVED = [
     ((1.0, 1.0, 0.5), [0.0, 0.0, 0.0, 1.0], [1.0, 0.0, 1e-100]),
     ((1.0, 1.0, 0.5), [0.0, 0.0, 0.0, 1.0], [1.0, 0.0, 1e-12]),
@@ -148,28 +148,3 @@ def test_backward_map_refuses_elements_at_a_symmetric_permanent_rotation():
         canonical_to_andoyer(at_rotation.S, at_rotation.Z, at_rotation.H, at_rotation.s, at_rotation.z,
                              at_rotation.h, *body.principal_moments)
     assert not symmetric_gap_resolved(at_rotation.S, at_rotation.Z, ic)
-
-
-#: Just above the resolution the round trip is the elements' conditioning, ε d / gap (1/ω_z²), not a
-#: defect: it stays within the floor of the backward map (tests/stress/test_phase_space_floor.py:
-#: the change of the state for two ulps of each element). Measured error / floor: 8.8e-10 / 7.0e-9
-#: = 0.13 (ω_z = 1e-3), 1.4e-4 / 7.0e-3 = 0.02 (1e-6), 0.18 / 0.78 = 0.23 (1e-7, where the floor
-#: itself is most of a radian); ROUND_TRIP_FLOORS = 2 as in that file.
-@pytest.mark.parametrize("omega_z", [1e-3, 1e-6, 1e-7])
-def test_round_trip_next_to_a_symmetric_permanent_rotation_is_at_the_floor(omega_z):
-    body = RigidBody((1.0, 1.0, 0.5))
-    state = RotationState(body, np.array([0.3, 0.5, -0.2, 0.787]) / np.linalg.norm([0.3, 0.5, -0.2, 0.787]),
-                          [1.0, 0.0, omega_z])
-    attitude, momentum = state._principal()
-    ic = inertia_constants(*body.principal_moments)
-    elements, flip, _ = elements_from_state(attitude, momentum, ic)
-    scale = float(np.linalg.norm(momentum))
-
-    def backward(el):
-        r, m = state_from_elements(el, flip, ic)
-        return attitude_to_quat(r), m
-
-    back = backward(elements)
-    floor = one_ulp_floor(elements, backward, back, scale)
-    error = state_distance(attitude_to_quat(attitude), momentum, *back, scale)
-    assert np.all(np.isfinite(back[0])) and error <= ROUND_TRIP_FLOORS * floor, (error, floor)

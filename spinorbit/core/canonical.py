@@ -238,7 +238,8 @@ def symmetric_gap_resolved(big_s, big_z, ic):
     with it every angle of the state, is not determined by the elements in double precision: they
     are singular there (s ~ 1/√gap is finite but carries no phase), like the permanent rotation
     itself. Above it the round trip degrades like ε d / gap, which is the elements' own
-    conditioning (``tests/stress/test_fuzz.py`` measures it against the floor of the map). Triaxial
+    conditioning (``tests/stress/test_phase_space_floor.py`` measures it against the floor of the
+    map; ``tests/stress/test_fuzz.py`` the refusals). Triaxial
     bodies: always True (their gaps to C and A enter only the amplitudes).
     """
     a, b, c, a_b, b_c, a_c = ic

@@ -644,7 +644,9 @@ def uniform_rotation(attitude, momentum, big_a, big_b, big_c, t):
     """Attitude matrix at time t of a permanent rotation (ω = I⁻¹M parallel to M).
 
     R(t) = R_ω(t) R0, R_ω(t) the passive rotation by |ω| t about ω, with |ω| t/2 carried in
-    double-double (the same path as :func:`torque_free_states` for MODE_UNIFORM).
+    double-double (the same path as :func:`torque_free_states` for MODE_UNIFORM; a symmetric body
+    takes the regular precession, which is this uniform rotation when the spin is perpendicular to
+    its symmetry axis).
     """
     times = np.array([t])
     return torque_free_attitudes(attitude, momentum, big_a, big_b, big_c, times)[0]

@@ -381,7 +381,7 @@ class Scene:
         else:
             decisions.append(Decision("outputs", f"{self.output_days.size} output times (dense output)",
                                       "several output times were asked"))
-        shape = self._shape_decision()
+        shape = self._shape_decision(skip)
         if not self.named and not self.fixed:
             decisions.append(Decision("route", "exact torque-free solution, no integration",
                                       "the scene has no perturbers: the torque is zero"))
@@ -436,17 +436,41 @@ class Scene:
         return Plan("one-way", source, kept, tuple(dropped), estimates, integrator, rtol, self.end_only,
                     tolerance, kappa, used, not skip, decisions, samples)
 
-    def _shape_decision(self):
-        body = self.state.body
+    def _shape_decision(self, skip=True):
+        """Which form of the exact free flow the torque-free route runs (the dispatch of ``core.torque_free``).
+
+        ``skip=False`` (the reference plan) runs the elliptic flow for every body, so that the closed
+        form's saving and agreement can be measured against it.
+        """
+        from .core.regular_precession import NO_SYMMETRY_AXIS, symmetry_axis
+
+        big_a, big_b, big_c = self.state.body.principal_moments
+        axis = symmetry_axis(big_a, big_b, big_c)
+        if axis != NO_SYMMETRY_AXIS and not skip:
+            return Decision("closed form", "elliptic free flow at parameter 0 (closed form not taken)",
+                            "skip=False (reference run): two principal moments are equal, but the reference plan "
+                            "runs the general elliptic flow")
+        if axis != NO_SYMMETRY_AXIS:
+            which = "A = B = C, a sphere" if big_a == big_c else (
+                "A = B: symmetry axis C" if axis == 2 else "B = C: symmetry axis A")
+            return Decision("closed form", "regular precession in closed form (core.regular_precession: two sin/cos "
+                            "per output, no elliptic function)",
+                            f"two principal moments are exactly equal ({which}): exact, same accuracy as the "
+                            "elliptic flow at parameter 0 and cheaper per output (docs/performance.md)")
         mode = self.state.mode
         if mode == "permanent rotation":
             return Decision("closed form", "uniform rotation (no elliptic functions)",
-                            "the spin is along a principal axis or the body is symmetric about it")
-        if body.is_axisymmetric:
-            return Decision("closed form", "regular precession (elliptic parameter m = 0)",
-                            "two principal moments are equal: sn, cn, dn reduce to sin, cos, 1")
-        return Decision("closed form", f"elliptic free flow, {mode}",
-                        "triaxial body: Jacobi functions and the secular pn of eq. (12)")
+                            "the spin is exactly along the intermediate axis B (a permanent rotation; spin along A or "
+                            "C takes the elliptic flow at parameter 0)")
+        asymmetry = min(big_b - big_a, big_c - big_b) / big_c
+        _, momentum = self.state._principal()
+        wobble = float(min(np.hypot(momentum[0], momentum[1]), np.hypot(momentum[1], momentum[2]))
+                       / np.linalg.norm(momentum))
+        return Decision("closed form", f"elliptic free flow, {mode} (exact; no approximate form taken)",
+                        f"triaxial body (smallest moment gap / C = {asymmetry:.3g}, wobble sin(angle of M from the A or C axis) = {wobble:.3g}): "
+                        "Jacobi functions and the secular pn of eq. (12). A regular precession or small-wobble "
+                        "approximation would make a phase error that grows with the span and has no tested bound "
+                        "here, so it is not used")
 
     def _survey(self, source, kappa, momentum, moments, keep=True):
         """Per-perturber bounds (planner module docstring) from a survey of the distances.
@@ -533,7 +557,7 @@ class Scene:
         report = progress or (lambda fraction: None)
         report(0.0)
         if plan.route == "torque-free":
-            table = self._torque_free_table()
+            table = self._torque_free_table(closed_forms=not plan.full)
             parts = {"dropped": plan.dropped_bound_rad, "integration": 0.0, "sampling": 0.0}
             stats = {}
         else:
@@ -549,9 +573,9 @@ class Scene:
     def _times(self):
         return time_from_tdb_days(self.output_days)
 
-    def _torque_free_table(self):
+    def _torque_free_table(self, closed_forms=True):
         offsets = self.output_days - self.epoch_day
-        quaternions, omegas = self.state.propagate_torque_free(offsets)
+        quaternions, omegas = self.state.propagate_torque_free(offsets, closed_forms=closed_forms)
         states = [RotationState(self.state.body, q, w) for q, w in zip(quaternions, omegas.value)]
         return self._table(states)
 

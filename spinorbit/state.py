@@ -51,6 +51,19 @@ class InvalidStateError(ValueError):
     """The attitude or spin given cannot describe a rotation state."""
 
 
+def _unresolved_gap_message(big_s, big_z, moments, what):
+    """Why (S, Z) of an axisymmetric body within rounding of a permanent rotation are refused."""
+    big_a, big_b, big_c = moments
+    equal = "B = C" if big_b == big_c else "A = B"
+    return (
+        f"{what}: the body is axisymmetric ({equal}) and the spin is within rounding of its permanent rotation "
+        f"perpendicular to the symmetry axis (S = {big_s!r}, Z = {big_z!r}): S and Z "
+        "cannot resolve the gap d − c (B = C) or a − d (A = B) that sets the rate of the elliptic argument, so the "
+        "canonical elements carry no phase there (spinorbit.core.canonical.symmetric_gap_resolved). "
+        "propagate_torque_free still works (regular precession in closed form); use the attitude and spin directly."
+    )
+
+
 def _as_quaternion(q) -> np.ndarray:
     q = np.asarray(q, dtype=float)
     if q.shape != (4,):
@@ -343,6 +356,9 @@ class RotationState:
         attitude, momentum = self._principal()
         frame = self._reference_frame(reference)
         ic = _canonical.inertia_constants(*moments)
+        if not _canonical.symmetric_gap_resolved(mo[_canonical.MO_S], mo[_canonical.MO_G], ic):
+            raise SingularElementsError(_unresolved_gap_message(
+                float(mo[_canonical.MO_S]), float(mo[_canonical.MO_G]), moments, "this state"))
         elements, flip, mode = _canonical.elements_from_state(attitude @ frame.T, momentum, ic)
         return CanonicalElements(*(float(x) for x in elements), flip=int(flip), mode=MODE_NAMES[mode], reference=frame)
 
@@ -350,19 +366,28 @@ class RotationState:
     def from_canonical_elements(cls, body: RigidBody, elements: CanonicalElements) -> "RotationState":
         """The state of given canonical elements (paper eqs. 7–8), in the elements' reference frame."""
         ic = _canonical.inertia_constants(*body.principal_moments)
+        mo = _canonical.motion_from_elements(abs(elements.S), elements.Z, ic)
+        if mo[_canonical.MO_MODE] == _canonical.MODE_UNIFORM or not _canonical.symmetric_gap_resolved(
+                abs(elements.S), elements.Z, ic):
+            raise SingularElementsError(_unresolved_gap_message(
+                elements.S, elements.Z, body.principal_moments, "these elements"))
         values = np.array([elements.S, elements.Z, elements.H, elements.s, elements.z, elements.h])
         attitude_ref, momentum = _canonical.state_from_elements(values, elements.flip, ic)
         p = body._to_principal
         attitude_user = p.T @ attitude_ref @ elements.reference
         return cls.from_matrix(body, attitude_user, (p.T @ momentum) / body._values)
 
-    def propagate_torque_free(self, dt) -> tuple[np.ndarray, u.Quantity]:
+    def propagate_torque_free(self, dt, closed_forms=True) -> tuple[np.ndarray, u.Quantity]:
         """Exact torque-free motion (paper eq. 12) at times ``dt`` after this state.
 
         Parameters
         ----------
         dt : Quantity or array_like
             Time offsets (days if plain floats), scalar or 1-D.
+        closed_forms : bool
+            True (default): a body with two exactly equal moments takes the regular precession in
+            closed form (``spinorbit.core.regular_precession``, trig only); False: the elliptic flow
+            at parameter 0 (same result to ~1e-15 rad, for comparisons).
 
         Returns
         -------
@@ -378,7 +403,8 @@ class RotationState:
         attitude, momentum = self._principal()
         p = self._body._to_principal
         principal_q, principal_m = _torque_free.torque_free_states(
-            _rotations.attitude_to_quat(attitude), momentum, *self._body.principal_moments, times
+            _rotations.attitude_to_quat(attitude), momentum, *self._body.principal_moments, times,
+            closed_forms=closed_forms,
         )
         # v_inertial = M(q_p) v_principal = M(q_p) P v_user, so q_user = q_p ⊗ q(P).
         p0, p1, p2, p3 = _rotations.matrix_to_quat(np.ascontiguousarray(p))

@@ -54,6 +54,40 @@ def test_no_perturbers_is_the_exact_free_motion():
     assert result.error_estimate.value == 0.0
 
 
+def _closed_form_decision(plan):
+    return next(d for d in plan.decisions if d.topic == "closed form")
+
+
+@pytest.mark.parametrize("moments", [(1.0, 1.0, 2.0), (0.5, 1.0, 1.0)], ids=["oblate A = B", "prolate B = C"])
+def test_axisymmetric_body_takes_the_regular_precession_within_tolerance_of_the_elliptic_run(moments, monkeypatch):
+    # Skip: the closed form. Taken for an exactly symmetric body; the reference plan runs the elliptic
+    # flow; the two runs agree far inside the tolerance (both exact: ~1e-15 rad, test_regular_precession).
+    state = RotationState.from_euler313(RigidBody(moments), 10 * u.deg, 40 * u.deg, 70 * u.deg,
+                                        [5, 3, 40] * u.deg / u.hour)
+    scene = Scene(state, EPOCH, EPOCH + np.linspace(1.0, 3000.0, 50) * u.day, tolerance=1e-12 * u.rad)
+    plan, reference = scene.plan(), scene.plan(skip=False)
+    assert _closed_form_decision(plan).choice.startswith("regular precession in closed form"), str(plan)
+    assert "closed form not taken" in _closed_form_decision(reference).choice, str(reference)
+    kernels = []  # what each run asked the free flow for: the plan's words must be what runs
+    propagate = RotationState.propagate_torque_free
+    monkeypatch.setattr(RotationState, "propagate_torque_free",
+                        lambda self, dt, closed_forms=True: kernels.append(closed_forms) or propagate(self, dt, closed_forms))
+    skipped, full = scene.run(plan), scene.run(reference)
+    assert kernels == [True, False]
+    assert worst_difference(skipped, full) <= min(scene.tolerance_rad, 1e-14)
+
+
+def test_nearly_symmetric_or_principal_axis_states_keep_the_exact_elliptic_flow():
+    # One ulp from symmetric, 1e-6 rad of wobble: no approximate form is claimed or run.
+    body = RigidBody([1.0, np.nextafter(1.0, 2.0), 2.0])
+    state = RotationState.from_angular_momentum(body, [1.0, 0.0, 0.0, 0.0], [1e-6, 0.0, 1.0])
+    decision = _closed_form_decision(Scene(state, EPOCH, EPOCH + 1 * u.day).plan())
+    assert decision.choice.startswith("elliptic free flow") and "no approximate form" in decision.choice
+    assert "no tested bound" in decision.reason and "wobble" in decision.reason
+    permanent = RotationState(RigidBody([0.61, 0.965, 1.0]), [1.0, 0.0, 0.0, 0.0], [0.0, 2.0, 0.0])
+    assert _closed_form_decision(Scene(permanent, EPOCH, EPOCH + 1 * u.day).plan()).choice.startswith("uniform")
+
+
 def test_torque_free_route_taken_when_the_torques_are_below_tolerance_and_stays_within_it():
     # Body on a 2.5 au circle, Sun and Jupiter, 0.2 d: all torques bounded by 0.05 arcsec (measured).
     scene = Scene(sam_state(), EPOCH, EPOCH + np.linspace(0.05, 0.2, 4) * u.day, perturbers=("sun", "jupiter"),

@@ -217,7 +217,40 @@ def motion_from_elements(big_s, big_z, ic):
         mode = MODE_SAM if (a_b > 0.0 and b_c > 0.0) else MODE_UNIFORM
     if mode == MODE_SAM and (a_b <= 0.0 or b_c <= 0.0) and a_d <= 0.0:
         mode = MODE_UNIFORM
+    if mode == MODE_LAM and b_c <= 0.0 and d_c <= 0.0:  # B = C, spin in the B–C plane (d = c)
+        mode = MODE_UNIFORM
     return motion_constants(mode, big_z, d_c, a_d, b_d, a, b, c, a_b, b_c, a_c)
+
+
+# (S, Z) resolve the gap of an axisymmetric body's motion to its permanent rotation only to about
+# this many units of roundoff (relative to a or d): one ulp each of S and Z moves d = a S²/Z² by
+# ≈ 2ε d and (Z − S)(Z + S) by ≈ 2ε Z², and the backward map adds ≈ 2ε of its own.
+GAP_RESOLUTION_ULPS = 4.0
+
+
+@jit
+def symmetric_gap_resolved(big_s, big_z, ic):
+    """False if (S, Z) of an axisymmetric body cannot tell its motion from the permanent rotation.
+
+    For B = C the rate of the elliptic argument is ∝ √(d − c) (LAM, eq. 8), for A = B ∝ √(a − d)
+    (SAM): the backward map needs that gap from S and Z, where it is a difference of nearly equal
+    numbers known to ≈ ``GAP_RESOLUTION_ULPS`` ε (relative to d, resp. a). Below that the gap, and
+    with it every angle of the state, is not determined by the elements in double precision: they
+    are singular there (s ~ 1/√gap is finite but carries no phase), like the permanent rotation
+    itself. Above it the round trip degrades like ε d / gap, which is the elements' own
+    conditioning (``tests/stress/test_phase_space_floor.py`` measures it against the floor of the
+    map; ``tests/stress/test_fuzz.py`` the refusals). Triaxial
+    bodies: always True (their gaps to C and A enter only the amplitudes).
+    """
+    a, b, c, a_b, b_c, a_c = ic
+    z2 = big_z * big_z
+    d = a * big_s * big_s / z2
+    eps = np.finfo(np.float64).eps
+    if b_c <= 0.0 < a_b:
+        return d - c > GAP_RESOLUTION_ULPS * eps * d
+    if a_b <= 0.0 < b_c:
+        return a * (big_z - big_s) * (big_z + big_s) / z2 > GAP_RESOLUTION_ULPS * eps * a
+    return True
 
 
 @jit
@@ -428,7 +461,7 @@ def canonical_from_andoyer_scalar(big_l, big_g, big_h, l, g, h, ic):
     sl, cl = math.sin(l), math.cos(l)
     mx, my, mz = transverse * sl, transverse * cl, big_l
     mo, flip = motion_from_momentum(mx, my, mz, ic)
-    if mo[MO_MODE] == MODE_UNIFORM:
+    if mo[MO_MODE] == MODE_UNIFORM or not symmetric_gap_resolved(mo[MO_S], big_g, ic):
         return nan, nan, nan, nan, nan, nan, STATUS_PERMANENT_ROTATION
     if flip == FLIP_A or flip == FLIP_C:
         return nan, nan, nan, nan, nan, nan, STATUS_SEPARATRIX_ARC
@@ -456,7 +489,7 @@ def andoyer_from_canonical_scalar(big_s, big_z, big_h, s, z, h, ic):
     if flipped:
         big_s, s = -big_s, -s
     mo = motion_from_elements(big_s, big_z, ic)
-    if mo[MO_MODE] == MODE_UNIFORM:
+    if mo[MO_MODE] == MODE_UNIFORM or not symmetric_gap_resolved(big_s, big_z, ic):
         return np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, STATUS_PERMANENT_ROTATION
     mk, pk = elliptic_constants(mo)
     arg = s * mo[MO_ARG_PER_S]

@@ -107,3 +107,18 @@ def dd_remainder(xh, xl, ph, pl):
     ql += j * pl
     rh, rl = dd_add(xh, xl, -qh, -ql)
     return j, rh + rl
+
+
+@jit
+def dd_scale(xh, xl, t):
+    """(xh + xl) · t for a double t, as a double-double (a rate times a time, the phase of a flow)."""
+    ph, pl = two_prod(xh, t)
+    return dd_add(ph, pl, xl * t, 0.0)
+
+
+@jit
+def dd_difference_ratio(big_x, big_y):
+    """(Y − X)/(X Y) = 1/X − 1/Y as a double-double, exact inputs X, Y (a − b = (B − A)/(AB))."""
+    dh, dl = two_sum(big_y, -big_x)
+    ph, pl = two_prod(big_x, big_y)
+    return dd_div(dh, dl, ph, pl)

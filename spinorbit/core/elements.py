@@ -58,7 +58,8 @@ def _raise_for_status(status, shape, direction):
     if status[index] == _canonical.STATUS_PERMANENT_ROTATION:
         raise SingularElementsError(
             f"{where} is a permanent rotation (spin exactly about the intermediate axis B, or a degenerate "
-            "state of a symmetric body or sphere): the canonical elements are infinite there. "
+            "state of a symmetric body or sphere, or one so close to it that S and Z cannot resolve the gap): "
+            "the canonical elements are infinite or carry no phase there. "
             "Propagate it with spinorbit.RotationState, which treats it as a uniform rotation."
         )
     raise SingularElementsError(

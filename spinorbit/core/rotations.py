@@ -20,6 +20,17 @@ from ._jit import jit
 
 
 @jit
+def qmul_parts(a0, a1, a2, a3, b0, b1, b2, b3):
+    """Hamilton product a ⊗ b of scalar-first quaternions given as components (no allocation)."""
+    return (
+        a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3,
+        a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
+        a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1,
+        a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0,
+    )
+
+
+@jit
 def quat_multiply(p, q):
     """Hamilton product p ⊗ q of two scalar-first quaternions."""
     out = np.empty(4)

@@ -37,6 +37,10 @@ double inputs (A, B, C, M):
 The reduced r then goes to the double kernels (one sn/cn/dn, one Π of the principal range: the
 pn of r), whose errors are bounded and do not grow. Measured errors are in ``docs/torque_free.md``.
 
+Bodies with two exactly equal moments (and spheres) do not come here: the loops below send them to
+the regular precession in closed form (:mod:`.regular_precession`, trig only, the same double-double
+phase treatment), unless ``closed_forms=False``.
+
 Output convention: quaternions scalar first, body → inertial (``docs/conventions.md``), and body
 angular momenta, in the user's principal-axis body frame.
 """
@@ -70,13 +74,14 @@ from .ddouble import (
     TWO_PI_HI,
     TWO_PI_LO,
     dd_add,
+    dd_difference_ratio as _dd_difference_ratio,
     dd_div,
     dd_mul,
     dd_remainder,
     dd_remainder_dd,
+    dd_scale as _dd_scale,
     dd_sqrt,
     two_prod,
-    two_sum,
 )
 from .elliptic import (
     MK_K_HI,
@@ -96,7 +101,8 @@ from .elliptic import (
     pn_k,
     sncndn_k,
 )
-from .rotations import attitude_to_quat, matrix_to_quat, quat_to_attitude
+from .regular_precession import NO_SYMMETRY_AXIS, evaluate_precession, precession_constants, symmetry_axis
+from .rotations import attitude_to_quat, matrix_to_quat, qmul_parts as _qmul, quat_to_attitude
 
 # The double-double AGM for K and Π stops when both the AGM gap and the last term of the Π series
 # are below this fraction of the result: the double-double unit roundoff is 2^-106 ≈ 1.2e-32.
@@ -208,14 +214,6 @@ def complete_k_pi_dd(f_hi, f_lo, mc_hi, mc_lo):
 
 
 @jit
-def _dd_difference_ratio(big_x, big_y):
-    """(Y − X)/(X Y) = 1/X − 1/Y as a double-double, exact inputs X, Y (a − b = (B − A)/(AB))."""
-    dh, dl = two_sum(big_y, -big_x)
-    ph, pl = two_prod(big_x, big_y)
-    return dd_div(dh, dl, ph, pl)
-
-
-@jit
 def _dd_lin(ah, al, xh, xl, bh, bl, yh, yl):
     """a·x + b·y for double-doubles."""
     uh, ul = dd_mul(ah, al, xh, xl)
@@ -292,13 +290,6 @@ def phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c):
     kh, kl, pih, pil = complete_k_pi_dd(fh, fl, pch, pcl)
     wh, wl = dd_mul(kah, kal, 2.0 * pih, 2.0 * pil)
     return nuh, nul, 2.0 * kh, 2.0 * kl, cgh, cgl, wh, wl, kah, kal, param, pch, -fh, 1.0
-
-
-@jit
-def _dd_scale(xh, xl, t):
-    """(xh + xl) · t for a double t, as a double-double."""
-    ph, pl = two_prod(xh, t)
-    return dd_add(ph, pl, xl * t, 0.0)
 
 
 # --------------------------------------------------------------------------------------------------
@@ -427,17 +418,6 @@ def _half_angles(sin_x, cos_x):
 
 
 @jit
-def _qmul(a0, a1, a2, a3, b0, b1, b2, b3):
-    """Hamilton product a ⊗ b of scalar-first quaternions given as components."""
-    return (
-        a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3,
-        a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
-        a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1,
-        a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0,
-    )
-
-
-@jit
 def _reduced_half(xh, xl):
     """(x/2) reduced modulo 2π, from a double-double x (the half angle of a quaternion)."""
     _, r = dd_remainder(0.5 * xh, 0.5 * xl, TWO_PI_HI, TWO_PI_LO)
@@ -517,16 +497,24 @@ def evaluate_flow(t, flow, mo, mk, pk, q_out, m_out):
 
 
 @jit
-def propagate_many_into(quaternions, momenta, moments, times, q_out, m_out):
+def propagate_many_into(quaternions, momenta, moments, times, q_out, m_out, closed_forms=True):
     """Kernel: N states × T times into preallocated (N, T, 4) and (N, T, 3) arrays.
 
-    ``moments`` is (N, 3) (broadcast by the caller for shared moments).
+    ``moments`` is (N, 3) (broadcast by the caller for shared moments). ``closed_forms``: bodies with
+    two equal moments take the regular precession (:mod:`.regular_precession`, trig only) instead
+    of the elliptic flow at parameter 0; False forces the elliptic flow (tests, benchmarks).
     """
     for i in range(quaternions.shape[0]):
         if momenta[i, 0] == 0.0 and momenta[i, 1] == 0.0 and momenta[i, 2] == 0.0:
             for k in range(times.shape[0]):  # no rotation at all
                 q_out[i, k, :] = quaternions[i]
                 m_out[i, k, :] = 0.0
+            continue
+        axis = symmetry_axis(moments[i, 0], moments[i, 1], moments[i, 2]) if closed_forms else NO_SYMMETRY_AXIS
+        if axis != NO_SYMMETRY_AXIS:
+            pc = precession_constants(quaternions[i], momenta[i], moments[i, 0], moments[i, 1], moments[i, 2], axis)
+            for k in range(times.shape[0]):
+                evaluate_precession(times[k], pc, q_out[i, k], m_out[i, k])
             continue
         flow, mo, mk, pk = flow_constants(
             quaternions[i], momenta[i], moments[i, 0], moments[i, 1], moments[i, 2]
@@ -552,7 +540,7 @@ def _as_states(quaternions, momenta, moments):
     return q, m, np.ascontiguousarray(inertia)
 
 
-def torque_free_states_many(quaternions, momenta, moments, times):
+def torque_free_states_many(quaternions, momenta, moments, times, closed_forms=True):
     """Exact torque-free attitudes and body momenta of N states at T times (paper eq. 12).
 
     Parameters
@@ -565,6 +553,10 @@ def torque_free_states_many(quaternions, momenta, moments, times):
         Principal moments A ≤ B ≤ C (mass·length²), shared or one row per state.
     times : (T,) array_like
         Times since the epoch of the states (the time unit of the momenta).
+    closed_forms : bool
+        True (default): states of bodies with two exactly equal moments take the regular
+        precession in closed form (:mod:`.regular_precession`: two sin/cos, no elliptic function);
+        False: every state takes the elliptic flow (for comparisons).
 
     Returns
     -------
@@ -583,11 +575,11 @@ def torque_free_states_many(quaternions, momenta, moments, times):
     t = np.ascontiguousarray(times, dtype=np.float64).reshape(-1)
     q_out = np.empty((q.shape[0], t.shape[0], 4))
     m_out = np.empty((q.shape[0], t.shape[0], 3))
-    propagate_many_into(q, m, inertia, t, q_out, m_out)
+    propagate_many_into(q, m, inertia, t, q_out, m_out, bool(closed_forms))
     return q_out, m_out
 
 
-def torque_free_states(quaternion, momentum, big_a, big_b, big_c, times):
+def torque_free_states(quaternion, momentum, big_a, big_b, big_c, times, closed_forms=True):
     """Exact torque-free attitude and body momentum of one state at T times (paper eq. 12).
 
     Parameters
@@ -600,6 +592,8 @@ def torque_free_states(quaternion, momentum, big_a, big_b, big_c, times):
         Principal moments A ≤ B ≤ C (mass·length²).
     times : (T,) array_like
         Times since the epoch of the state.
+    closed_forms : bool
+        As in :func:`torque_free_states_many`.
 
     Returns
     -------
@@ -609,7 +603,8 @@ def torque_free_states(quaternion, momentum, big_a, big_b, big_c, times):
         Body angular momenta.
     """
     q_out, m_out = torque_free_states_many(
-        np.reshape(quaternion, (1, 4)), np.reshape(momentum, (1, 3)), (big_a, big_b, big_c), times
+        np.reshape(quaternion, (1, 4)), np.reshape(momentum, (1, 3)), (big_a, big_b, big_c), times,
+        closed_forms,
     )
     return q_out[0], m_out[0]
 
@@ -618,7 +613,8 @@ def torque_free_states(quaternion, momentum, big_a, big_b, big_c, times):
 def torque_free_attitudes(attitude, momentum, big_a, big_b, big_c, times):
     """Exact torque-free attitude matrices (inertial → body) at many times, (T, 3, 3) (eq. 12).
 
-    Matrix form of :func:`torque_free_states` for callers that hold attitude matrices.
+    Matrix form of :func:`torque_free_states` for callers that hold attitude matrices (closed form
+    for axisymmetric bodies, as there).
     """
     n = times.shape[0]
     out = np.empty((n, 3, 3))
@@ -628,6 +624,13 @@ def torque_free_attitudes(attitude, momentum, big_a, big_b, big_c, times):
     if momentum[0] == 0.0 and momentum[1] == 0.0 and momentum[2] == 0.0:
         for i in range(n):
             out[i] = attitude
+        return out
+    axis = symmetry_axis(big_a, big_b, big_c)
+    if axis != NO_SYMMETRY_AXIS:
+        pc = precession_constants(q0, momentum, big_a, big_b, big_c, axis)
+        for i in range(n):
+            evaluate_precession(times[i], pc, q, m)
+            out[i] = quat_to_attitude(q)
         return out
     flow, mo, mk, pk = flow_constants(q0, momentum, big_a, big_b, big_c)
     for i in range(n):
@@ -641,7 +644,9 @@ def uniform_rotation(attitude, momentum, big_a, big_b, big_c, t):
     """Attitude matrix at time t of a permanent rotation (ω = I⁻¹M parallel to M).
 
     R(t) = R_ω(t) R0, R_ω(t) the passive rotation by |ω| t about ω, with |ω| t/2 carried in
-    double-double (the same path as :func:`torque_free_states` for MODE_UNIFORM).
+    double-double (the same path as :func:`torque_free_states` for MODE_UNIFORM; a symmetric body
+    takes the regular precession, which is this uniform rotation when the spin is perpendicular to
+    its symmetry axis).
     """
     times = np.array([t])
     return torque_free_attitudes(attitude, momentum, big_a, big_b, big_c, times)[0]

@@ -6,10 +6,13 @@ perturbers, the orbits as given, nothing left out), actually run. Numbers in com
 on the shared 2-core machine when the tests were written.
 """
 
+import math
 
 import numpy as np
 import pytest
+import rebound
 from _offline import no_network  # noqa: F401
+from astropy import constants as const
 from astropy import units as u
 from astropy.time import Time
 
@@ -19,10 +22,14 @@ from spinorbit.asteroids import (
     apophis_encounter_simulation,
     apophis_rotation_state,
 )
+from spinorbit.core.gravity_field import make_body
+from spinorbit.core.rotations import attitude_to_quat, quat_to_attitude
 from spinorbit.coupling.rebound_adapter import MissingBodyError, simulation_from_de421
+from spinorbit.coupling.rigid_body import CoupledRigidBody
 from spinorbit.ephemeris import UnknownBodyError, de421_constants, moon_orientation
 from spinorbit.planner import ARCSEC_PER_RAD, Plan, attitude_sensitivity
-from spinorbit.scene import FixedPerturber, Orbit, PlanError, Scene, SceneError, _angles  # noqa: F401
+from spinorbit.scene import FixedPerturber, Orbit, PlanError, Scene, SceneError, _angles
+from spinorbit.time import tdb_days
 
 EPOCH = Time("2020-01-01", scale="tdb")
 
@@ -316,3 +323,143 @@ def test_run_refuses_something_that_is_not_a_plan():
     with pytest.raises(SceneError, match="Plan"):
         scene.run(plan="fast")
     assert isinstance(scene.plan(), Plan)
+
+
+# ------------------------------------------------------------------------------------------------
+# Skip 5: one-way coupling instead of the fully coupled REBOUND run (the figure's back-reaction).
+
+MSUN = (1 * u.M_sun).to(u.kg)
+
+
+def massive_scene(mass_msun, a_au, e, span_days, tolerance, perturbers=("sun", "planet"), mass_kg=None):
+    """A massive body with a large figure ((C-A)/(M R²) = 0.05) orbiting a 3e-6 Msun planet 1 au from a Sun.
+
+    Moon-like: mass 3.7e-8 Msun at 0.00257 au (R = 1735 km); close binary: 1e-6 Msun at 0.0015 au.
+    """
+    day0 = float(sum(tdb_days(EPOCH)))
+    sim = rebound.Simulation()
+    sim.units = ("AU", "day", "Msun")
+    sim.t = day0
+    sim.add(m=1.0, name="Sun")
+    sim.add(m=3e-6, a=1.0, name="Planet")
+    sim.add(m=mass_msun, a=a_au, e=e, inc=0.1, primary=sim.particles[1], name="Body")
+    sim.move_to_com()
+    sim.exact_finish_time = 1
+    mass = mass_msun * MSUN
+    radius = 1.16e-5 * u.au * (mass_msun / 3.7e-8) ** (1 / 3)
+    body = RigidBody(([0.35, 0.38, 0.40] * mass * radius**2).to(u.kg * u.m**2),
+                     mass=mass if mass_kg is None else mass_kg)
+    n = math.sqrt(sim.G * (3e-6 + mass_msun) / a_au**3)  # spin near synchronous
+    state = RotationState.from_euler313(body, 10 * u.deg, 20 * u.deg, 30 * u.deg, [0.01 * n, 0.02 * n, n] * u.rad / u.day)
+    return Scene(state, EPOCH, EPOCH + np.linspace(span_days / 5, span_days, 5) * u.day, perturbers=perturbers,
+                 orbit=Orbit.rebound(sim, "Body"), tolerance=tolerance)
+
+
+def direct_coupled(scene, coupled, eps=1e-13, names=("Sun", "Planet"), sim=None, particle=None):
+    """The scene's body run by CoupledRigidBody itself (BS, eps 1e-13) on a copy of its REBOUND orbit (or
+    of ``sim``, the body being ``particle``): user-axis quaternions at the outputs."""
+    particle = scene.orbit.name if particle is None else particle
+    sim = (scene.orbit.simulation if sim is None else sim).copy()
+    sim.integrator = "bs"
+    sim.integrator.eps_abs = sim.integrator.eps_rel = eps
+    m = sim.particles[particle].m
+    body = scene.state.body
+    per_mass = (np.array(body.principal_moments) * body.moment_unit / body.mass).to_value(u.au**2)
+    figure = make_body(tuple(per_mass * m), mass=m)  # moments in Msun au²
+    p = scene.state.body.to_principal
+    y0 = np.concatenate([attitude_to_quat(np.ascontiguousarray(p @ scene.state.attitude_matrix)),
+                         p @ scene.state.angular_velocity.to_value(u.rad / u.day)])
+    body = CoupledRigidBody(sim, particle, figure, y0, perturbers=list(names), coupled=coupled)
+    out = []
+    for day in scene.output_days:
+        body.integrate(day)
+        out.append(RotationState.from_matrix(scene.state.body, p.T @ quat_to_attitude(body.quaternion),
+                                             p.T @ body.omega).quaternion)
+    return np.array(out)
+
+
+def flattened_earth_scene(tolerance, orbit):
+    """The Earth with a 50x flattened figure ((C-A)/(M R²) = 0.05, R = 6378 km), Moon and Sun torquing it, 10 d."""
+    mass = (de421_constants().gm["earth"] * u.au**3 / u.day**2 / const.G).to(u.kg)
+    body = RigidBody(([0.33, 0.331, 0.38] * mass * (6378 * u.km) ** 2).to(u.kg * u.m**2), mass=mass)
+    state = RotationState.from_euler313(body, 10 * u.deg, 23 * u.deg, 30 * u.deg, [0, 0, 2 * np.pi] * u.rad / u.day)
+    return Scene(state, EPOCH, EPOCH + np.linspace(2.0, 10.0, 5) * u.day, perturbers=("moon", "sun"),
+                 orbit=orbit, tolerance=tolerance)
+
+
+def test_negligible_back_reaction_gives_one_way_within_its_bound_of_the_coupled_run():
+    # On DE421's orbits: bound 1.97 arcsec <= 5 (half the tolerance), so one-way. The back-reaction
+    # itself (CoupledRigidBody coupled vs one-way on the DE421 simulation) measured 5.3e-5 arcsec: the
+    # bound takes the worst attitude and the worst orbit response at every instant, and the fast spin
+    # averages the torque change out.
+    scene = flattened_earth_scene(10 * u.arcsec, Orbit.de421("earth"))
+    plan = scene.plan()
+    assert plan.route == "one-way" and plan.orbit_source == "de421", str(plan)
+    assert 0 < plan.back_reaction_rad <= 0.5 * scene.tolerance_rad
+    assert "back-reaction bound" in str(plan) and "back-reaction" in str(plan).splitlines()[1]
+    sim = simulation_from_de421(EPOCH)
+    coupled, one_way = (direct_coupled(scene, mode, names=("Moon", "Sun"), sim=sim, particle="Earth")
+                        for mode in (True, False))
+    measured = float(np.max(_angles(coupled, one_way)))
+    assert 1e-6 / ARCSEC_PER_RAD < measured <= plan.back_reaction_rad  # resolved (BS noise ~1e-7 arcsec)
+    # Against the coupled run (REBOUND on DE421's initial state): within the planned run's estimate.
+    planned = scene.run(plan)
+    assert planned.error_parts["back_reaction"].to_value(u.rad) == pytest.approx(plan.back_reaction_rad)
+    assert float(np.max(_angles(planned.table["quaternion"], coupled))) <= planned.error_estimate.to_value(u.rad)
+    assert planned.error_estimate.to_value(u.rad) <= scene.tolerance_rad
+    # Given as a REBOUND particle, the same body takes the coupled route (cheaper, nothing left out).
+    assert flattened_earth_scene(10 * u.arcsec, Orbit.rebound(sim, "Earth")).plan().route == "coupled"
+
+
+def test_on_a_rebound_orbit_the_coupled_route_is_taken_as_the_cheaper_one():
+    # Moon-like body, 10 d, tolerance 200 arcsec: one-way would fit (bound 58 arcsec <= 100), but the
+    # coupled BS run costs less than one-way's N-body sampling (bench_scene_skips). The bound still
+    # covers the measured back-reaction (0.019 arcsec).
+    scene = massive_scene(3.7e-8, 0.00257, 0.05, 10.0, 200 * u.arcsec)
+    plan = scene.plan()
+    assert plan.route == "coupled" and "cheaper" in str(plan), str(plan)
+    assert plan.back_reaction_bound_rad <= 0.5 * scene.tolerance_rad
+    measured = float(np.max(_angles(direct_coupled(scene, True), direct_coupled(scene, False))))
+    assert 1e-4 / ARCSEC_PER_RAD < measured <= plan.back_reaction_bound_rad
+    result = scene.run(plan)
+    assert worst_difference(result, scene.run(scene.plan(skip=False))) == 0.0  # the reference is the same run
+
+
+def test_large_back_reaction_takes_the_coupled_route_equal_to_coupled_rigid_body():
+    # Close binary (companion 1/3 of the primary's mass at 0.0015 au), 5 d, tolerance 1 arcsec: bound
+    # 2.6e3 arcsec; measured one-way vs coupled 1.94 arcsec (CoupledRigidBody both ways): one-way would
+    # miss the tolerance.
+    scene = massive_scene(1e-6, 0.0015, 0.1, 5.0, 1 * u.arcsec)
+    plan = scene.plan()
+    assert plan.route == "coupled" and plan.integrator == "rebound-bs" and not plan.dropped, str(plan)
+    result = scene.run(plan)
+    assert set(result.table.colnames) >= {"time", "quaternion", "omega", "momentum_direction", "P_psi"}
+    coupled, one_way = direct_coupled(scene, True), direct_coupled(scene, False)
+    measured = float(np.max(_angles(coupled, one_way)))
+    assert scene.tolerance_rad < measured <= plan.back_reaction_bound_rad  # one-way would miss the tolerance
+    # The route is CoupledRigidBody: its eps 1e-10 run against eps 1e-13 (measured 1.9e-7 arcsec),
+    # within the run's own integration estimate (measured 1.0e-6 arcsec).
+    assert float(np.max(_angles(result.table["quaternion"], coupled))) <= result.error_estimate.to_value(u.rad)
+    assert result.tolerance_met and result.error_parts["sampling"].value == 0.0
+
+
+def test_the_moons_back_reaction_is_in_de421():
+    constants = de421_constants()
+    q, omega = moon_orientation(EPOCH)
+    mass = (constants.gm["moon"] * u.au**3 / u.day**2 / const.G).to(u.kg)
+    radius = 1738 * u.km
+    body = RigidBody((np.array(constants.moon_moments_over_mr2) * mass * radius**2).to(u.kg * u.m**2), mass=mass)
+    scene = Scene(RotationState(body, q, omega), EPOCH, EPOCH + 1 * u.day, perturbers=("earth", "sun"),
+                  orbit=Orbit.de421("moon"), tolerance=1e-6 * u.arcsec)
+    plan = scene.plan()
+    assert plan.route == "one-way" and plan.back_reaction_rad == 0.0 and "in the ephemeris" in str(plan)
+    assert plan.back_reaction_bound_rad > 0
+
+
+def test_coupled_route_refused_in_words_when_it_cannot_be_run():
+    fixed = FixedPerturber("p", 1e-12 * u.au**3 / u.day**2, [1, 0, 0] * u.au)
+    scene = massive_scene(1e-6, 0.0015, 0.1, 5.0, 1 * u.arcsec, perturbers=("sun", "planet", fixed))
+    with pytest.raises(PlanError, match="not particles of a REBOUND simulation"):
+        scene.plan()
+    with pytest.raises(SceneError, match="differs from its mass in the orbit model"):
+        massive_scene(1e-6, 0.0015, 0.1, 5.0, 1 * u.arcsec, mass_kg=1e22 * u.kg)

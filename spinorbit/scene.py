@@ -265,6 +265,9 @@ class Scene:
         Attitude (relative to ICRF) and spin at ``epoch``. When its RigidBody has moments in kg m²
         and a ``mass`` (which must match the body's mass in the orbit model within 1 %), the planner
         estimates the figure's back-reaction on the orbits and runs the coupled route if needed.
+        A sequence or a mapping ``{name: state}`` makes a scene of several bodies
+        (:mod:`spinorbit.scene_bodies`: planned per body, sampled once per shared orbit; names from
+        ``RigidBody.name`` or ``body0``, ``body1``…).
     epoch : astropy.time.Time
         Time of ``state`` (scalar).
     times : astropy.time.Time
@@ -272,8 +275,9 @@ class Scene:
     perturbers : sequence of str or FixedPerturber
         DE421 body names (``"sun"``, ``"earth"``, ``"jupiter"``…; particle names for a REBOUND orbit)
         and/or :class:`FixedPerturber` s. Empty: torque-free.
-    orbit : Orbit, optional
-        Needed when any perturber is named.
+    orbit : Orbit or dict, optional
+        Needed when any perturber is named; for several bodies, one Orbit for all or
+        ``{name: Orbit}``.
     tolerance : Quantity
         Attitude tolerance (angle) of the whole run.
     quantities : sequence of str
@@ -291,6 +295,18 @@ class Scene:
 
     def __init__(self, state, epoch, times, perturbers=(), orbit=None, tolerance=1 * u.arcsec,
                  quantities=QUANTITIES, integrator="auto", sample_tolerance=1e-10):
+        self.members, self._cache = None, None
+        if isinstance(state, (list, tuple, dict)):
+            from . import scene_bodies
+
+            def make(member_state, member_orbit):
+                return Scene(member_state, epoch, times, perturbers, member_orbit, tolerance, quantities, integrator,
+                             sample_tolerance)
+
+            self.members = scene_bodies.members(state, orbit, make)
+            self.epoch, self.times, self.tolerance_rad, self.output_days, self.epoch_day = (
+                scene_bodies.common_times(self.members))
+            return
         if not isinstance(state, RotationState):
             raise SceneError(f"state expects a spinorbit.RotationState; got {type(state).__name__}.")
         if not isinstance(epoch, Time) or not epoch.isscalar:
@@ -452,9 +468,14 @@ class Scene:
 
         Returns
         -------
-        Plan
-            ``print(plan)`` lists every decision with its reason.
+        Plan or spinorbit.scene_bodies.ScenePlans
+            ``print(plan)`` lists every decision with its reason; one Plan per body for a scene of
+            several bodies.
         """
+        if self.members is not None:
+            from .scene_bodies import plan_many
+
+            return plan_many(self.members, skip)
         decisions = []
         tolerance = self.tolerance_rad
         moments = self.state.body.principal_moments
@@ -682,8 +703,13 @@ class Scene:
     def run(self, plan=None, progress=None):
         """Carry out ``plan`` (default: :meth:`plan`) and return a :class:`SceneResult`.
 
-        ``progress``, if given, is called with a fraction in [0, 1] as the run advances.
+        ``progress``, if given, is called with a fraction in [0, 1] as the run advances. A scene of
+        several bodies returns :class:`~spinorbit.scene_bodies.SceneResults` (one result per body).
         """
+        if self.members is not None:
+            from .scene_bodies import run_many
+
+            return run_many(self.members, self.plan() if plan is None else plan, progress)
         clock = _time.perf_counter()
         plan = self.plan() if plan is None else plan
         if not isinstance(plan, Plan):

@@ -463,3 +463,58 @@ def test_coupled_route_refused_in_words_when_it_cannot_be_run():
         scene.plan()
     with pytest.raises(SceneError, match="differs from its mass in the orbit model"):
         massive_scene(1e-6, 0.0015, 0.1, 5.0, 1 * u.arcsec, mass_kg=1e22 * u.kg)
+
+
+# ------------------------------------------------------------------------------------------------
+# Several rotating bodies in one scene.
+
+
+def slow_state():
+    """A flatter body spinning 10x slower than sam_state(): its perturber bounds are 4x larger."""
+    return RotationState.from_euler313(RigidBody([0.3, 0.9, 1.0]), 10 * u.deg, 40 * u.deg, 70 * u.deg,
+                                       [5, 3, 4] * u.deg / u.hour)
+
+
+def test_bodies_are_planned_each_on_its_own_and_share_the_orbit_sampling(monkeypatch):
+    # Tolerance 0.3 arcsec, drop share 0.15: Jupiter's bound is 0.089 arcsec for the fast body (all four
+    # planets dropped, 0.105 together) and 0.36 arcsec for the slow one (kept).
+    times = EPOCH + np.linspace(2.0, 20.0, 5) * u.day
+    kwargs = {"perturbers": ("sun", "jupiter", "venus", "mars", "saturn"), "orbit": Orbit.circular(2.5 * u.au),
+              "tolerance": 0.3 * u.arcsec}
+    calls = []
+    sample = Scene._sample
+    monkeypatch.setattr(Scene, "_sample", lambda self, *args: calls.append(args[1]) or sample(self, *args))
+    scene = Scene({"fast": sam_state(), "slow": slow_state()}, EPOCH, times, **kwargs)
+    plans = scene.plan()
+    assert plans["fast"].kept == ("sun",) and plans["slow"].kept == ("sun", "jupiter"), str(plans)
+    assert "fast, slow share one orbit" in str(plans) and "body slow:" in str(plans)
+    results = scene.run(plans)
+    # One survey for both bodies, one sampling of the union of the kept (Sun, Jupiter) for the run.
+    assert [tuple(c) for c in calls] == [scene.members["fast"].named, ("sun", "jupiter")]
+    assert set(results.tables) == {"fast", "slow"} and results.tolerance_met
+    for name, state in (("fast", sam_state()), ("slow", slow_state())):
+        alone = Scene(state, EPOCH, times, **kwargs)
+        alone_plan = alone.plan()
+        assert alone_plan.kept == plans[name].kept and alone_plan.rtol == plans[name].rtol
+        single = alone.run(alone_plan)
+        # Same plan, same integration; only the sample grid differs (refined for Jupiter too):
+        # measured 0 (fast) and 1e-16 rad (slow) with a union grid equal to Sun + Jupiter's.
+        assert worst_difference(results[name], single) <= 1e-3 * single.error_estimate.to_value(u.rad)
+
+
+def test_bodies_on_their_own_orbits_and_bad_collections():
+    times = EPOCH + np.linspace(2.0, 20.0, 3) * u.day
+    scene = Scene([sam_state(), slow_state()], EPOCH, times, perturbers=("sun",),
+                  orbit={"body0": Orbit.circular(2.5 * u.au), "body1": Orbit.circular(1.5 * u.au)})
+    plans = scene.plan()
+    assert set(plans.plans) == {"body0", "body1"} and "no two share an orbit" in str(plans)
+    assert plans["body0"].estimates["sun"].closest_au == pytest.approx(2.5, abs=0.01)  # the Sun is within 0.01 au of the barycentre
+    assert plans["body1"].estimates["sun"].closest_au == pytest.approx(1.5, abs=0.01)
+    with pytest.raises(SceneError, match="missing"):
+        Scene([sam_state(), slow_state()], EPOCH, times, perturbers=("sun",), orbit={"body0": Orbit.circular(2.5 * u.au)})
+    with pytest.raises(SceneError, match="empty"):
+        Scene([], EPOCH, times)
+    with pytest.raises(SceneError, match="RotationStates for every body"):
+        Scene({"a": sam_state(), "b": "spin"}, EPOCH, times)
+    with pytest.raises(SceneError, match="ScenePlans"):
+        scene.run(plans["body0"])

@@ -61,7 +61,8 @@ from .planner import (
 from .state import RotationState
 from .time import tdb_days, time_from_tdb_days
 
-__all__ = ["QUANTITIES", "FixedPerturber", "Orbit", "PlanError", "Scene", "SceneError", "SceneResult"]
+__all__ = ["QUANTITIES", "EphemerisPerturber", "FixedPerturber", "Orbit", "PlanError", "Scene", "SceneError",
+           "SceneResult"]
 
 #: Quantities a scene can ask for.
 QUANTITIES = ("attitude", "omega", "periods")
@@ -163,6 +164,13 @@ class Orbit:
         return cls("rebound", str(particle), simulation=simulation)
 
 
+def _check_gm(kind, name, gm):
+    if not isinstance(gm, u.Quantity) or gm.unit.physical_type != (u.m**3 / u.s**2).physical_type:
+        raise SceneError(f"{kind} {name!r}: gm expects a Quantity in length³/time² such as 3.986e14 m3/s2; "
+                         f"got {gm!r}.")
+    return float(gm.to_value(u.au**3 / u.day**2))
+
+
 @dataclass(frozen=True)
 class FixedPerturber:
     """A point mass at a fixed ICRF position relative to the body (a user position).
@@ -181,10 +189,8 @@ class FixedPerturber:
     position: u.Quantity
 
     def __post_init__(self):
-        gm, position = self.gm, self.position
-        if not isinstance(gm, u.Quantity) or gm.unit.physical_type != (u.m**3 / u.s**2).physical_type:
-            raise SceneError(f"FixedPerturber {self.name!r}: gm expects a Quantity in length³/time² such as "
-                             f"3.986e14 m3/s2; got {gm!r}.")
+        _check_gm("FixedPerturber", self.name, self.gm)
+        position = self.position
         if (not isinstance(position, u.Quantity) or position.unit.physical_type != "length"
                 or position.shape != (3,) or not np.all(np.isfinite(position.value)) or not np.any(position.value)):
             raise SceneError(f"FixedPerturber {self.name!r}: position expects a finite, non-zero length "
@@ -192,11 +198,64 @@ class FixedPerturber:
 
     @property
     def gm_au3_day2(self):
-        return float(self.gm.to_value(u.au**3 / u.day**2))
+        return _check_gm("FixedPerturber", self.name, self.gm)
 
     @property
     def position_au(self):
         return self.position.to_value(u.au).astype(float)
+
+
+@dataclass(frozen=True)
+class EphemerisPerturber:
+    """A point mass moving on a user ephemeris (like :meth:`Orbit.ephemeris`, for a perturber).
+
+    It goes through the planner like a DE421 body: surveyed, bounded, dropped or kept, and sampled
+    onto the same adaptive Hermite grid (:func:`spinorbit.coupling.one_way.sample_states`).
+
+    Parameters
+    ----------
+    name : str
+    gm : Quantity
+        G·M (any unit of length³/time²).
+    function : callable
+        ``function(days) -> (positions (n, 3) au, velocities (n, 3) au/day)`` at TDB days since J2000
+        (vectorised over ``days``), ICRF axes.
+    relative : bool
+        True: the states are relative to the rotating body's centre (no orbit of the body needed);
+        False (default): barycentric, and the scene's ``orbit`` gives the body's.
+    """
+
+    name: str
+    gm: u.Quantity
+    function: object
+    relative: bool = False
+
+    def __post_init__(self):
+        _check_gm("EphemerisPerturber", self.name, self.gm)
+        if not callable(self.function):
+            raise SceneError(f"EphemerisPerturber {self.name!r}: function expects a callable days -> (positions, "
+                             f"velocities); got {type(self.function).__name__}.")
+        if not isinstance(self.relative, bool):
+            raise SceneError(f"EphemerisPerturber {self.name!r}: relative expects True or False; got {self.relative!r}.")
+
+    @property
+    def gm_au3_day2(self):
+        return _check_gm("EphemerisPerturber", self.name, self.gm)
+
+    def states(self, days):
+        """(n, 6) positions and velocities at ``days``; SceneError if the function returns other shapes."""
+        try:
+            positions, velocities = (np.asarray(a, dtype=float) for a in self.function(days))
+        except (TypeError, ValueError) as error:
+            raise SceneError(f"EphemerisPerturber {self.name!r}: function expects to return (positions, velocities) "
+                             f"as arrays of shape ({days.size}, 3); calling it failed: {error}") from None
+        if positions.shape != (days.size, 3) or velocities.shape != (days.size, 3):
+            raise SceneError(f"EphemerisPerturber {self.name!r}: function expects to return (positions, velocities) "
+                             f"of shape ({days.size}, 3) each for {days.size} times; got {positions.shape} and "
+                             f"{velocities.shape}.")
+        if not (np.all(np.isfinite(positions)) and np.all(np.isfinite(velocities))):
+            raise SceneError(f"EphemerisPerturber {self.name!r}: function returned NaN or inf.")
+        return np.concatenate([positions, velocities], axis=1)
 
 
 @dataclass
@@ -339,16 +398,24 @@ class Scene:
                              f"got {type(orbit).__name__}.")
         self.orbit = orbit
         self.fixed = tuple(p for p in perturbers if isinstance(p, FixedPerturber))
-        named = [p for p in perturbers if not isinstance(p, FixedPerturber)]
+        self.moving = tuple(p for p in perturbers if isinstance(p, EphemerisPerturber))
+        named = [p for p in perturbers if not isinstance(p, (FixedPerturber, EphemerisPerturber))]
         bad = [p for p in named if not isinstance(p, str)]
         if bad:
-            raise SceneError(f"perturbers expects body names (str) or FixedPerturber; got {bad[0]!r}.")
+            raise SceneError(f"perturbers expects body names (str), FixedPerturber or EphemerisPerturber; got "
+                             f"{bad[0]!r}.")
+        barycentric = [p.name for p in self.moving if not p.relative]
+        if barycentric and orbit is None:
+            raise SceneError(f"perturbers {barycentric} are barycentric EphemerisPerturbers and need the body's orbit: "
+                             "give orbit=Orbit.de421(...), Orbit.ephemeris(...) or Orbit.rebound(...), or "
+                             "relative=True.")
         if named and orbit is None:
             raise SceneError(f"perturbers {named} need the body's orbit: give orbit=Orbit.de421(...), "
                              "Orbit.ephemeris(...) or Orbit.rebound(...).")
         self.named = tuple(self._resolve(named))
-        if len(set(self.named)) != len(self.named):
-            raise SceneError(f"perturbers lists a body twice: {list(self.named)}.")
+        everyone = [*self.named, *(p.name for p in self.fixed), *(p.name for p in self.moving)]
+        if len(set(everyone)) != len(everyone):
+            raise SceneError(f"perturbers lists a body twice: {everyone}.")
         self._cache = None  # perturber samples shared within one plan() / run() (see _sharing_samples)
         self.moments_per_mass = self._moments_per_mass()
 
@@ -454,6 +521,9 @@ class Scene:
     def _sample(self, source, names, tolerance):
         from .coupling import one_way
 
+        if source == "user":
+            return self._sample_user(names, tolerance)
+
         start = time_from_tdb_days(self.epoch_day)
         end = time_from_tdb_days(self.output_days[-1])
         if source == "rebound":
@@ -461,6 +531,34 @@ class Scene:
                                                tolerance=tolerance)
         orbit = (one_way.de421_orbit(self.orbit.name) if source == "de421" else self.orbit.function)
         return one_way.sample_from_ephemeris(orbit, start, end, names, tolerance=tolerance)
+
+    def _sample_user(self, names, tolerance):
+        """Sample the EphemerisPerturbers ``names`` relative to the body (same grid and checks as DE421's)."""
+        from .coupling import one_way
+
+        chosen = [next(p for p in self.moving if p.name == name) for name in names]
+        body = self._body_orbit() if any(not p.relative for p in chosen) else None
+
+        def provider(days):
+            out = np.empty((days.size, len(chosen), 6))
+            centre = None if body is None else np.concatenate([np.asarray(a, dtype=float) for a in body(days)], axis=1)
+            for i, perturber in enumerate(chosen):
+                out[:, i] = perturber.states(days) - (0.0 if perturber.relative else centre)
+            return out
+
+        return one_way.sample_states(provider, names, [p.gm_au3_day2 for p in chosen],
+                                     time_from_tdb_days(self.epoch_day), time_from_tdb_days(self.output_days[-1]),
+                                     tolerance)
+
+    def _body_orbit(self):
+        """The body's barycentric orbit as a callable days -> (positions, velocities), au and au/day."""
+        from .coupling import one_way
+
+        if self.orbit.kind == "de421":
+            return one_way.de421_orbit(self.orbit.name)
+        if self.orbit.kind == "rebound":
+            return one_way.rebound_orbit(self.orbit.simulation, self.orbit.name)
+        return self.orbit.function
 
     @_sharing_samples
     def plan(self, skip=True):
@@ -487,7 +585,7 @@ class Scene:
             decisions.append(Decision("outputs", f"{self.output_days.size} output times (dense output)",
                                       "several output times were asked"))
         shape = self._shape_decision()
-        if not self.named and not self.fixed:
+        if not self.named and not self.fixed and not self.moving:
             decisions.append(Decision("route", "exact torque-free solution, no integration",
                                       "the scene has no perturbers: the torque is zero"))
             decisions.append(shape)
@@ -575,16 +673,21 @@ class Scene:
         estimates = {}
         t_end = self.output_days[-1]
         survey = None
+        surveys = []
         if self.named:
             # With a REBOUND orbit every sampling pass is an N-body run, whose cost hardly depends on the
             # tolerance (the pilot and the run dominate): survey at the run's tolerance and keep it.
             # With an ephemeris, sampling costs per perturber: survey loosely, sample only the kept.
             keep = self._keeps_survey(source, keep)
             survey = self._sampler(source, self.named, self._survey_tolerance(keep))
-            distances = np.linalg.norm(survey.states[:, :, :3], axis=2)
-            for i, name in enumerate(survey.names):
-                n = max_torque_over_a(moments, survey.gm[i], distances[:, i])
-                bound = dropped_torque_bound(survey.days, n, t_end, kappa, momentum)
+            surveys.append(survey)
+        if self.moving:  # user ephemerides: like an ephemeris, surveyed loosely, the kept sampled for the run
+            surveys.append(self._sampler("user", [p.name for p in self.moving], SURVEY_TOLERANCE))
+        for samples in surveys:
+            distances = np.linalg.norm(samples.states[:, :, :3], axis=2)
+            for i, name in enumerate(samples.names):
+                n = max_torque_over_a(moments, samples.gm[i], distances[:, i])
+                bound = dropped_torque_bound(samples.days, n, t_end, kappa, momentum)
                 estimates[name] = PerturberEstimate(name, float(distances[:, i].min()), bound, True)
         days = np.array([self.epoch_day, t_end])
         for fixed in self.fixed:
@@ -602,7 +705,7 @@ class Scene:
     def _coupled_runnable(self):
         """The coupled route can run: a REBOUND orbit, a body with mass in it and a figure of known
         size, and every perturber a particle of the simulation."""
-        return (self.orbit is not None and self.orbit.kind == "rebound" and not self.fixed
+        return (self.orbit is not None and self.orbit.kind == "rebound" and not self.fixed and not self.moving
                 and self.moments_per_mass is not None and self._gm_in_orbit_model() > 0.0)
 
     def _survey_tolerance(self, keep):
@@ -666,7 +769,7 @@ class Scene:
                 "coupling", choice + "; back-reaction left out (in the error estimate)",
                 "skip=False (reference run), but a coupled run needs the orbits as a REBOUND simulation and "
                 f"every perturber as one of its particles; {numbers}")]
-        user = [p.name for p in self.fixed]
+        user = [p.name for p in (*self.fixed, *self.moving)]
         what = (f"the perturbers {user} are not particles of a REBOUND simulation" if user else
                 f"the orbit is {self.orbit.kind!r}, not a REBOUND simulation")
         raise PlanError(
@@ -763,6 +866,9 @@ class Scene:
 
         named = tuple(n for n in plan.kept if n in self.named)
         fixed = [fixed_source(p.gm_au3_day2, p.position_au) for p in self.fixed if p.name in plan.kept]
+        moving = [p.name for p in self.moving if p.name in plan.kept]
+        if moving:
+            fixed += self._sampler("user", moving, self.sample_tolerance).sources()
         if named and plan.samples is not None:
             samples = _subset(plan.samples, named)
         else:
@@ -785,7 +891,7 @@ class Scene:
                 break
             rtol = max(rtol / 100.0, 1e-13)
         kept_bound = sum(plan.estimates[n].bound_rad for n in plan.kept)
-        sampling = 3.0 * self.sample_tolerance * kept_bound if named else 0.0
+        sampling = 3.0 * self.sample_tolerance * kept_bound if named or moving else 0.0
         if "omega" not in self.quantities:
             run.remove_column("omega")
         run.meta["rtol"] = rtol

@@ -28,7 +28,9 @@ from spinorbit.coupling.rebound_adapter import MissingBodyError, simulation_from
 from spinorbit.coupling.rigid_body import CoupledRigidBody
 from spinorbit.ephemeris import UnknownBodyError, de421_constants, moon_orientation
 from spinorbit.planner import ARCSEC_PER_RAD, Plan, attitude_sensitivity
-from spinorbit.scene import FixedPerturber, Orbit, PlanError, Scene, SceneError, _angles
+from spinorbit.core.perturbers import kepler_source
+from spinorbit.coupling.one_way import propagate_one_way
+from spinorbit.scene import EphemerisPerturber, FixedPerturber, Orbit, PlanError, Scene, SceneError, _angles, _NoSamples
 from spinorbit.time import tdb_days
 
 EPOCH = Time("2020-01-01", scale="tdb")
@@ -518,3 +520,76 @@ def test_bodies_on_their_own_orbits_and_bad_collections():
         Scene({"a": sam_state(), "b": "spin"}, EPOCH, times)
     with pytest.raises(SceneError, match="ScenePlans"):
         scene.run(plans["body0"])
+
+
+# ------------------------------------------------------------------------------------------------
+# Moving user perturbers (EphemerisPerturber).
+
+#: A moonlet on a circle of 0.001 au about the body in the ICRF xy plane, 2.1-day period.
+MOONLET_RADIUS, MOONLET_RATE = 1e-3, 3.0
+
+
+def moonlet(gm, relative=True, centre=None):
+    """The moonlet as an EphemerisPerturber; barycentric (relative=False) about the ``centre`` orbit."""
+    def states(days):
+        days = np.atleast_1d(np.asarray(days, dtype=float))
+        c, s, zero = np.cos(MOONLET_RATE * days), np.sin(MOONLET_RATE * days), np.zeros(days.shape)
+        r = MOONLET_RADIUS * np.stack([c, s, zero], axis=1)
+        v = MOONLET_RADIUS * MOONLET_RATE * np.stack([-s, c, zero], axis=1)
+        if centre is not None:
+            body_r, body_v = centre(days)
+            r, v = r + body_r, v + body_v
+        return r, v
+
+    return EphemerisPerturber("moonlet", gm * u.au**3 / u.day**2, states, relative=relative)
+
+
+def test_moving_perturber_dropped_or_kept_against_its_bound():
+    times = EPOCH + np.linspace(2.0, 20.0, 5) * u.day
+    orbit = Orbit.circular(2.5 * u.au)
+    # gm 1e-18: bound 0.080 arcsec, dropped at 1 arcsec; gm 1e-16: 8.0 arcsec, kept (the bound is linear in gm).
+    small = Scene(sam_state(), EPOCH, times, perturbers=("sun", moonlet(1e-18)), orbit=orbit, tolerance=1 * u.arcsec)
+    plan = small.plan()
+    estimate = plan.estimates["moonlet"]
+    assert estimate.closest_au == pytest.approx(MOONLET_RADIUS, rel=1e-9)
+    assert "moonlet" in plan.dropped and estimate.bound_rad <= 0.5 * small.tolerance_rad
+    skipped, full = small.run(plan), small.run(small.plan(skip=False))
+    assert worst_difference(skipped, full) <= skipped.error_estimate.to_value(u.rad) + full.error_estimate.to_value(u.rad)
+    large = Scene(sam_state(), EPOCH, times, perturbers=("sun", moonlet(1e-16)), orbit=orbit, tolerance=1 * u.arcsec)
+    plan = large.plan()
+    assert "moonlet" in plan.kept and plan.estimates["moonlet"].bound_rad > 0.5 * large.tolerance_rad, str(plan)
+
+
+def test_moving_perturber_run_equals_a_direct_one_way_propagation_with_its_kepler_orbit():
+    # The same circle as an analytic Kepler source (core.perturbers), no sampling: the scene's
+    # Hermite-sampled moonlet (relative and barycentric) must agree within the run's error estimate.
+    times = EPOCH + np.linspace(1.0, 5.0, 5) * u.day
+    state = sam_state()
+    gm = 1e-14
+    kepler = kepler_source(gm, MOONLET_RADIUS, 0.0, 0.0, 0.0, 0.0, 0.0, epoch=0.0,
+                           mu_orbit=MOONLET_RATE**2 * MOONLET_RADIUS**3)
+    direct = propagate_one_way(state, EPOCH, times, _NoSamples(float(sum(tdb_days(EPOCH))), float(sum(tdb_days(times[-1])))),
+                               rtol=1e-13, periods=False, extra_sources=[kepler])
+    orbit = Orbit.circular(2.5 * u.au)
+    effect = float(np.max(_angles(Scene(state, EPOCH, times).run().table["quaternion"], direct["quaternion"])))
+    # Measured: effect 0.113 arcsec; scene vs direct 2.0e-5 arcsec both ways, estimate 1.8e-4 arcsec.
+    for perturber in (moonlet(gm), moonlet(gm, relative=False, centre=orbit.function)):
+        scene = Scene(state, EPOCH, times, perturbers=(perturber,), orbit=orbit, tolerance=1e-3 * u.arcsec)
+        plan = scene.plan()
+        assert plan.route == "one-way" and plan.kept == ("moonlet",), str(plan)
+        result = scene.run(plan)
+        measured = float(np.max(_angles(result.table["quaternion"], direct["quaternion"])))
+        assert measured <= result.error_estimate.to_value(u.rad) < 1e-2 * effect  # the moonlet is resolved
+        assert result.error_parts["sampling"].value > 0
+
+
+def test_moving_perturber_bad_input():
+    with pytest.raises(SceneError, match="gm expects"):
+        EphemerisPerturber("p", 1e-7, lambda d: d)
+    with pytest.raises(SceneError, match="callable"):
+        EphemerisPerturber("p", 1e-7 * u.au**3 / u.day**2, "not callable")
+    with pytest.raises(SceneError, match="need the body's orbit"):
+        Scene(sam_state(), EPOCH, EPOCH + 1 * u.day, perturbers=(moonlet(1e-12, relative=False),))
+    wrong = EphemerisPerturber("p", 1e-12 * u.au**3 / u.day**2, lambda d: (np.ones((3,)), np.ones((3,))), relative=True)
+    with pytest.raises(SceneError, match=r"of shape \(\d+, 3\) each"):
+        Scene(sam_state(), EPOCH, EPOCH + 1 * u.day, perturbers=(wrong,)).plan()

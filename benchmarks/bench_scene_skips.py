@@ -22,6 +22,8 @@ import time
 from pathlib import Path
 
 import numpy as np
+import rebound
+from astropy import constants as const
 from astropy import units as u
 from astropy.time import Time
 
@@ -30,9 +32,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from _report import machine_line, write_section
 
 from spinorbit import RigidBody, RotationState, asteroids
-from spinorbit.coupling.rebound_adapter import simulation_from_de421
+from spinorbit.coupling.rebound_adapter import body_index, simulation_from_de421
 from spinorbit.ephemeris import de421_constants, moon_orientation
 from spinorbit.scene import Orbit, Scene, _angles
+from spinorbit.time import tdb_days
 
 EPOCH = Time("2020-01-01", scale="tdb")
 
@@ -41,6 +44,51 @@ def sam_state():
     """The Apophis-like short-axis state of tests/test_scene.py (moment ratios 0.61 : 0.965 : 1, 9 h spin)."""
     return RotationState.from_euler313(RigidBody([0.61, 0.965, 1.0]), 10 * u.deg, 40 * u.deg, 70 * u.deg,
                                        [5, 3, 40] * u.deg / u.hour)
+
+
+def luna_scene(span_days, outputs, tolerance, figure=True):
+    """The Moon with its DE421 figure, renamed 'Luna' in the 11-body DE421 simulation so that the planner
+    cannot take DE421's orbit. ``figure``: moments in kg m² and the mass (the back-reaction can be
+    estimated and the coupled route run); otherwise the moment ratios alone (one-way only)."""
+    constants = de421_constants()
+    sim = simulation_from_de421(EPOCH)
+    sim.particles[body_index(sim, "moon")].name = "Luna"
+    q, omega = moon_orientation(EPOCH)
+    mass = (constants.gm["moon"] * u.au**3 / u.day**2 / const.G).to(u.kg)
+    ratios = np.array(constants.moon_moments_over_mr2)
+    body = RigidBody((ratios * mass * (1738 * u.km) ** 2).to(u.kg * u.m**2), mass=mass) if figure else RigidBody(ratios)
+    return Scene(RotationState(body, q, omega), EPOCH, EPOCH + np.linspace(span_days / outputs, span_days, outputs) * u.day,
+                 perturbers=("earth", "sun"), orbit=Orbit.rebound(sim, "Luna"), tolerance=tolerance)
+
+
+def flattened_earth_scene(span_days, outputs, tolerance, orbit):
+    """The Earth with a 50x flattened figure, Moon + Sun (the scene of tests/test_scene.py): one-way on
+    DE421's orbits within the back-reaction bound, coupled when given as a REBOUND particle."""
+    mass = (de421_constants().gm["earth"] * u.au**3 / u.day**2 / const.G).to(u.kg)
+    body = RigidBody(([0.33, 0.331, 0.38] * mass * (6378 * u.km) ** 2).to(u.kg * u.m**2), mass=mass)
+    state = RotationState.from_euler313(body, 10 * u.deg, 23 * u.deg, 30 * u.deg, [0, 0, 2 * np.pi] * u.rad / u.day)
+    return Scene(state, EPOCH, EPOCH + np.linspace(span_days / outputs, span_days, outputs) * u.day,
+                 perturbers=("moon", "sun"), orbit=orbit, tolerance=tolerance)
+
+
+def moonlike_scene(span_days, outputs, tolerance, figure=True):
+    """A Moon-mass body with a 200x lunar figure ((C-A)/(M R²) = 0.05) 0.00257 au from a 3e-6 Msun planet
+    1 au from a Sun (the three-body system of tests/test_scene.py)."""
+    sim = rebound.Simulation()
+    sim.units = ("AU", "day", "Msun")
+    sim.t = float(sum(tdb_days(EPOCH)))
+    sim.add(m=1.0, name="Sun")
+    sim.add(m=3e-6, a=1.0, name="Planet")
+    sim.add(m=3.7e-8, a=0.00257, e=0.05, inc=0.1, primary=sim.particles[1], name="Body")
+    sim.move_to_com()
+    sim.exact_finish_time = 1
+    mass, radius = 3.7e-8 * const.M_sun, 1.16e-5 * u.au
+    body = (RigidBody(([0.35, 0.38, 0.40] * mass * radius**2).to(u.kg * u.m**2), mass=mass) if figure
+            else RigidBody([0.35, 0.38, 0.40]))
+    n = float(np.sqrt(sim.G * 3.037e-6 / 0.00257**3))
+    state = RotationState.from_euler313(body, 10 * u.deg, 20 * u.deg, 30 * u.deg, [0.01 * n, 0.02 * n, n] * u.rad / u.day)
+    return Scene(state, EPOCH, EPOCH + np.linspace(span_days / outputs, span_days, outputs) * u.day,
+                 perturbers=("sun", "planet"), orbit=Orbit.rebound(sim, "Body"), tolerance=tolerance)
 
 
 def scenes():
@@ -77,6 +125,20 @@ def scenes():
     closed = Scene(symmetric, EPOCH, EPOCH + np.linspace(0.01, 100.0, 2000) * u.day, tolerance=1e-12 * u.rad)
     out.append(("closed form", "axisymmetric body (1, 1, 2), no perturbers, 100 d, 2000 outputs: regular precession "
                 "vs the elliptic flow", closed, closed))
+    # The coupling: on DE421's orbits one-way is the skip (the full run is coupled, in REBOUND); on a
+    # REBOUND orbit the planner takes the coupled route, and its "full" peer here is the one-way run of
+    # the same state given by moment ratios (the only way to ask a Scene for one-way there).
+    out.append(("one-way (DE421) instead of coupled", "Earth with a 50x flattened figure, Moon + Sun, 10 d, "
+                "100 outputs, tolerance 10 arcsec (full: the same given as a REBOUND particle)",
+                flattened_earth_scene(10.0, 100, 10 * u.arcsec, Orbit.de421("earth")),
+                flattened_earth_scene(10.0, 100, 10 * u.arcsec, Orbit.rebound(simulation_from_de421(EPOCH), "Earth"))))
+    for outputs in (5, 200):
+        out.append(("coupled instead of one-way (N-body)", f"the Moon's figure as 'Luna' in the 11-body DE421 "
+                    f"REBOUND simulation, Earth + Sun, 30 d, {outputs} outputs",
+                    luna_scene(30.0, outputs, 1 * u.arcsec), luna_scene(30.0, outputs, 1 * u.arcsec, figure=False)))
+    out.append(("coupled instead of one-way (N-body)", "Moon-mass body with a 200x lunar figure, planet + Sun "
+                "(3 bodies), 10 d, 100 outputs, tolerance 200 arcsec", moonlike_scene(10.0, 100, 200 * u.arcsec),
+                moonlike_scene(10.0, 100, 200 * u.arcsec, figure=False)))
     return out
 
 
@@ -104,7 +166,8 @@ def measure(repeat):
         rows.append({"skip": skip, "description": description, "full": full_time, "planned": planned_time,
                          "error": error * 206264.80624709636, "estimate": planned.error_estimate.to_value(u.arcsec),
                          "tolerance": planned.plan.tolerance_rad * 206264.80624709636, "route": planned.plan.route,
-                         "dropped": ", ".join(planned.plan.dropped) or "none", "source": planned.plan.orbit_source})
+                         "dropped": ", ".join(planned.plan.dropped) or "none", "source": planned.plan.orbit_source,
+                         "full_route": full_plan.route})
         print(f"{skip:26s} full {full_time * 1e3:8.1f} ms  planned {planned_time * 1e3:8.1f} ms  "
               f"x{full_time / planned_time:6.2f}  error {rows[-1]['error']:.2e} arcsec  "
               f"estimate {rows[-1]['estimate']:.2e}  ({planned.plan.route}, dropped {rows[-1]['dropped']})")
@@ -123,7 +186,7 @@ def markdown(rows, repeat):
              "| tolerance (arcsec) | plan |"),
              "|---|---|---:|---:|---:|---:|---:|---:|---|"]
     for r in rows:
-        plan = f"{r['route']}, orbits {r['source']}, dropped {r['dropped']}"
+        plan = f"{r['route']}, orbits {r['source']}, dropped {r['dropped']} (full: {r['full_route']})"
         lines.append(f"| {r['skip']} | {r['description']} | {r['full'] * 1e3:.1f} | {r['planned'] * 1e3:.1f} | "
                      f"{r['full'] / r['planned']:.2f} | {r['error']:.2e} | {r['estimate']:.2e} | {r['tolerance']:g} "
                      f"| {plan} |")

@@ -16,10 +16,13 @@ Decisions, cheapest first:
 3. **Known orbits → ephemeris**: a body DE421 carries (even when handed over as a REBOUND particle)
    and its perturbers are taken from DE421; a REBOUND (N-body) run only when the body's orbit is
    known through the simulation alone.
-4. **Back-reaction → one-way coupling**: the rotation does not act on the orbits. The estimate needs
-   absolute moments and a mass; a plan that finds the back-reaction above tolerance is refused
-   (:class:`PlanError`): fully coupled runs are :class:`spinorbit.coupling.rigid_body.CoupledRigidBody`
-   and ``spinorbit moon``.
+4. **Negligible back-reaction → one-way coupling**: the rotation does not act on the orbits. For a
+   body with mass in the orbit model whose RigidBody gives moments in kg m² and its mass, the figure's
+   force on the orbits is bounded through to the attitude (:func:`spinorbit.planner.back_reaction_bound`);
+   within the drop share of the tolerance → one-way, that number in the reason and in the error
+   estimate; above it → the **coupled** route: REBOUND's BS with the rotation as a user ODE and the
+   figure's back-reaction (:class:`spinorbit.coupling.rigid_body.CoupledRigidBody`, ``coupled=True``).
+   The Moon on DE421's orbits needs neither: DE421 integrated its orbit with the lunar figure.
 5. **Outputs only at the end → one output time**: the dense interpolant is formed for the last step alone, quantities computed once.
 6. **Integrator**: the quaternion DOP853 (non-singular everywhere), the fastest in every measured
    work-precision scene (``docs/performance.md``). The canonical-element integrator is used only when
@@ -31,6 +34,7 @@ times are astropy Times (TDB inside), distances au, GM au³/day².
 
 from __future__ import annotations
 
+import functools
 import math
 import time as _time
 from dataclasses import dataclass, field
@@ -49,6 +53,7 @@ from .planner import (
     PerturberEstimate,
     Plan,
     attitude_sensitivity,
+    back_reaction_bound,
     dropped_torque_bound,
     initial_rtol,
     max_torque_over_a,
@@ -56,7 +61,8 @@ from .planner import (
 from .state import RotationState
 from .time import tdb_days, time_from_tdb_days
 
-__all__ = ["QUANTITIES", "FixedPerturber", "Orbit", "PlanError", "Scene", "SceneError", "SceneResult"]
+__all__ = ["QUANTITIES", "EphemerisPerturber", "FixedPerturber", "Orbit", "PlanError", "Scene", "SceneError",
+           "SceneResult"]
 
 #: Quantities a scene can ask for.
 QUANTITIES = ("attitude", "omega", "periods")
@@ -67,6 +73,30 @@ CHECK_RTOL_FACTOR = 10.0
 #: Near the singular sets of the canonical elements the planner refuses that integrator: 1 − m (or
 #: 1 − μ) and sin J below this many times the element integrator's own stop thresholds.
 SINGULAR_MARGIN = 100.0
+#: BS eps range of the coupled route. Its error control covers the orbits too (positions ~1 au):
+#: looser than 1e-10 would put the orbits' error above the one-way sampler's default 1e-10.
+COUPLED_EPS_RANGE = (1e-13, 1e-10)
+#: Largest relative difference allowed between the body's mass (RigidBody.mass) and its mass in the
+#: orbit model (G is known to 2e-5 and DE421's GMs come with their own rounding).
+MASS_MISMATCH = 1e-2
+
+
+def _sharing_samples(method):
+    """Share perturber samples between the steps of one plan() or run() call, and forget them after
+    (a later call samples afresh: a benchmark timing a run must not find the samples of the last)."""
+
+    @functools.wraps(method)
+    def wrapper(self, *args, **kwargs):
+        owned = self._cache is None
+        if owned:
+            self._cache = []
+        try:
+            return method(self, *args, **kwargs)
+        finally:
+            if owned:
+                self._cache = None
+
+    return wrapper
 
 
 class SceneError(SpinorbitError, ValueError):
@@ -134,6 +164,13 @@ class Orbit:
         return cls("rebound", str(particle), simulation=simulation)
 
 
+def _check_gm(kind, name, gm):
+    if not isinstance(gm, u.Quantity) or gm.unit.physical_type != (u.m**3 / u.s**2).physical_type:
+        raise SceneError(f"{kind} {name!r}: gm expects a Quantity in length³/time² such as 3.986e14 m3/s2; "
+                         f"got {gm!r}.")
+    return float(gm.to_value(u.au**3 / u.day**2))
+
+
 @dataclass(frozen=True)
 class FixedPerturber:
     """A point mass at a fixed ICRF position relative to the body (a user position).
@@ -152,10 +189,8 @@ class FixedPerturber:
     position: u.Quantity
 
     def __post_init__(self):
-        gm, position = self.gm, self.position
-        if not isinstance(gm, u.Quantity) or gm.unit.physical_type != (u.m**3 / u.s**2).physical_type:
-            raise SceneError(f"FixedPerturber {self.name!r}: gm expects a Quantity in length³/time² such as "
-                             f"3.986e14 m3/s2; got {gm!r}.")
+        _check_gm("FixedPerturber", self.name, self.gm)
+        position = self.position
         if (not isinstance(position, u.Quantity) or position.unit.physical_type != "length"
                 or position.shape != (3,) or not np.all(np.isfinite(position.value)) or not np.any(position.value)):
             raise SceneError(f"FixedPerturber {self.name!r}: position expects a finite, non-zero length "
@@ -163,11 +198,64 @@ class FixedPerturber:
 
     @property
     def gm_au3_day2(self):
-        return float(self.gm.to_value(u.au**3 / u.day**2))
+        return _check_gm("FixedPerturber", self.name, self.gm)
 
     @property
     def position_au(self):
         return self.position.to_value(u.au).astype(float)
+
+
+@dataclass(frozen=True)
+class EphemerisPerturber:
+    """A point mass moving on a user ephemeris (like :meth:`Orbit.ephemeris`, for a perturber).
+
+    It goes through the planner like a DE421 body: surveyed, bounded, dropped or kept, and sampled
+    onto the same adaptive Hermite grid (:func:`spinorbit.coupling.one_way.sample_states`).
+
+    Parameters
+    ----------
+    name : str
+    gm : Quantity
+        G·M (any unit of length³/time²).
+    function : callable
+        ``function(days) -> (positions (n, 3) au, velocities (n, 3) au/day)`` at TDB days since J2000
+        (vectorised over ``days``), ICRF axes.
+    relative : bool
+        True: the states are relative to the rotating body's centre (no orbit of the body needed);
+        False (default): barycentric, and the scene's ``orbit`` gives the body's.
+    """
+
+    name: str
+    gm: u.Quantity
+    function: object
+    relative: bool = False
+
+    def __post_init__(self):
+        _check_gm("EphemerisPerturber", self.name, self.gm)
+        if not callable(self.function):
+            raise SceneError(f"EphemerisPerturber {self.name!r}: function expects a callable days -> (positions, "
+                             f"velocities); got {type(self.function).__name__}.")
+        if not isinstance(self.relative, bool):
+            raise SceneError(f"EphemerisPerturber {self.name!r}: relative expects True or False; got {self.relative!r}.")
+
+    @property
+    def gm_au3_day2(self):
+        return _check_gm("EphemerisPerturber", self.name, self.gm)
+
+    def states(self, days):
+        """(n, 6) positions and velocities at ``days``; SceneError if the function returns other shapes."""
+        try:
+            positions, velocities = (np.asarray(a, dtype=float) for a in self.function(days))
+        except (TypeError, ValueError) as error:
+            raise SceneError(f"EphemerisPerturber {self.name!r}: function expects to return (positions, velocities) "
+                             f"as arrays of shape ({days.size}, 3); calling it failed: {error}") from None
+        if positions.shape != (days.size, 3) or velocities.shape != (days.size, 3):
+            raise SceneError(f"EphemerisPerturber {self.name!r}: function expects to return (positions, velocities) "
+                             f"of shape ({days.size}, 3) each for {days.size} times; got {positions.shape} and "
+                             f"{velocities.shape}.")
+        if not (np.all(np.isfinite(positions)) and np.all(np.isfinite(velocities))):
+            raise SceneError(f"EphemerisPerturber {self.name!r}: function returned NaN or inf.")
+        return np.concatenate([positions, velocities], axis=1)
 
 
 @dataclass
@@ -184,8 +272,10 @@ class SceneResult:
     error_estimate : Quantity
         Attitude error estimate (arcsec): the sum of ``error_parts``.
     error_parts : dict of Quantity
-        ``dropped`` (bound of what the plan left out), ``integration`` (a posteriori: the run against
-        one at 10× its rtol; conservative), ``sampling`` (3ε × the kept torques' bound).
+        ``dropped`` (bound of the perturbers the plan left out), ``integration`` (a posteriori: the run
+        against one at 10× its rtol or BS eps; conservative), ``sampling`` (3ε × the kept torques'
+        bound; 0 on the coupled route, which has no sampling), ``back_reaction`` (bound of the
+        figure's force on the orbits that a one-way route leaves out).
     plan : Plan
     wall_seconds : float
         Wall time of :meth:`Scene.run` (it includes planning only when ``run`` planned itself).
@@ -231,7 +321,12 @@ class Scene:
     Parameters
     ----------
     state : spinorbit.RotationState
-        Attitude (relative to ICRF) and spin at ``epoch``.
+        Attitude (relative to ICRF) and spin at ``epoch``. When its RigidBody has moments in kg m²
+        and a ``mass`` (which must match the body's mass in the orbit model within 1 %), the planner
+        estimates the figure's back-reaction on the orbits and runs the coupled route if needed.
+        A sequence or a mapping ``{name: state}`` makes a scene of several bodies
+        (:mod:`spinorbit.scene_bodies`: planned per body, sampled once per shared orbit; names from
+        ``RigidBody.name`` or ``body0``, ``body1``…).
     epoch : astropy.time.Time
         Time of ``state`` (scalar).
     times : astropy.time.Time
@@ -239,8 +334,9 @@ class Scene:
     perturbers : sequence of str or FixedPerturber
         DE421 body names (``"sun"``, ``"earth"``, ``"jupiter"``…; particle names for a REBOUND orbit)
         and/or :class:`FixedPerturber` s. Empty: torque-free.
-    orbit : Orbit, optional
-        Needed when any perturber is named.
+    orbit : Orbit or dict, optional
+        Needed when any perturber is named; for several bodies, one Orbit for all or
+        ``{name: Orbit}``.
     tolerance : Quantity
         Attitude tolerance (angle) of the whole run.
     quantities : sequence of str
@@ -258,6 +354,18 @@ class Scene:
 
     def __init__(self, state, epoch, times, perturbers=(), orbit=None, tolerance=1 * u.arcsec,
                  quantities=QUANTITIES, integrator="auto", sample_tolerance=1e-10):
+        self.members, self._cache = None, None
+        if isinstance(state, (list, tuple, dict)):
+            from . import scene_bodies
+
+            def make(member_state, member_orbit):
+                return Scene(member_state, epoch, times, perturbers, member_orbit, tolerance, quantities, integrator,
+                             sample_tolerance)
+
+            self.members = scene_bodies.members(state, orbit, make)
+            self.epoch, self.times, self.tolerance_rad, self.output_days, self.epoch_day = (
+                scene_bodies.common_times(self.members))
+            return
         if not isinstance(state, RotationState):
             raise SceneError(f"state expects a spinorbit.RotationState; got {type(state).__name__}.")
         if not isinstance(epoch, Time) or not epoch.isscalar:
@@ -290,16 +398,60 @@ class Scene:
                              f"got {type(orbit).__name__}.")
         self.orbit = orbit
         self.fixed = tuple(p for p in perturbers if isinstance(p, FixedPerturber))
-        named = [p for p in perturbers if not isinstance(p, FixedPerturber)]
+        self.moving = tuple(p for p in perturbers if isinstance(p, EphemerisPerturber))
+        named = [p for p in perturbers if not isinstance(p, (FixedPerturber, EphemerisPerturber))]
         bad = [p for p in named if not isinstance(p, str)]
         if bad:
-            raise SceneError(f"perturbers expects body names (str) or FixedPerturber; got {bad[0]!r}.")
+            raise SceneError(f"perturbers expects body names (str), FixedPerturber or EphemerisPerturber; got "
+                             f"{bad[0]!r}.")
+        barycentric = [p.name for p in self.moving if not p.relative]
+        if barycentric and orbit is None:
+            raise SceneError(f"perturbers {barycentric} are barycentric EphemerisPerturbers and need the body's orbit: "
+                             "give orbit=Orbit.de421(...), Orbit.ephemeris(...) or Orbit.rebound(...), or "
+                             "relative=True.")
         if named and orbit is None:
             raise SceneError(f"perturbers {named} need the body's orbit: give orbit=Orbit.de421(...), "
                              "Orbit.ephemeris(...) or Orbit.rebound(...).")
         self.named = tuple(self._resolve(named))
-        if len(set(self.named)) != len(self.named):
-            raise SceneError(f"perturbers lists a body twice: {list(self.named)}.")
+        everyone = [*self.named, *(p.name for p in self.fixed), *(p.name for p in self.moving)]
+        if len(set(everyone)) != len(everyone):
+            raise SceneError(f"perturbers lists a body twice: {everyone}.")
+        self._cache = None  # perturber samples shared within one plan() / run() (see _sharing_samples)
+        self.moments_per_mass = self._moments_per_mass()
+
+    def _moments_per_mass(self):
+        """(A, B, C)/M in au² when the body's RigidBody has moments in kg m² and a mass, else None.
+
+        The back-reaction needs the figure's absolute size; moment *ratios* do not give it. The mass
+        must agree with the body's mass in the orbit model (to :data:`MASS_MISMATCH`).
+        """
+        from astropy import constants
+
+        body = self.state.body
+        if body.mass is None or body.moment_unit.physical_type != "moment of inertia":
+            return None
+        per_mass = (np.array(body.principal_moments) * body.moment_unit / body.mass).to_value(u.au**2)
+        model = self._gm_in_orbit_model()
+        given = float((constants.G * body.mass).to_value(u.au**3 / u.day**2))
+        if model > 0.0 and abs(given / model - 1.0) > MASS_MISMATCH:
+            raise SceneError(
+                f"the body's mass {body.mass:.6g} (G·M = {given:.6g} au³/day²) differs from its mass in the orbit model "
+                f"(G·M = {model:.6g} au³/day², '{self.orbit.name}') by {abs(given / model - 1.0):.2%}; expected them "
+                f"to agree within {MASS_MISMATCH:.0%}. Give RigidBody the orbit model's mass (or fix the particle's m).")
+        return tuple(float(v) for v in per_mass)
+
+    def _gm_in_orbit_model(self):
+        """The body's G·M (au³/day²) in the orbit model: 0 for a test particle or a given ephemeris."""
+        if self.orbit is None or self.orbit.kind == "ephemeris":
+            return 0.0
+        if self.orbit.kind == "rebound":
+            from .coupling.rebound_adapter import body_index
+
+            sim = self.orbit.simulation
+            return float(sim.particles[body_index(sim, self.orbit.name)].m * sim.G)
+        from .ephemeris import de421_constants
+
+        return float(de421_constants().gm[self.orbit.name])
 
     def _resolve(self, names):
         if self.orbit is not None and self.orbit.kind == "rebound":
@@ -352,8 +504,25 @@ class Scene:
         return "rebound"
 
     def _sampler(self, source, names, tolerance):
-        """Sample ``names`` relative to the body from ``source`` over the epoch…last-output span."""
+        """Sample ``names`` relative to the body from ``source`` over the epoch…last-output span.
+
+        Within one :meth:`plan` or :meth:`run` (and across the bodies of a scene that share an orbit),
+        samples already taken at the same tolerance from the same source are reused.
+        """
+        if self._cache is not None:
+            for cached_source, cached_tolerance, cached in self._cache:
+                if cached_source == source and cached_tolerance == tolerance and set(names) <= set(cached.names):
+                    return cached if tuple(names) == cached.names else _subset(cached, names)
+        samples = self._sample(source, names, tolerance)
+        if self._cache is not None:
+            self._cache.append((source, tolerance, samples))
+        return samples
+
+    def _sample(self, source, names, tolerance):
         from .coupling import one_way
+
+        if source == "user":
+            return self._sample_user(names, tolerance)
 
         start = time_from_tdb_days(self.epoch_day)
         end = time_from_tdb_days(self.output_days[-1])
@@ -363,14 +532,48 @@ class Scene:
         orbit = (one_way.de421_orbit(self.orbit.name) if source == "de421" else self.orbit.function)
         return one_way.sample_from_ephemeris(orbit, start, end, names, tolerance=tolerance)
 
+    def _sample_user(self, names, tolerance):
+        """Sample the EphemerisPerturbers ``names`` relative to the body (same grid and checks as DE421's)."""
+        from .coupling import one_way
+
+        chosen = [next(p for p in self.moving if p.name == name) for name in names]
+        body = self._body_orbit() if any(not p.relative for p in chosen) else None
+
+        def provider(days):
+            out = np.empty((days.size, len(chosen), 6))
+            centre = None if body is None else np.concatenate([np.asarray(a, dtype=float) for a in body(days)], axis=1)
+            for i, perturber in enumerate(chosen):
+                out[:, i] = perturber.states(days) - (0.0 if perturber.relative else centre)
+            return out
+
+        return one_way.sample_states(provider, names, [p.gm_au3_day2 for p in chosen],
+                                     time_from_tdb_days(self.epoch_day), time_from_tdb_days(self.output_days[-1]),
+                                     tolerance)
+
+    def _body_orbit(self):
+        """The body's barycentric orbit as a callable days -> (positions, velocities), au and au/day."""
+        from .coupling import one_way
+
+        if self.orbit.kind == "de421":
+            return one_way.de421_orbit(self.orbit.name)
+        if self.orbit.kind == "rebound":
+            return one_way.rebound_orbit(self.orbit.simulation, self.orbit.name)
+        return self.orbit.function
+
+    @_sharing_samples
     def plan(self, skip=True):
         """Decide how to run the scene; ``skip=False`` gives the reference plan (nothing skipped).
 
         Returns
         -------
-        Plan
-            ``print(plan)`` lists every decision with its reason.
+        Plan or spinorbit.scene_bodies.ScenePlans
+            ``print(plan)`` lists every decision with its reason; one Plan per body for a scene of
+            several bodies.
         """
+        if self.members is not None:
+            from .scene_bodies import plan_many
+
+            return plan_many(self.members, skip)
         decisions = []
         tolerance = self.tolerance_rad
         moments = self.state.body.principal_moments
@@ -382,7 +585,7 @@ class Scene:
             decisions.append(Decision("outputs", f"{self.output_days.size} output times (dense output)",
                                       "several output times were asked"))
         shape = self._shape_decision(skip)
-        if not self.named and not self.fixed:
+        if not self.named and not self.fixed and not self.moving:
             decisions.append(Decision("route", "exact torque-free solution, no integration",
                                       "the scene has no perturbers: the torque is zero"))
             decisions.append(shape)
@@ -406,10 +609,11 @@ class Scene:
                 e.kept = False
             return Plan("torque-free", source, (), tuple(names), estimates, "exact", None, self.end_only,
                         tolerance, kappa, total, False, decisions)
+        route, back_reaction, bound, coupling = self._coupling(skip, source, kappa, momentum, moments)
         dropped, used = [], 0.0
-        if skip:
+        if skip and route == "one-way":
             for name in sorted(names, key=lambda n: estimates[n].bound_rad):
-                if used + estimates[name].bound_rad <= DROP_SHARE * tolerance:
+                if used + estimates[name].bound_rad <= DROP_SHARE * tolerance - back_reaction:
                     used += estimates[name].bound_rad
                     dropped.append(name)
         for name in names:
@@ -420,21 +624,33 @@ class Scene:
                    f"{e.bound_rad * ARCSEC_PER_RAD:.3g} arcsec")
             if name in dropped:
                 why += f" (all dropped together {used * ARCSEC_PER_RAD:.3g} arcsec ≤ {DROP_SHARE:g} × tolerance)"
+            elif route == "coupled":
+                why = ("the coupled route keeps every perturber (in an N-body run dropping one saves nothing "
+                       "measurable, docs/scenes.md); " + why)
             elif skip:
                 why += f" > what is left of {DROP_SHARE:g} × tolerance"
             else:
                 why = "skip=False (reference run); " + why
             decisions.append(Decision(f"perturber {name}", verdict, why))
         decisions.append(Decision("bound", "per-perturber estimate", survey_note))
-        decisions.append(self._coupling_decision())
+        decisions.extend(coupling)
+        if route == "coupled":
+            eps = float(np.clip(initial_rtol(tolerance), *COUPLED_EPS_RANGE))
+            decisions.append(Decision("integrator", f"REBOUND BS, eps {eps:.1e}, rotation as a user ODE (checked a "
+                                      f"posteriori against a run at {CHECK_RTOL_FACTOR:g}× eps)",
+                                      "BS is the one REBOUND integrator that integrates a user ODE together with the "
+                                      "orbits (docs/coupling.md); eps within "
+                                      f"{COUPLED_EPS_RANGE[0]:g}…{COUPLED_EPS_RANGE[1]:g} since it controls the orbits too"))
+            return Plan("coupled", "rebound", tuple(names), (), estimates, "rebound-bs", eps, self.end_only,
+                        tolerance, kappa, 0.0, not skip, decisions, None, 0.0, bound)
         integrator, reason = self._integrator_choice(skip)
-        share = tolerance - used
+        share = tolerance - used - back_reaction
         rtol = initial_rtol(share)
         decisions.append(Decision("integrator", f"{integrator} DOP853, rtol {rtol:.1e} (checked a posteriori "
                                   f"against a run at {CHECK_RTOL_FACTOR:g}× rtol)", reason))
         kept = tuple(n for n in names if n not in dropped)
         return Plan("one-way", source, kept, tuple(dropped), estimates, integrator, rtol, self.end_only,
-                    tolerance, kappa, used, not skip, decisions, samples)
+                    tolerance, kappa, used, not skip, decisions, samples, back_reaction, bound)
 
     def _shape_decision(self, skip=True):
         """Which form of the exact free flow the torque-free route runs (the dispatch of ``core.torque_free``).
@@ -481,17 +697,21 @@ class Scene:
         estimates = {}
         t_end = self.output_days[-1]
         survey = None
+        surveys = []
         if self.named:
             # With a REBOUND orbit every sampling pass is an N-body run, whose cost hardly depends on the
             # tolerance (the pilot and the run dominate): survey at the run's tolerance and keep it.
             # With an ephemeris, sampling costs per perturber: survey loosely, sample only the kept.
-            keep = keep and source == "rebound"
-            tolerance = self.sample_tolerance if keep else SURVEY_TOLERANCE
-            survey = self._sampler(source, self.named, tolerance)
-            distances = np.linalg.norm(survey.states[:, :, :3], axis=2)
-            for i, name in enumerate(survey.names):
-                n = max_torque_over_a(moments, survey.gm[i], distances[:, i])
-                bound = dropped_torque_bound(survey.days, n, t_end, kappa, momentum)
+            keep = self._keeps_survey(source, keep)
+            survey = self._sampler(source, self.named, self._survey_tolerance(keep))
+            surveys.append(survey)
+        if self.moving:  # user ephemerides: like an ephemeris, surveyed loosely, the kept sampled for the run
+            surveys.append(self._sampler("user", [p.name for p in self.moving], SURVEY_TOLERANCE))
+        for samples in surveys:
+            distances = np.linalg.norm(samples.states[:, :, :3], axis=2)
+            for i, name in enumerate(samples.names):
+                n = max_torque_over_a(moments, samples.gm[i], distances[:, i])
+                bound = dropped_torque_bound(samples.days, n, t_end, kappa, momentum)
                 estimates[name] = PerturberEstimate(name, float(distances[:, i].min()), bound, True)
         days = np.array([self.epoch_day, t_end])
         for fixed in self.fixed:
@@ -501,26 +721,87 @@ class Scene:
                                                                                           momentum), True)
         return estimates, (survey if keep else None)
 
-    def _coupling_decision(self):
-        """One-way, with the reason that fits the body: massless in the orbit model, or not estimated."""
-        massive = False
-        if self.orbit is not None and self.orbit.kind == "rebound":
-            from .coupling.rebound_adapter import body_index
+    def _keeps_survey(self, source, skip):
+        """Whether the survey is taken at the run's tolerance and kept for it: a planned one-way run on
+        a REBOUND orbit (the coupled route samples nothing; the reference run samples for itself)."""
+        return skip and source == "rebound" and not self._coupled_runnable()
 
-            sim = self.orbit.simulation
-            massive = sim.particles[body_index(sim, self.orbit.name)].m > 0
-        elif self.orbit is not None and self.orbit.kind == "de421":
-            massive = True
+    def _coupled_runnable(self):
+        """The coupled route can run: a REBOUND orbit, a body with mass in it and a figure of known
+        size, and every perturber a particle of the simulation."""
+        return (self.orbit is not None and self.orbit.kind == "rebound" and not self.fixed and not self.moving
+                and self.moments_per_mass is not None and self._gm_in_orbit_model() > 0.0)
+
+    def _survey_tolerance(self, keep):
+        """The survey's sampling tolerance: the run's when the survey is kept for the run."""
+        return self.sample_tolerance if keep else SURVEY_TOLERANCE
+
+    def _coupling(self, skip, source, kappa, momentum, moments):
+        """One-way or fully coupled: (route, back-reaction left out (rad), its bound (rad or None), decisions).
+
+        The bound (:func:`spinorbit.planner.back_reaction_bound`) needs the figure's absolute size and
+        the body's mass; a massless body in the orbit model has none to estimate.
+        """
         choice = "one-way (the rotation does not act on the orbits)"
-        if not massive:
-            return Decision("coupling", choice,
-                            "the body is massless in the orbit model (a test particle or a given ephemeris), so its "
-                            "figure cannot act on the orbits; for a real small body that force is of relative size "
-                            "(C-A)/(M r²) ~ J2 (R/r)², ≈ 1e-13 for a 300 m asteroid at 1 au (coupling/one_way.py)")
-        return Decision("coupling", choice + "; back-reaction NOT estimated",
-                        f"'{self.orbit.name}' has mass in the orbit model but a Scene knows only its moment ratios; "
-                        "for the Moon the back-reaction was measured at ≈ 0.1 arcsec over a year (docs/coupling.md: "
-                        "0.305 one-way vs 0.207 arcsec coupled): for that, run CoupledRigidBody or spinorbit moon")
+        gm_body = self._gm_in_orbit_model()
+        if gm_body == 0.0:
+            return "one-way", 0.0, None, [Decision(
+                "coupling", choice,
+                "the body is massless in the orbit model (a test particle or a given ephemeris), so its figure cannot "
+                "act on the orbits; for a real small body that force is of relative size (C-A)/(M r²) ~ J2 (R/r)², "
+                "≈ 1e-13 for a 300 m asteroid at 1 au (coupling/one_way.py)")]
+        if self.moments_per_mass is None:
+            return "one-way", 0.0, None, [Decision(
+                "coupling", choice + "; back-reaction NOT estimated",
+                f"'{self.orbit.name}' has mass in the orbit model but a Scene knows only its moment ratios (give "
+                "RigidBody the moments in kg m² and the mass for the estimate); for the Moon the back-reaction was "
+                "measured at ≈ 0.1 arcsec over a year (docs/coupling.md: 0.305 one-way vs 0.207 arcsec coupled)")]
+        big_a, _, big_c = self.moments_per_mass
+        survey = self._sampler(source, self.named, self._survey_tolerance(self._keeps_survey(source, skip)))
+        distances = np.linalg.norm(survey.states[:, :, :3], axis=2)
+        bound, displacement = back_reaction_bound(survey.days, distances, survey.gm, gm_body, big_c - big_a, moments,
+                                                  self.output_days[-1], kappa, momentum)
+        au_km = float((1 * u.au).to_value(u.km))
+        numbers = (f"figure (C-A)/M = ({math.sqrt(big_c - big_a) * au_km:.3g} km)², G·M = {gm_body:.3g} au³/day²: "
+                   f"the figure's force moves the perturber vectors by at most {float(np.max(displacement)) * au_km:.3g} "
+                   f"km and so the attitude by at most {bound * ARCSEC_PER_RAD:.3g} arcsec over the span "
+                   "(planner: back-reaction bound)")
+        if source == "de421" and self.orbit.name == "moon":
+            return "one-way", 0.0, bound, [Decision(
+                "coupling", choice + "; the back-reaction is in the ephemeris",
+                "DE421 integrated the lunar orbit together with the lunar figure (Williams et al. 2008), so its orbits "
+                "already hold what a coupled run adds; " + numbers)]
+        share = DROP_SHARE * self.tolerance_rad
+        runnable = self._coupled_runnable()
+        coupled = "fully coupled: REBOUND with the figure's force on the orbits (CoupledRigidBody, coupled=True)"
+        if runnable:
+            # Given a REBOUND orbit, the coupled BS run needs no sampling: it measured cheaper than the
+            # one-way route in every scene of benchmarks/bench_scene_skips.py, so it is the cheap route.
+            why = "skip=False (reference run): nothing left out; " if not skip else (
+                "with a REBOUND orbit the coupled run is also the cheaper one (it needs no sampling: 2.0-5.8x "
+                "faster than one-way in bench_scene_skips, docs/performance.md) and leaves nothing out; ")
+            decisions = [Decision("coupling", coupled, why + numbers)]
+            if source != "rebound":
+                decisions.append(Decision("orbits", "REBOUND (N-body) run after all",
+                                          "the coupled route integrates the orbits with the figure's force on "
+                                          "them; the ephemeris does not have it"))
+            return "coupled", 0.0, bound, decisions
+        if skip and bound <= share:
+            return "one-way", bound, bound, [Decision("coupling", choice, f"{numbers} ≤ {DROP_SHARE:g} × tolerance")]
+        if not skip:
+            return "one-way", bound, bound, [Decision(
+                "coupling", choice + "; back-reaction left out (in the error estimate)",
+                "skip=False (reference run), but a coupled run needs the orbits as a REBOUND simulation and "
+                f"every perturber as one of its particles; {numbers}")]
+        user = [p.name for p in (*self.fixed, *self.moving)]
+        what = (f"the perturbers {user} are not particles of a REBOUND simulation" if user else
+                f"the orbit is {self.orbit.kind!r}, not a REBOUND simulation")
+        raise PlanError(
+            f"the back-reaction bound {bound * ARCSEC_PER_RAD:.3g} arcsec exceeds {DROP_SHARE:g} × tolerance "
+            f"({share * ARCSEC_PER_RAD:.3g} arcsec), so one-way coupling is not within the tolerance; a coupled run "
+            f"needs every orbit in one REBOUND simulation, but {what}. Give orbit=Orbit.rebound(sim, "
+            f"'{self.orbit.name}') with the body and its perturbers as particles (e.g. from simulation_from_de421), "
+            "or loosen the tolerance.")
 
     def _integrator_choice(self, skip):
         measured = ("quaternion DOP853 was the fastest spinorbit method at every measured precision "
@@ -545,11 +826,17 @@ class Scene:
     # ------------------------------------------------------------------------------------------
     # Running
 
+    @_sharing_samples
     def run(self, plan=None, progress=None):
         """Carry out ``plan`` (default: :meth:`plan`) and return a :class:`SceneResult`.
 
-        ``progress``, if given, is called with a fraction in [0, 1] as the run advances.
+        ``progress``, if given, is called with a fraction in [0, 1] as the run advances. A scene of
+        several bodies returns :class:`~spinorbit.scene_bodies.SceneResults` (one result per body).
         """
+        if self.members is not None:
+            from .scene_bodies import run_many
+
+            return run_many(self.members, self.plan() if plan is None else plan, progress)
         clock = _time.perf_counter()
         plan = self.plan() if plan is None else plan
         if not isinstance(plan, Plan):
@@ -560,8 +847,11 @@ class Scene:
             table = self._torque_free_table(closed_forms=not plan.full)
             parts = {"dropped": plan.dropped_bound_rad, "integration": 0.0, "sampling": 0.0}
             stats = {}
+        elif plan.route == "coupled":
+            table, parts, stats = self._coupled(plan, report)
         else:
             table, parts, stats = self._one_way(plan, report)
+        parts.setdefault("back_reaction", plan.back_reaction_rad)
         report(1.0)
         parts_q = {k: (v * u.rad).to(u.arcsec) for k, v in parts.items()}
         total = sum(parts.values()) * u.rad
@@ -600,6 +890,9 @@ class Scene:
 
         named = tuple(n for n in plan.kept if n in self.named)
         fixed = [fixed_source(p.gm_au3_day2, p.position_au) for p in self.fixed if p.name in plan.kept]
+        moving = [p.name for p in self.moving if p.name in plan.kept]
+        if moving:
+            fixed += self._sampler("user", moving, self.sample_tolerance).sources()
         if named and plan.samples is not None:
             samples = _subset(plan.samples, named)
         else:
@@ -622,13 +915,37 @@ class Scene:
                 break
             rtol = max(rtol / 100.0, 1e-13)
         kept_bound = sum(plan.estimates[n].bound_rad for n in plan.kept)
-        sampling = 3.0 * self.sample_tolerance * kept_bound if named else 0.0
+        sampling = 3.0 * self.sample_tolerance * kept_bound if named or moving else 0.0
         if "omega" not in self.quantities:
             run.remove_column("omega")
         run.meta["rtol"] = rtol
         stats = {k: run.meta[k] for k in ("accepted", "rejected", "rhs_calls")}
         stats.update(rtol=rtol, samples=int(samples.days.size), passes=int(getattr(samples, "passes", 0)))
         return run, {"dropped": plan.dropped_bound_rad, "integration": integration, "sampling": sampling}, stats
+
+    def _coupled(self, plan, report):
+        """The fully coupled REBOUND run (BS), checked against a second run at 10× eps."""
+        from .coupling.one_way import _from_core, _to_core
+        from .coupling.rigid_body import coupled_run
+
+        y0 = _to_core(self.state)
+        eps = plan.rtol
+        share = max(plan.integration_share_rad, 0.0)
+        for attempt in range(MAX_RTOL_RETRIES + 1):
+            rows, stats = coupled_run(self.orbit.simulation, self.orbit.name, self.moments_per_mass, y0,
+                                      self.epoch_day, self.output_days, plan.kept, eps)
+            check, _ = coupled_run(self.orbit.simulation, self.orbit.name, self.moments_per_mass, y0,
+                                   self.epoch_day, self.output_days, plan.kept, min(eps * CHECK_RTOL_FACTOR, 1e-6))
+            integration = float(np.max(_angles(rows[:, :4], check[:, :4])))
+            report((attempt + 1) / (MAX_RTOL_RETRIES + 1))
+            if integration <= 0.5 * share or eps <= COUPLED_EPS_RANGE[0]:
+                break
+            eps = max(eps / 100.0, COUPLED_EPS_RANGE[0])
+        rows[:, :4] /= np.linalg.norm(rows[:, :4], axis=1, keepdims=True)
+        table = self._table([_from_core(self.state.body, y) for y in rows])
+        table.meta["rtol"] = eps
+        stats.update(rtol=eps)
+        return table, {"dropped": 0.0, "integration": integration, "sampling": 0.0}, stats
 
 
 def _subset(samples, names):

@@ -15,6 +15,7 @@ from spinorbit.coupling.rebound_adapter import (
     MissingBodyError,
     RotationCallbackError,
     install_extra_forces,
+    set_nongravitational,
 )
 from spinorbit.coupling.rigid_body import CoupledRigidBody, RestoreError
 
@@ -171,3 +172,24 @@ def test_ias15_pseudo_particle_route_conserves_and_agrees_with_bs():
     # 1.5e-14 (ω); 1e-9 leaves room for other platforms and step sequences.
     assert np.max(np.abs(np.abs(quaternion) - np.abs(reference.quaternion))) < 1e-9
     assert np.max(np.abs(hooks.state[4:] - reference.omega)) < 1e-9
+
+
+def test_attaching_a_body_keeps_earlier_non_gravitational_forces():
+    # A transverse 1e-10 au/day² on the Moon, set before the body is attached: the combined force must
+    # carry it (it was dropped when only J2/EIH flags were folded in). Over 10 d it moves the Moon by
+    # ~a t² = 1e-8 au; BS at 1e-13 is reproducible to ~1e-15 au.
+    positions = []
+    for a2 in (0.0, 1e-10):
+        sim = rebound.Simulation()
+        sim.units = ("AU", "day", "Msun")
+        sim.integrator = "bs"
+        sim.integrator.eps_abs = sim.integrator.eps_rel = BS_TOLERANCE
+        sim.add(m=1.0, name="Sun")
+        sim.add(m=3e-6, a=1.0, name="Earth")
+        sim.add(m=3.7e-8, a=0.00257, primary=sim.particles[1], name="Moon")
+        install_extra_forces(sim, earth_j2=False, gr=False)
+        set_nongravitational(sim, "Moon", 0.0, a2)
+        body = CoupledRigidBody(sim, "Moon", make_body((1e-20, 1.1e-20, 1.2e-20)), [1, 0, 0, 0, 0, 0, 0.23])
+        body.integrate(10.0)
+        positions.append(np.array(sim.particles["Moon"].xyz))
+    assert np.linalg.norm(positions[1] - positions[0]) > 1e-9

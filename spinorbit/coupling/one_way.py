@@ -68,6 +68,7 @@ __all__ = [
     "sample_from_ephemeris",
     "sample_from_rebound",
     "sample_relative_states",
+    "sample_states",
     "propagate_one_way",
     "de421_orbit",
     "rebound_orbit",
@@ -352,9 +353,33 @@ def sample_relative_states(provider, perturbers, start, end, tolerance=DEFAULT_S
     names = _perturber_names(perturbers)
     start_day, end_day = _as_days_span(start, end)
     _check_de421_span(start_day, end_day)
-    gm = np.array([de421_constants().gm[n] for n in names])
+    return sample_states(provider, names, [de421_constants().gm[n] for n in names], start, end, tolerance)
+
+
+def sample_states(provider, names, gm, start, end, tolerance=DEFAULT_SAMPLE_TOLERANCE):
+    """Sample any perturbers given as states relative to the body (adaptive grid, module docstring).
+
+    Parameters
+    ----------
+    provider : callable
+        ``provider(days) -> (n, k, 6)``: positions (au) and velocities (au/day) relative to the body
+        at sorted TDB days since J2000.
+    names : sequence of str
+        The k perturbers' names.
+    gm : sequence of float
+        Their G·M, au³/day².
+    start, end : astropy.time.Time
+    tolerance : float
+        Relative interpolation error ε.
+
+    Returns
+    -------
+    SampledPerturbers
+    """
+    names = tuple(names)
+    start_day, end_day = _as_days_span(start, end)
     grid, states, error, passes, closest = _adaptive_samples(provider, start_day, end_day, tolerance)
-    return SampledPerturbers(names, gm, grid, states, tolerance, error, passes,
+    return SampledPerturbers(names, np.asarray(gm, dtype=float), grid, states, tolerance, error, passes,
                              {names[i]: c for i, c in closest.items()})
 
 

@@ -880,10 +880,13 @@ def attach_rotation_hooks(sim, body: str, perturbers, figure, state, coupled: bo
         raise ValueError(f"degrees: expected one degree ≥ 2 per perturber, got {degrees!r}.")
     parameters[_R_DEGREES:_R_DEGREES + len(indices)] = [min(d, n_max) for d in degrees]
     extra = None
-    if isinstance(previous, ExtraForces):  # fold forces installed earlier into the combined cfunc
-        earth_j2, gr = previous.earth_j2, previous.gr
-        earth_pole = previous.parameters[_P_POLE:_P_POLE + 3]
-    if earth_j2 or gr:
+    if isinstance(previous, ExtraForces):
+        # Fold the forces installed earlier into the combined cfunc: their whole block (it indexes
+        # this simulation's particles), so that non-gravitational terms carry over with J2 and EIH.
+        extra = previous
+        parameters[_R_EXTRA:_R_EXTRA + _N_PARAMETERS] = previous.parameters
+        parameters[_R_USE_EXTRA] = 1.0
+    elif earth_j2 or gr:
         probe = rebound.Simulation()  # fill the EIH/J2 block with install_extra_forces' own code
         probe.add(m=1.0, name="Earth")
         extra = install_extra_forces(probe, earth_j2=earth_j2, gr=gr, earth_pole=earth_pole)

@@ -24,7 +24,7 @@ from .rebound_adapter import (
     simulation_from_binary,
 )
 
-__all__ = ["CHECKPOINT_KIND", "SAVE_FORMAT_VERSION", "CoupledRigidBody", "RestoreError"]
+__all__ = ["CHECKPOINT_KIND", "SAVE_FORMAT_VERSION", "CoupledRigidBody", "RestoreError", "coupled_run"]
 
 #: Version of the file format written by :meth:`CoupledRigidBody.save` (:mod:`spinorbit.checkpoint`).
 SAVE_FORMAT_VERSION = CHECKPOINT_FORMAT_VERSION
@@ -213,3 +213,56 @@ class CoupledRigidBody:
         except CheckpointError as error:
             raise RestoreError(str(error)) from None
         return cls.from_checkpoint(checkpoint)
+
+
+def coupled_run(sim, body, moments_per_mass, state, start, times, perturbers, tolerance):
+    """The fully coupled rotation of ``body`` at ``times``, on a copy of ``sim`` (``sim`` is not modified).
+
+    The copy (particles, G, integrator, extra forces reinstalled, as the one-way sampler rebuilds it)
+    is first carried to ``start`` by its own integrator with point masses — the orbits the one-way
+    route samples — then switched to BS (the only integrator that couples a user ODE,
+    ``docs/coupling.md``) with the rotation attached, ``coupled=True``, and integrated through
+    ``times`` with ``exact_finish_time``.
+
+    Parameters
+    ----------
+    sim : rebound.Simulation
+        ("AU", "day", "Msun") units, ``t`` in TDB days since J2000 (e.g. ``simulation_from_de421``).
+    body : str
+        Particle with the figure; it must have mass.
+    moments_per_mass : (A, B, C)
+        Principal moments over the body's mass, au² (degree-2 figure; times the particle's mass it is
+        the figure in the simulation's units).
+    state : array_like, shape (7,)
+        (q, ω) at ``start``: q principal axes → ICRF (scalar first), ω principal axes, rad/day.
+    start : float
+        TDB days since J2000.
+    times : ndarray
+        Output times after ``start``, increasing, TDB days since J2000.
+    perturbers : sequence of str
+        Particles that torque the figure and feel its back-reaction.
+    tolerance : float
+        BS eps_abs = eps_rel.
+
+    Returns
+    -------
+    states : ndarray, shape (n, 7)
+        (q, ω) at ``times``, same axes as ``state``.
+    stats : dict
+        ``steps`` (BS steps taken, REBOUND's ``steps_done``), ``wall_seconds`` (integration only).
+    """
+    from ..core.gravity_field import make_body
+    from .chunked_run import integrate_to_outputs
+    from .one_way import _Snapshot
+
+    copy = _Snapshot.of(sim).build()
+    copy.integrate(start)
+    copy.integrator = "bs"
+    copy.integrator.eps_abs = tolerance
+    copy.integrator.eps_rel = tolerance
+    mass = copy.particles[body_index(copy, body)].m
+    figure = make_body(tuple(float(m) * mass for m in moments_per_mass), mass=mass)
+    rigid = CoupledRigidBody(copy, body, figure, state, perturbers=perturbers, coupled=True)
+    steps = copy.steps_done
+    _, rows, wall = integrate_to_outputs(rigid, times, lambda b: b.state, 7)
+    return rows, {"steps": int(copy.steps_done - steps), "wall_seconds": wall}

@@ -223,6 +223,28 @@ def _shift_phase(y, period, advance_g):
         y[4] = z - 2.0 * math.pi * np.rint(z / (2.0 * math.pi))
 
 
+@jit
+def _rk8_scratch():
+    """Stage derivatives, stage state and new state of :func:`_rk8_step` (allocated once per run)."""
+    return np.empty((N_STAGES, 6)), np.empty(6), np.empty(6)
+
+
+@jit(inline="always")
+def _accept_step(y, y_new, free):
+    """y ← y_new, whole periods of s moved into z (``free`` from :func:`free_motion_numbers`)."""
+    for c in range(6):
+        y[c] = y_new[c]
+    _shift_phase(y, free[3], free[4])
+
+
+@jit
+def _write_output(row, y, ic):
+    """One output row: y in one representation (|κ s| ≤ 2K, :func:`reduce_phase`)."""
+    for c in range(6):
+        row[c] = y[c]
+    reduce_phase(row, ic)
+
+
 @jit(inline="always")
 def _landing_step(h, remaining):
     """Step h shortened to land on an output ``remaining`` away: in one step if within 1 % of a
@@ -249,9 +271,7 @@ def mean_elements_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, model, fr
     """
     y = el0.copy()
     t = t0
-    k = np.empty((N_STAGES, 6))
-    tmp = np.empty(6)
-    y_new = np.empty(6)
+    k, tmp, y_new = _rk8_scratch()
     steps = 0
     for i in range(t_out.shape[0]):
         target = t_out[i]
@@ -268,13 +288,9 @@ def mean_elements_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, model, fr
             h = _landing_step(h, remaining)
             _rk8_step(t, y, direction * h, mc, model, frame, ic, kind, k, tmp, y_new)
             t = target if h == remaining else t + direction * h
-            for c in range(6):
-                y[c] = y_new[c]
-            _shift_phase(y, free[3], free[4])
+            _accept_step(y, y_new, free)
             steps += 1
-        for c in range(6):
-            out[i, c] = y[c]
-        reduce_phase(out[i], ic)  # outputs in one representation: |κ s| ≤ 2K
+        _write_output(out[i], y, ic)
     return t_out.shape[0], t, y, VALID, steps
 
 
@@ -331,9 +347,7 @@ def mean_elements_anomaly_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, m
     t = t0
     f = true_anomaly_of_time(t0, model, par)
     free_rate = mc[MC_A] * el0[0]  # ds/dt of the free motion
-    k = np.empty((N_STAGES, 6))
-    tmp = np.empty(6)
-    y_new = np.empty(6)
+    k, tmp, y_new = _rk8_scratch()
     steps = 0
     for i in range(t_out.shape[0]):
         target = t_out[i]
@@ -356,13 +370,9 @@ def mean_elements_anomaly_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, m
                 t_new = time_of_true_anomaly(f, model, par)
             y_new[3] += free_rate * (t_new - t)
             t = t_new
-            for c in range(6):
-                y[c] = y_new[c]
-            _shift_phase(y, free[3], free[4])
+            _accept_step(y, y_new, free)
             steps += 1
-        for c in range(6):
-            out[i, c] = y[c]
-        reduce_phase(out[i], ic)
+        _write_output(out[i], y, ic)
     return t_out.shape[0], t, y, VALID, steps
 
 

@@ -51,7 +51,8 @@ HARMONIC_NOISE = 1e-11
 #: asymptotic, so more terms help only up to a point. Measured on the Toutatis-like scene (Sun only,
 #: n/Ω ≈ 1/9 at perihelion), 100 orbits against heyoka's mean elements (same map on both sides),
 #: largest z error: order 2 3.5e-3 rad, order 3 7.1e-4 (7.6e-4 with 3-point ċ, c̈), order 4 (a
-#: 5-point fourth difference) 9.0e-4; Apophis-like (n/Ω ≈ 1/100) 7.1e-6 at every order.
+#: 5-point fourth difference) 9.0e-4; Apophis-like (Ω_min/n ≈ 20 at perihelion) 7.08e-6 (order 2),
+#: 7.05e-6 (order 3).
 TIME_DERIVATIVE_ORDER = 3
 #: The c⃛ term is kept only for harmonics above this fraction of the largest: on the small ones its
 #: third difference, divided by Ω_jk⁴, is rounding noise that the central differences of W amplify

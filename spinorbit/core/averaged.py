@@ -57,8 +57,10 @@ from .gravity_field import BODY_A, BODY_B, BODY_C
 from .perturbers import (
     K_A,
     K_E,
+    K_MEAN_MOTION,
     K_P,
     K_Q,
+    K_ROOT,
     KIND_KEPLER,
     PERTURBER_ROW,
     perturber_position_xyz,
@@ -125,10 +127,10 @@ def mean_constants(big_s, big_z, ic, moments):
     return out
 
 
-@jit
-def _add_axisymmetric_term(weight, c0, c0_s, c0_z, c1, c1_s, c1_z, dx, dy, dz, big_z, big_h, h, du):
-    """Add the partials of weight·(c0 + c1 p²), p = d·l (d a reference-frame unit vector), to
-    du = ∂U/∂(S, Z, H, h) and return the term's value."""
+@jit(inline="always")
+def _axisymmetric_term(weight, c0, c0_s, c0_z, c1, c1_s, c1_z, dx, dy, dz, big_z, big_h, h):
+    """weight·(c0 + c1 p²), p = d·l (d a reference-frame unit vector), and its partials in
+    (S, Z, H, h): five floats (inlined: no array crosses a call on the hot path)."""
     cos_i = big_h / big_z
     sin_i = math.sqrt(max((big_z - big_h) * (big_z + big_h), 0.0)) / big_z
     sh, ch = math.sin(h), math.cos(h)
@@ -137,11 +139,30 @@ def _add_axisymmetric_term(weight, c0, c0_s, c0_z, c1, c1_s, c1_z, dx, dy, dz, b
     dp_dh = sin_i * (dx * ch + dy * sh)
     dp_dbig_h = -along * cos_i / (big_z * sin_i) + dz / big_z
     dp_dz = along * cos_i * cos_i / (big_z * sin_i) - dz * cos_i / big_z
-    du[0] += weight * (c0_s + c1_s * p * p)
-    du[1] += weight * (c0_z + c1_z * p * p + 2.0 * c1 * p * dp_dz)
-    du[2] += weight * 2.0 * c1 * p * dp_dbig_h
-    du[3] += weight * 2.0 * c1 * p * dp_dh
-    return weight * (c0 + c1 * p * p)
+    return (weight * (c0 + c1 * p * p), weight * (c0_s + c1_s * p * p),
+            weight * (c0_z + c1_z * p * p + 2.0 * c1 * p * dp_dz), weight * 2.0 * c1 * p * dp_dbig_h,
+            weight * 2.0 * c1 * p * dp_dh)
+
+
+@jit(inline="always")
+def _alpha_beta(mc):
+    """(α, ∂α/∂S, ∂α/∂Z, β, ∂β/∂S, ∂β/∂Z) of ⟨Rᵀ I R⟩ = α 1 + β l lᵀ (module docstring)."""
+    q, q_s, q_z, trace = mc[MC_Q], mc[MC_DQ_DS], mc[MC_DQ_DZ], mc[MC_TRACE]
+    return 0.5 * (trace - q), -0.5 * q_s, -0.5 * q_z, 0.5 * (3.0 * q - trace), 1.5 * q_s, 1.5 * q_z
+
+
+@jit(inline="always")
+def _point_mass_term(mu, ix, iy, iz, elements, mc, frame):
+    """Degree-2 ⟨U⟩ of one point mass μ at inertial position (ix, iy, iz) and its partials in
+    (S, Z, H, h): five floats."""
+    alpha, alpha_s, alpha_z, beta, beta_s, beta_z = _alpha_beta(mc)
+    norm = math.sqrt(ix * ix + iy * iy + iz * iz)
+    weight = -1.5 * mu / norm ** 3
+    dx = (frame[0, 0] * ix + frame[0, 1] * iy + frame[0, 2] * iz) / norm
+    dy = (frame[1, 0] * ix + frame[1, 1] * iy + frame[1, 2] * iz) / norm
+    dz = (frame[2, 0] * ix + frame[2, 1] * iy + frame[2, 2] * iz) / norm
+    return _axisymmetric_term(weight, alpha, alpha_s, alpha_z, beta, beta_s, beta_z, dx, dy, dz,
+                              elements[1], elements[2], elements[5])
 
 
 @jit
@@ -160,10 +181,7 @@ def degree2_mean_partials(t, elements, mc, model, frame, orbit_averaged):
 def degree2_mean_partials_into(t, elements, mc, model, frame, orbit_averaged, du):
     """:func:`degree2_mean_partials` writing ∂⟨U⟩/∂(S, Z, H, h) into du (4,), returning ⟨U⟩; no
     allocation (the mean equations' inner call)."""
-    big_z, big_h, h = elements[1], elements[2], elements[5]
-    q, q_s, q_z, trace = mc[MC_Q], mc[MC_DQ_DS], mc[MC_DQ_DZ], mc[MC_TRACE]
-    alpha, alpha_s, alpha_z = 0.5 * (trace - q), -0.5 * q_s, -0.5 * q_z
-    beta, beta_s, beta_z = 0.5 * (3.0 * q - trace), 1.5 * q_s, 1.5 * q_z
+    alpha, alpha_s, alpha_z, beta, beta_s, beta_z = _alpha_beta(mc)
     for i in range(4):
         du[i] = 0.0
     u = 0.0
@@ -177,19 +195,18 @@ def degree2_mean_partials_into(t, elements, mc, model, frame, orbit_averaged, du
             qx, qy, qz = model[par + K_Q], model[par + K_Q + 1], model[par + K_Q + 2]
             ix, iy, iz = py * qz - pz * qy, pz * qx - px * qz, px * qy - py * qx  # orbit normal
             weight = -3.0 * mu / (4.0 * semi ** 3 * (1.0 - ecc * ecc) ** 1.5)
-            c0, c0_s, c0_z = 2.0 * alpha + beta, 2.0 * alpha_s + beta_s, 2.0 * alpha_z + beta_z
-            c1, c1_s, c1_z = -beta, -beta_s, -beta_z
-            norm = 1.0
+            dx = frame[0, 0] * ix + frame[0, 1] * iy + frame[0, 2] * iz
+            dy = frame[1, 0] * ix + frame[1, 1] * iy + frame[1, 2] * iz
+            dz = frame[2, 0] * ix + frame[2, 1] * iy + frame[2, 2] * iz
+            term = _axisymmetric_term(weight, 2.0 * alpha + beta, 2.0 * alpha_s + beta_s, 2.0 * alpha_z + beta_z,
+                                      -beta, -beta_s, -beta_z, dx, dy, dz, elements[1], elements[2], elements[5])
         else:
             ix, iy, iz = perturber_position_xyz(t, model, row)
-            norm = math.sqrt(ix * ix + iy * iy + iz * iz)
-            weight = -1.5 * mu / norm ** 3
-            c0, c0_s, c0_z, c1, c1_s, c1_z = alpha, alpha_s, alpha_z, beta, beta_s, beta_z
-        dx = (frame[0, 0] * ix + frame[0, 1] * iy + frame[0, 2] * iz) / norm
-        dy = (frame[1, 0] * ix + frame[1, 1] * iy + frame[1, 2] * iz) / norm
-        dz = (frame[2, 0] * ix + frame[2, 1] * iy + frame[2, 2] * iz) / norm
-        u += _add_axisymmetric_term(weight, c0, c0_s, c0_z, c1, c1_s, c1_z, dx, dy, dz, big_z, big_h, h, du)
-    return u, du
+            term = _point_mass_term(mu, ix, iy, iz, elements, mc, frame)
+        u += term[0]
+        for i in range(4):
+            du[i] += term[1 + i]
+    return u
 
 
 @jit
@@ -204,6 +221,40 @@ def degree2_mean_rhs(t, elements, mc, model, frame, orbit_averaged, dy):
     dy[3] = mc[MC_A] * elements[0] - d_s
     dy[4] = -d_z
     dy[5] = -d_h_big
+
+
+@jit(inline="always")
+def anomaly_position_xyz(f, model, par):
+    """(x, y, z, dt/df) of the elliptic KIND_KEPLER row with parameters at model[par:] at true anomaly
+    f: r = a(1 − e²)/(1 + e cos f) along P cos f + Q sin f, and dt/df = r²/(n a² √(1 − e²)) (the
+    areal velocity is constant). No Kepler equation to solve."""
+    ecc, semi = model[par + K_E], model[par + K_A]
+    cf, sf = math.cos(f), math.sin(f)
+    r = semi * (1.0 - ecc) * (1.0 + ecc) / (1.0 + ecc * cf)
+    px, py = r * cf, r * sf
+    dt_df = r * r / (model[par + K_MEAN_MOTION] * semi * semi * model[par + K_ROOT])
+    return (model[par + K_P] * px + model[par + K_Q] * py, model[par + K_P + 1] * px + model[par + K_Q + 1] * py,
+            model[par + K_P + 2] * px + model[par + K_Q + 2] * py, dt_df)
+
+
+@jit(inline="always")
+def degree2_mean_rhs_anomaly(f, elements, mc, model, frame, dy):
+    """Mean eq. (11), degree-2 ⟨U⟩ of the one perturber of ``model`` (an elliptic Kepler orbit),
+    with its true anomaly f as the independent variable: writes d(S, Z, H, s, z, h)/df into dy,
+    *without* the free rate a S of s (which the caller adds exactly as a S Δt).
+
+    In f the torque is (dt/df)/r³ · r̂ r̂ᵀ ∝ (1 + e cos f) r̂ r̂ᵀ: a trigonometric polynomial of
+    degree 3 in f, so a step spans the perihelion passage as well as the aphelion one.
+    """
+    row = MODEL_PERTURBERS + 1
+    ix, iy, iz, dt_df = anomaly_position_xyz(f, model, row + 2)
+    _, d_s, d_z, d_h_big, d_h = _point_mass_term(model[row + 1], ix, iy, iz, elements, mc, frame)
+    dy[0] = 0.0
+    dy[1] = 0.0
+    dy[2] = d_h * dt_df
+    dy[3] = -d_s * dt_df
+    dy[4] = -d_z * dt_df
+    dy[5] = -d_h_big * dt_df
 
 
 @jit

@@ -3,7 +3,11 @@
 The mean equations (:mod:`spinorbit.core.averaged`) have no rotation time scale left: S and Z are
 constant, (H, h) and the slow phases move at the torque's rate, so they are stepped on the orbital
 time scale by a fixed-step 8th-order Runge–Kutta (the DOP853 tableau without error control; steps
-land on the output times). The osculating state is recovered at each output by the first-order
+land on the output times). With one perturber on an elliptic Kepler orbit (a heliocentric body and
+the Sun) the independent variable is the perturber's true anomaly f
+(:func:`mean_elements_anomaly_kernel`): in f the torque is a trigonometric polynomial, the position
+needs no Kepler solve, and equal steps in f follow the perihelion passage; otherwise time, with the
+step set by the perturbers' angular rate (:func:`mean_elements_kernel`). The osculating state is recovered at each output by the first-order
 short-period corrections (:mod:`spinorbit.core.short_period`).
 
 Validity (checked at every step, :func:`validity_code`); averaging is refused where:
@@ -33,7 +37,10 @@ from ._dop853_tableau import B as _B_FULL
 from ._dop853_tableau import C as _C_FULL
 from ._jit import jit
 from .averaged import (
+    MC_A,
+    anomaly_position_xyz,
     degree2_mean_rhs,
+    degree2_mean_rhs_anomaly,
     fast_frequencies,
     mean_constants,
     moments_of,
@@ -52,15 +59,31 @@ from .element_forces import attitude_and_momentum, inertial_quaternion, reduce_p
 from .gravity_field import BODY_NMAX
 from .integrate_elements import elements_of_state, reference_frame_for
 from .integrate_quaternion import _validate_times, integrate_quaternion
-from .perturbers import K_E, KIND_KEPLER, PERTURBER_ROW, perturber_state
+from .perturbers import (
+    K_E,
+    K_M0,
+    K_MEAN_MOTION,
+    K_T0,
+    KIND_KEPLER,
+    PERTURBER_ROW,
+    perturber_state,
+    solve_kepler_elliptic,
+)
 from .short_period import mean_to_osculating, osculating_to_mean
 
 #: Steps of the mean equations per 2π/n, n the fastest angular rate of a perturber's direction at
-#: the step's start. Measured over 1000 orbits against 96 per turn: Apophis-like 12 → 7e-9, 16 →
-#: 7e-10, 24 → 8e-11 (rad or /Z, slow quantities); Toutatis-like (e = 0.63) 12 → 2e-5, 16 → 2e-6,
-#: 24 → 4e-8. The averaging itself errs by 1e-4 (Apophis-like) and 4e-2 (Toutatis-like) over that
-#: span (docs/averaged.md), so 12 leaves the stepping error ≥ 1000× below it.
+#: the step's start (the time-stepped kernel: several or non-elliptic perturbers, quadrature,
+#: hand-back after a flyby). Measured over 1000 orbits against 96 per turn: Apophis-like 12 → 7e-9
+#: (rad or /Z, slow quantities); Toutatis-like (e = 0.63) 12 → 1.9e-3, 24 → 5e-7, 48 → 3e-10 — a
+#: stepping error 20× below that scene's averaging error (4e-2), 1e4× below Apophis' (1e-4).
 STEPS_PER_TURN = 12.0
+#: Steps per 2π of the perturber's true anomaly (:func:`mean_elements_anomaly_kernel`, one elliptic
+#: perturber). Measured over 1000 orbits against 96 per turn (slow quantities, rad or /Z):
+#: Apophis-like 12 → 3e-10, 8 → 1.4e-8, 6 → 1.8e-7, 4 → 5.6e-6; Toutatis-like 12 → 1.9e-8,
+#: 8 → 5.6e-7, 6 → 5.0e-6, 4 → 7.7e-5. 8 keeps the stepping error ≥ 5000× (Apophis-like) and
+#: ≥ 6e4× (Toutatis-like) below the first-order theory's own error over the span; both scale with
+#: the torque (stepping ∝ ε, theory ∝ ε²), so at 100× weaker torques it is still 50× below.
+STEPS_PER_ANOMALY_TURN = 8.0
 #: Largest step as a fraction of the radial time r/|ṙ| of a perturber not on an elliptic orbit: on a
 #: near-radial approach (a flyby) the rate n grows like 1/r², which the n-limit alone would step over.
 RADIAL_STEP_FRACTION = 0.1
@@ -75,8 +98,8 @@ MIN_FREQUENCY_RATIO = 5.0
 MAX_PERTURBATION = 0.05
 MIN_SEPARATRIX_DISTANCE = 1e-3
 
-# Right-hand-side choices of the mean equations.
-RHS_DEGREE2, RHS_DEGREE2_ORBIT_AVERAGED, RHS_QUADRATURE = 0, 1, 2
+# Right-hand-side choices of the mean equations (RHS_DEGREE2_ANOMALY: d/df, f the true anomaly).
+RHS_DEGREE2, RHS_DEGREE2_ORBIT_AVERAGED, RHS_QUADRATURE, RHS_DEGREE2_ANOMALY = 0, 1, 2, 3
 #: Torus grid of the quadrature right-hand side (points in s, in z; z > degree 4).
 QUADRATURE_POINTS_S, QUADRATURE_POINTS_Z = 24, 9
 
@@ -157,9 +180,11 @@ def _validity_from_numbers(rate_max, strength, free, thresholds):
     return VALID
 
 
-@jit
+@jit(inline="always")
 def _rhs(t, y, mc, model, frame, ic, kind, dy):
-    if kind == RHS_QUADRATURE:
+    if kind == RHS_DEGREE2_ANOMALY:
+        degree2_mean_rhs_anomaly(t, y, mc, model, frame, dy)
+    elif kind == RHS_QUADRATURE:
         torus_mean_rhs(t, y, model, frame, ic, QUADRATURE_POINTS_S, QUADRATURE_POINTS_Z, dy)
     else:
         degree2_mean_rhs(t, y, mc, model, frame, kind == RHS_DEGREE2_ORBIT_AVERAGED, dy)
@@ -199,6 +224,39 @@ def _shift_phase(y, period, advance_g):
 
 
 @jit
+def _rk8_scratch():
+    """Stage derivatives, stage state and new state of :func:`_rk8_step` (allocated once per run)."""
+    return np.empty((N_STAGES, 6)), np.empty(6), np.empty(6)
+
+
+@jit(inline="always")
+def _accept_step(y, y_new, free):
+    """y ← y_new, whole periods of s moved into z (``free`` from :func:`free_motion_numbers`)."""
+    for c in range(6):
+        y[c] = y_new[c]
+    _shift_phase(y, free[3], free[4])
+
+
+@jit
+def _write_output(row, y, ic):
+    """One output row: y in one representation (|κ s| ≤ 2K, :func:`reduce_phase`)."""
+    for c in range(6):
+        row[c] = y[c]
+    reduce_phase(row, ic)
+
+
+@jit(inline="always")
+def _landing_step(h, remaining):
+    """Step h shortened to land on an output ``remaining`` away: in one step if within 1 % of a
+    full step, else never leaving a sliver shorter than half a step."""
+    if remaining <= 1.01 * h:
+        return remaining
+    if remaining < 1.5 * h:
+        return 0.5 * remaining
+    return h
+
+
+@jit
 def mean_elements_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, model, frame, ic, kind, thresholds, free,
                          out):
     """Step the mean elements from (t0, el0) to each t_out[i] (rows of ``out``).
@@ -213,9 +271,7 @@ def mean_elements_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, model, fr
     """
     y = el0.copy()
     t = t0
-    k = np.empty((N_STAGES, 6))
-    tmp = np.empty(6)
-    y_new = np.empty(6)
+    k, tmp, y_new = _rk8_scratch()
     steps = 0
     for i in range(t_out.shape[0]):
         target = t_out[i]
@@ -229,21 +285,94 @@ def mean_elements_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, model, fr
             if rate > 0.0 and steps_per_turn > 0.0:
                 h = min(h, 2.0 * math.pi / (steps_per_turn * rate), RADIAL_STEP_FRACTION * radial_time)
             remaining = abs(target - t)
-            # Land on the output: take it in one step if within 1 % of a full step, else never
-            # leave a sliver shorter than half a step.
-            if remaining <= 1.01 * h:
-                h = remaining
-            elif remaining < 1.5 * h:
-                h = 0.5 * remaining
+            h = _landing_step(h, remaining)
             _rk8_step(t, y, direction * h, mc, model, frame, ic, kind, k, tmp, y_new)
             t = target if h == remaining else t + direction * h
-            for c in range(6):
-                y[c] = y_new[c]
-            _shift_phase(y, free[3], free[4])
+            _accept_step(y, y_new, free)
             steps += 1
-        for c in range(6):
-            out[i, c] = y[c]
-        reduce_phase(out[i], ic)  # outputs in one representation: |κ s| ≤ 2K
+        _write_output(out[i], y, ic)
+    return t_out.shape[0], t, y, VALID, steps
+
+
+@jit
+def true_anomaly_of_time(t, model, par):
+    """True anomaly f (rad, unwrapped: continuous in t) at time t of the elliptic KIND_KEPLER row with
+    parameters at model[par:]: M → E (Kepler's equation) → f = 2 atan(√((1 + e)/(1 − e)) tan(E/2))."""
+    ecc = model[par + K_E]
+    big_e = solve_kepler_elliptic(model[par + K_M0] + model[par + K_MEAN_MOTION] * (t - model[par + K_T0]), ecc)
+    turns = math.floor((big_e + math.pi) / (2.0 * math.pi))
+    half = 0.5 * (big_e - 2.0 * math.pi * turns)
+    return 2.0 * math.atan2(math.sqrt(1.0 + ecc) * math.sin(half), math.sqrt(1.0 - ecc) * math.cos(half)) \
+        + 2.0 * math.pi * turns
+
+
+@jit
+def time_of_true_anomaly(f, model, par):
+    """Inverse of :func:`true_anomaly_of_time`, closed form: f → E → M = E − e sin E → t."""
+    ecc = model[par + K_E]
+    turns = math.floor((f + math.pi) / (2.0 * math.pi))
+    half = 0.5 * (f - 2.0 * math.pi * turns)
+    big_e = 2.0 * math.atan2(math.sqrt(1.0 - ecc) * math.sin(half), math.sqrt(1.0 + ecc) * math.cos(half))
+    mean_anomaly = big_e - ecc * math.sin(big_e) + 2.0 * math.pi * turns
+    return model[par + K_T0] + (mean_anomaly - model[par + K_M0]) / model[par + K_MEAN_MOTION]
+
+
+def steps_in_anomaly(model, kind):
+    """Whether the mean equations can be stepped in the perturber's true anomaly: one perturber, on
+    an elliptic Kepler orbit, with the (not orbit-averaged) degree-2 closed form."""
+    row = MODEL_PERTURBERS + 1
+    return (kind == RHS_DEGREE2 and int(model[MODEL_PERTURBERS]) == 1 and model[row] == KIND_KEPLER
+            and model[row + 2 + K_E] < 1.0)
+
+
+@jit
+def mean_elements_anomaly_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, model, frame, ic, thresholds,
+                                 free, out):
+    """:func:`mean_elements_kernel` for one perturber on an elliptic Kepler orbit, stepped in its true
+    anomaly f (:func:`spinorbit.core.averaged.degree2_mean_rhs_anomaly`; :func:`steps_in_anomaly`).
+
+    Steps of 2π/steps_per_turn in f (at most ``max_step`` · df/dt in time), landing on the anomalies
+    of the output times. In f the torque is a trigonometric polynomial, smooth through perihelion,
+    and the perturber's position costs one cos/sin, no Kepler solve. The free rate of s, a S
+    (constant: S is constant in the mean), is added exactly as a S Δt, with t(f) in closed form
+    (:func:`time_of_true_anomaly`), so the body phase carries no stepping error from it. The
+    validity check runs before every step with the closed-form rate df/dt = n a² √(1 − e²)/r² and
+    strength 3μ/r³ (a bound orbit has no radial-time limit). Same returns as
+    :func:`mean_elements_kernel`.
+    """
+    row = MODEL_PERTURBERS + 1
+    par = row + 2
+    mu = model[row + 1]
+    y = el0.copy()
+    t = t0
+    f = true_anomaly_of_time(t0, model, par)
+    free_rate = mc[MC_A] * el0[0]  # ds/dt of the free motion
+    k, tmp, y_new = _rk8_scratch()
+    steps = 0
+    for i in range(t_out.shape[0]):
+        target = t_out[i]
+        f_target = true_anomaly_of_time(target, model, par)
+        direction = 1.0 if target > t else -1.0
+        while t != target:
+            ix, iy, iz, dt_df = anomaly_position_xyz(f, model, par)
+            r2 = ix * ix + iy * iy + iz * iz
+            code = _validity_from_numbers(1.0 / dt_df, 3.0 * mu / r2 ** 1.5, free, thresholds)
+            if code != VALID:
+                return i, t, y, code, steps
+            h = min(2.0 * math.pi / steps_per_turn, max_step / dt_df)
+            remaining = abs(f_target - f)
+            h = _landing_step(h, remaining)
+            _rk8_step(f, y, direction * h, mc, model, frame, ic, RHS_DEGREE2_ANOMALY, k, tmp, y_new)
+            if h == remaining:
+                f, t_new = f_target, target
+            else:
+                f += direction * h
+                t_new = time_of_true_anomaly(f, model, par)
+            y_new[3] += free_rate * (t_new - t)
+            t = t_new
+            _accept_step(y, y_new, free)
+            steps += 1
+        _write_output(out[i], y, ic)
     return t_out.shape[0], t, y, VALID, steps
 
 
@@ -318,7 +447,8 @@ class AveragedResult:
 def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False, quadrature=None,
                        osculating=False, hand_over=True, min_frequency_ratio=MIN_FREQUENCY_RATIO,
                        max_perturbation=MAX_PERTURBATION, min_separatrix_distance=MIN_SEPARATRIX_DISTANCE,
-                       handover_chunk=None, rtol=1e-12, frame=None, mean0=None):
+                       handover_chunk=None, rtol=1e-12, frame=None, mean0=None, anomaly=None,
+                       steps_per_turn=None):
     """Propagate the rotation through mean canonical elements (averaged over the free rotation).
 
     Parameters
@@ -333,8 +463,9 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
         :func:`spinorbit.core.dynamics.make_model`.
     max_step : float, optional
         Largest step of the mean equations (time unit); the step is also at most
-        2π/(STEPS_PER_TURN · n), n the perturbers' fastest angular rate at the step's start (not
-        when orbit-averaged). Default: the span (span/64 when orbit-averaged).
+        2π/(steps_per_turn · n), n the perturbers' fastest angular rate at the step's start (not
+        when orbit-averaged; in true anomaly: 2π/steps_per_turn in f). Default: the span (span/64
+        when orbit-averaged).
     orbit_averaged : bool
         Average over each perturber's Keplerian orbit as well (doubly averaged; elliptic Kepler
         perturbers only, others are used at their instantaneous position).
@@ -357,6 +488,13 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
         Inertial → reference rotation of H, h (default :func:`averaging_frame`).
     mean0 : array_like (6,), optional
         Mean initial elements in ``frame`` (skips the osculating → mean conversion of y0).
+    anomaly : bool, optional
+        Step in the perturber's true anomaly (:func:`mean_elements_anomaly_kernel`). Default: when
+        :func:`steps_in_anomaly` allows it (one elliptic Kepler perturber, degree-2 closed form, not
+        orbit-averaged); True where it does not raises ValueError.
+    steps_per_turn : float, optional
+        Steps per 2π of true anomaly (default STEPS_PER_ANOMALY_TURN) or, stepping in time, per
+        2π/n (default STEPS_PER_TURN). Ignored when orbit-averaged.
 
     Returns
     -------
@@ -386,8 +524,17 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
     span = abs(t_out[-1] - t0)
     if max_step is None:
         max_step = span / 64.0 if orbit_averaged else span
+    possible = steps_in_anomaly(model, kind)
+    if anomaly and not possible:
+        raise ValueError("anomaly=True needs one perturber on an elliptic Kepler orbit and the degree-2 closed "
+                         "form without orbit averaging; pass anomaly=None to step in time.")
+    anomaly = possible if anomaly is None else bool(anomaly)
+    if steps_per_turn is None:
+        steps_per_turn = STEPS_PER_ANOMALY_TURN if anomaly else STEPS_PER_TURN
+    if not steps_per_turn > 0.0:
+        raise ValueError(f"steps_per_turn must be > 0, got {steps_per_turn!r}.")
     # Orbit-averaged: the right-hand side has no orbital time scale left; only max_step limits.
-    steps_per_turn = 0.0 if orbit_averaged else STEPS_PER_TURN
+    steps_per_turn = 0.0 if orbit_averaged else float(steps_per_turn)
     omega_s, omega_g = fast_frequencies(mean, ic)
     if handover_chunk is None:
         handover_chunk = 2.0 * math.pi / min(abs(omega_s), abs(omega_g))
@@ -401,10 +548,14 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
     steps = 0
     while done < t_out.size:
         mc = mean_constants(mean[0], mean[1], ic, moments)
-        written, t_stop, y_stop, code, n_steps = mean_elements_kernel(
-            mean, t, t_out[done:], float(max_step), steps_per_turn, mc, model, frame, ic, kind, thresholds,
-            free_motion_numbers(mean, ic),
-            out_mean[done:])
+        if anomaly:
+            written, t_stop, y_stop, code, n_steps = mean_elements_anomaly_kernel(
+                mean, t, t_out[done:], float(max_step), steps_per_turn, mc, model, frame, ic, thresholds,
+                free_motion_numbers(mean, ic), out_mean[done:])
+        else:
+            written, t_stop, y_stop, code, n_steps = mean_elements_kernel(
+                mean, t, t_out[done:], float(max_step), steps_per_turn, mc, model, frame, ic, kind, thresholds,
+                free_motion_numbers(mean, ic), out_mean[done:])
         steps += n_steps
         if osculating:
             for i in range(done, done + written):

@@ -48,3 +48,18 @@ def write_section(name: str, markdown: str, page: str = "performance.md") -> Pat
     path.parent.mkdir(parents=True, exist_ok=True)
     write_bytes_atomically(path, text.encode())
     return path
+
+
+def repeat_main(section: str, description: str, measure, markdown, repeat: int = 3, argv=None) -> None:
+    """The command line of a benchmark timed best of ``--repeat``: measure, print its Markdown and, unless
+    ``--no-write``, write it as ``section`` of docs/performance.md."""
+    import argparse
+
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--repeat", type=int, default=repeat)
+    parser.add_argument("--no-write", action="store_true", help="print only, do not touch docs/performance.md")
+    args = parser.parse_args(argv)
+    text = markdown(measure(args.repeat), args.repeat)
+    print(text)
+    if not args.no_write:
+        print(f"wrote {write_section(section, text)}")

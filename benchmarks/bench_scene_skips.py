@@ -15,7 +15,6 @@ Usage::
 
 from __future__ import annotations
 
-import argparse
 import math
 import sys
 import time
@@ -29,7 +28,7 @@ from astropy.time import Time
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from _report import machine_line, write_section
+from _report import machine_line, repeat_main
 
 from spinorbit import RigidBody, RotationState, asteroids
 from spinorbit.coupling.rebound_adapter import body_index, simulation_from_de421
@@ -194,15 +193,7 @@ def markdown(rows, repeat):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=3)
-    parser.add_argument("--no-write", action="store_true", help="print only, do not touch docs/performance.md")
-    args = parser.parse_args(argv)
-    rows = measure(args.repeat)
-    text = markdown(rows, args.repeat)
-    print(text)
-    if not args.no_write:
-        print(f"wrote {write_section('scene_skips', text)}")
+    repeat_main("scene_skips", __doc__.splitlines()[0], measure, markdown, repeat=3, argv=argv)
 
 
 if __name__ == "__main__":

@@ -59,6 +59,7 @@ from .planner import (
     max_torque_over_a,
 )
 from .state import RotationState
+from .state_table import from_principal, table_columns
 from .time import tdb_days, time_from_tdb_days
 
 __all__ = ["QUANTITIES", "EphemerisPerturber", "FixedPerturber", "Orbit", "PlanError", "Scene", "SceneError",
@@ -268,7 +269,9 @@ class SceneResult:
         ``time`` (Time, TDB), ``quaternion`` (scalar first, user body axes → ICRF), ``omega``
         (rad/day, user body axes), ``momentum_direction`` (ICRF); with "periods" asked: ``mode``,
         ``energy_ratio``, ``P_psi``, ``P_phi``. Only the quantities asked for are filled in beyond
-        time and quaternion.
+        time and quaternion. Each row holds what its RotationState would give
+        (:func:`spinorbit.state_table.table_columns`, all rows at once); on the torque-free route
+        mode, E/E0 and the periods are constants of the motion, taken once from the initial state.
     error_estimate : Quantity
         Attitude error estimate (arcsec): the sum of ``error_parts``.
     error_parts : dict of Quantity
@@ -866,22 +869,16 @@ class Scene:
     def _torque_free_table(self, closed_forms=True):
         offsets = self.output_days - self.epoch_day
         quaternions, omegas = self.state.propagate_torque_free(offsets, closed_forms=closed_forms)
-        states = [RotationState(self.state.body, q, w) for q, w in zip(quaternions, omegas.value)]
-        return self._table(states)
+        # Mode, E/E0 and the periods are constants of the torque-free motion: the initial state's, once.
+        return self._table(quaternions, omegas.to_value(u.rad / u.day), motion=self.state)
 
-    def _table(self, states):
+    def _table(self, quaternions, omegas, motion="rows"):
+        """The result table of user-axes rows (quaternions, ω in rad/day), all rows at once."""
         table = QTable()
         table["time"] = self._times()
-        table["quaternion"] = np.array([s.quaternion for s in states])
-        if "omega" in self.quantities:
-            table["omega"] = np.array([s.angular_velocity.to_value(u.rad / u.day) for s in states]) * (u.rad / u.day)
-        table["momentum_direction"] = np.array([s.angular_momentum_direction for s in states])
-        if "periods" in self.quantities:
-            table["mode"] = [s.mode for s in states]
-            table["energy_ratio"] = [s.energy_ratio for s in states]
-            pairs = [s.periods for s in states]
-            table["P_psi"] = [p[0].to_value(u.day) for p in pairs] * u.day
-            table["P_phi"] = [p[1].to_value(u.day) for p in pairs] * u.day
+        for name, column in table_columns(self.state.body, quaternions, omegas, omega="omega" in self.quantities,
+                                          motion=motion if "periods" in self.quantities else None).items():
+            table[name] = column
         return table
 
     def _one_way(self, plan, report):
@@ -925,7 +922,7 @@ class Scene:
 
     def _coupled(self, plan, report):
         """The fully coupled REBOUND run (BS), checked against a second run at 10× eps."""
-        from .coupling.one_way import _from_core, _to_core
+        from .coupling.one_way import _to_core
         from .coupling.rigid_body import coupled_run
 
         y0 = _to_core(self.state)
@@ -942,7 +939,7 @@ class Scene:
                 break
             eps = max(eps / 100.0, COUPLED_EPS_RANGE[0])
         rows[:, :4] /= np.linalg.norm(rows[:, :4], axis=1, keepdims=True)
-        table = self._table([_from_core(self.state.body, y) for y in rows])
+        table = self._table(*from_principal(self.state.body, rows))
         table.meta["rtol"] = eps
         stats.update(rtol=eps)
         return table, {"dropped": 0.0, "integration": integration, "sampling": 0.0}, stats

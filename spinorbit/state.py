@@ -16,7 +16,7 @@ from astropy import units as u
 from .body import RigidBody
 from .core import andoyer as _andoyer
 from .core import canonical as _canonical
-from .core import elliptic as _elliptic
+from .core import motion_summary as _summary
 from .core import rotations as _rotations
 from .core import torque_free as _torque_free
 from .core.errors import SingularElementsError
@@ -39,6 +39,7 @@ MODE_NAMES = {
     _canonical.MODE_SAM: "SAM",
     _canonical.MODE_LAM: "LAM",
     _canonical.MODE_UNIFORM: "permanent rotation",
+    _summary.MODE_SEPARATRIX: "separatrix",
 }
 
 
@@ -235,9 +236,7 @@ class RotationState:
     def mode(self) -> str:
         """'SAM' (short-axis mode, about C), 'LAM' (long-axis mode, about A), 'separatrix' or 'permanent rotation'."""
         mo, _, _, _ = self._motion()
-        if mo[_canonical.MO_MODE] == _canonical.MODE_SAM and mo[_canonical.MO_PARAM_C] == 0.0:
-            return "separatrix"
-        return MODE_NAMES[int(mo[_canonical.MO_MODE])]
+        return MODE_NAMES[_summary.mode_code(mo)]
 
     @property
     def sense(self) -> str:
@@ -254,8 +253,7 @@ class RotationState:
         1 for principal-axis rotation about C; C/A for rotation about A; C/B on the separatrix.
         """
         _, momentum = self._principal()
-        moments = np.array(self._body.principal_moments)
-        return float(np.sum(momentum**2 / moments) * moments[2] / np.sum(momentum**2))
+        return float(_summary.energy_ratio(*momentum, *self._body.principal_moments))
 
     @property
     def periods(self) -> tuple[u.Quantity, u.Quantity]:
@@ -270,22 +268,8 @@ class RotationState:
         infinite on the separatrix; a permanent rotation has P_ψ = ∞ and P_φ = 2π/|ω|.
         """
         mo, _, momentum, moments = self._motion()
-        if mo[_canonical.MO_MODE] == _canonical.MODE_UNIFORM:
-            rate = np.linalg.norm(momentum / np.array(moments))
-            return math.inf * u.day, (2 * math.pi / rate) * u.day
-        param, param_c = mo[_canonical.MO_PARAM], mo[_canonical.MO_PARAM_C]
-        if param_c == 0.0:
-            return math.inf * u.day, math.inf * u.day
-        quarter = _elliptic.ellipk(param, param_c)
-        complete_pi = _elliptic.characteristic_constants(mo[_canonical.MO_PN_N], param, param_c)[_elliptic.NK_COMPLETE]
-        nu = mo[_canonical.MO_ARG_PER_S] * mo[_canonical.MO_S_RATE]
-        mean_g_rate = mo[_canonical.MO_G] / moments[2] + mo[_canonical.MO_PN_COEFF] * complete_pi / quarter * nu
-        rotation_period = 4 * quarter / nu
-        if mo[_canonical.MO_MODE] == _canonical.MODE_LAM:
-            # In LAM, l librates and the long axis A circulates about the momentum: its azimuth gains
-            # one turn less than g per polhode period.
-            mean_g_rate -= 2 * math.pi / rotation_period
-        return rotation_period * u.day, (2 * math.pi / mean_g_rate) * u.day
+        rotation, precession = _summary.periods(mo, *momentum, *moments)  # the one definition (core)
+        return rotation * u.day, precession * u.day
 
     def _reference_frame(self, reference) -> np.ndarray:
         """Passive rotation inertial → frame of the Andoyer angles h, I (see :meth:`canonical_elements`)."""

@@ -57,6 +57,7 @@ from ..core.integrate_quaternion import integrate_quaternion
 from ..core.perturbers import sampled_source
 from ..ephemeris import DE421_SPAN_JD_TDB, EphemerisRangeError, _resolve_body, barycentric_state_au, de421_constants
 from ..state import RotationState
+from ..state_table import from_principal, table_columns
 from ..time import J2000_JD_TDB, tdb_days, time_from_tdb_days
 from .rebound_adapter import ExtraForces, body_index, reinstall_extra_forces
 
@@ -532,12 +533,6 @@ def _to_core(state):
     return np.concatenate([_rotations.attitude_to_quat(np.ascontiguousarray(attitude)), omega])
 
 
-def _from_core(body, y):
-    p = body._to_principal
-    attitude = p.T @ _rotations.quat_to_attitude(np.ascontiguousarray(y[:4]))
-    return RotationState.from_matrix(body, attitude, p.T @ y[4:])
-
-
 def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=True, integrator="quaternion",
                       extra_sources=()):
     """Integrate the rotation of ``state`` under the sampled perturbers' torques.
@@ -596,18 +591,11 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
         stats.pop("frame")
     else:
         ys, stats = integrate_quaternion(_to_core(state), t0, t_out, model, rtol=rtol, return_stats=True)
-    rotation_states = [_from_core(body, y) for y in ys]
     table = QTable()
     table["time"] = time_from_tdb_days(t_out)
-    table["quaternion"] = np.array([s.quaternion for s in rotation_states])
-    table["omega"] = np.array([s.angular_velocity.to_value(u.rad / u.day) for s in rotation_states]) * (u.rad / u.day)
-    table["momentum_direction"] = np.array([s.angular_momentum_direction for s in rotation_states])
-    if periods:
-        table["mode"] = [s.mode for s in rotation_states]
-        table["energy_ratio"] = [s.energy_ratio for s in rotation_states]
-        pairs = [s.periods for s in rotation_states]
-        table["P_psi"] = [p[0].to_value(u.day) for p in pairs] * u.day
-        table["P_phi"] = [p[1].to_value(u.day) for p in pairs] * u.day
+    quaternions, omegas = from_principal(body, ys)  # all rows at once, no RotationState per row
+    for name, column in table_columns(body, quaternions, omegas, motion="rows" if periods else None).items():
+        table[name] = column
     table.meta.update(stats)
     table.meta["rtol"] = rtol
     table.meta["integrator"] = integrator

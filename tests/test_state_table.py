@@ -1,0 +1,144 @@
+"""The vectorised table columns against one RotationState per row (the definition they replace).
+
+Tolerances are units of roundoff with their reason next to them: the columns divide by norms formed in
+another order than RotationState's (np.linalg.norm of one vector uses a dot product, of rows a sum),
+which may move the last bit; everything else is the same arithmetic.
+"""
+
+import math
+
+import numpy as np
+import pytest
+from astropy import units as u
+
+from spinorbit import RigidBody, RotationState
+from spinorbit.core.rotations import quat_to_attitude
+from spinorbit.state import InvalidStateError
+from spinorbit.state_table import from_principal, table_columns
+
+EPS = np.finfo(float).eps
+
+
+def _states():
+    """(name, state): triaxial SAM and LAM, both axisymmetric kinds, near and on the separatrix, permanent rotation."""
+    near = RigidBody([1.0, 2.0, 2.5])  # separatrix where b−c M_z² = (a−b) M_x², i.e. M_z = √5 M_x
+    return [
+        ("triaxial SAM", RotationState.from_euler313(RigidBody([0.61, 0.965, 1.0]), 10 * u.deg, 40 * u.deg,
+                                                     70 * u.deg, [5, 3, 40] * u.deg / u.hour)),
+        ("triaxial LAM", RotationState.from_euler313(RigidBody([3.0836, 3.235, 1.0]), 145.498 * u.deg, 65.865 * u.deg,
+                                                     241.524 * u.deg, [14.51, 33.529, -98.709] * u.deg / u.day)),
+        ("oblate A = B", RotationState.from_euler313(RigidBody([1.0, 1.0, 2.0]), 10 * u.deg, 40 * u.deg, 70 * u.deg,
+                                                     [5, 3, 40] * u.deg / u.hour)),
+        ("prolate B = C", RotationState.from_angular_momentum(RigidBody([2.0, 1.0, 2.0]), [0.6, 0.0, 0.8, 0.0],
+                                                              [0.3, 1.0, -0.2])),
+        ("near separatrix", RotationState.from_angular_momentum(near, [1.0, 0.0, 0.0, 0.0],
+                                                                [1.0, 0.3, math.sqrt(5.0) * (1 + 1e-7)])),
+        # (3, 4, 6) has a − b = b − c = 1/12 exactly: M_x = M_z is on the separatrix without rounding.
+        ("separatrix", RotationState.from_angular_momentum(RigidBody([3.0, 4.0, 6.0]), [1.0, 0.0, 0.0, 0.0],
+                                                           [1.0, 0.5, 1.0])),
+        ("permanent rotation", RotationState(near, [0.8, 0.6, 0.0, 0.0], [0.0, 1.7, 0.0])),
+    ]
+
+
+STATES = _states()
+TIMES = np.linspace(0.0, 60.0, 97)
+
+
+def _rows(state):
+    quaternions, omegas = state.propagate_torque_free(TIMES)
+    omegas = omegas.to_value(u.rad / u.day)
+    return quaternions, omegas, [RotationState(state.body, q, w) for q, w in zip(quaternions, omegas)]
+
+
+@pytest.mark.parametrize("name, state", STATES, ids=[n for n, _ in STATES])
+def test_columns_are_each_rows_rotation_state(name, state):
+    quaternions, omegas, rows = _rows(state)
+    columns = table_columns(state.body, quaternions, omegas, motion="rows")
+    assert list(columns) == ["quaternion", "omega", "momentum_direction", "mode", "energy_ratio", "P_psi", "P_phi"]
+    # The norms differ from RotationState's by the order of the sum: ≤ 1 ulp of each unit component.
+    assert np.abs(columns["quaternion"] - [s.quaternion for s in rows]).max() <= EPS
+    assert np.array_equal(columns["omega"].to_value(u.rad / u.day), [s.angular_velocity.value for s in rows])
+    # Rᵀ I ω of unit-size rows, then a norm: a few ulps of 1.
+    assert np.abs(columns["momentum_direction"] - [s.angular_momentum_direction for s in rows]).max() <= 4 * EPS
+    # Mode, E/E0 and the periods come from the very kernels RotationState calls: bit for bit.
+    assert list(columns["mode"]) == [s.mode for s in rows]
+    assert np.array_equal(columns["energy_ratio"], [s.energy_ratio for s in rows])
+    assert np.array_equal(columns["P_psi"].to_value(u.day), [s.periods[0].to_value(u.day) for s in rows])
+    assert np.array_equal(columns["P_phi"].to_value(u.day), [s.periods[1].to_value(u.day) for s in rows])
+
+
+@pytest.mark.parametrize("name, state", STATES, ids=[n for n, _ in STATES])
+def test_torque_free_constants_are_the_rows_values_to_rounding(name, state):
+    """Mode, E/E0 and the periods are constants of the torque-free motion: the initial state's values,
+    taken once, are every propagated row's to the rounding of the propagated momentum (on the exact
+    separatrix too: the flow's rows stay on it here, mode "separatrix" and infinite periods)."""
+    quaternions, omegas, rows = _rows(state)
+    constant = table_columns(state.body, quaternions, omegas, motion=state)
+    each = table_columns(state.body, quaternions, omegas, motion="rows")
+    assert np.array_equal(constant["quaternion"], each["quaternion"])
+    assert np.array_equal(constant["momentum_direction"], each["momentum_direction"])
+    assert list(constant["mode"]) == list(each["mode"]) == [state.mode] * len(TIMES)
+    # E/E0 of a rounded momentum: a few ulps (measured ≤ 1.5 ulps).
+    assert np.abs(constant["energy_ratio"] / each["energy_ratio"] - 1).max() <= 4 * EPS
+    # The periods are smooth in (G, T) except through 1 − m, whose rounding from b − d is amplified by
+    # b/|b − d| (~1e7 near the separatrix here; K ~ ln(1/(1 − m)) damps it): measured 6.1e-11 relative
+    # there, so 1e-9; ≤ 2.5 ulps elsewhere, so 8 ulps.
+    tolerance = 1e-9 if name == "near separatrix" else 8 * EPS
+    for key in ("P_psi", "P_phi"):
+        a, b = constant[key].to_value(u.day), each[key].to_value(u.day)
+        finite = np.isfinite(a)
+        assert np.array_equal(finite, np.isfinite(b)) and (finite.all() or state.mode != "SAM")
+        assert np.abs(a[finite] / b[finite] - 1).max(initial=0.0) <= tolerance
+
+
+def test_from_principal_is_rotation_state_from_matrix():
+    """Core rows (principal q, ω) → user axes as RotationState.from_matrix(body, Pᵀ R(q), Pᵀ ω) makes them."""
+    body = RigidBody([3.0836, 3.235, 1.0])  # principal axes a permutation of the user's
+    rng = np.random.default_rng(5)
+    q = rng.normal(size=(50, 4))
+    rows = np.hstack([q / np.linalg.norm(q, axis=1, keepdims=True), rng.normal(size=(50, 3))])
+    quaternions, omegas = from_principal(body, rows)
+    p = body.to_principal
+    reference = [RotationState.from_matrix(body, p.T @ quat_to_attitude(np.ascontiguousarray(y[:4])), p.T @ y[4:])
+                 for y in rows]
+    # Same representative (largest component positive); ≤ 1 ulp from the second normalisation.
+    assert np.abs(quaternions - [s.quaternion for s in reference]).max() <= 2 * EPS
+    assert np.array_equal(omegas, [s.angular_velocity.value for s in reference])
+
+
+def test_rows_that_are_not_states_are_refused():
+    body = RigidBody([1.0, 2.0, 2.5])
+    with pytest.raises(InvalidStateError, match="unit norm"):
+        table_columns(body, [[1.0, 0.1, 0.0, 0.0]], [[0.0, 0.0, 1.0]])
+    with pytest.raises(InvalidStateError, match="finite"):
+        table_columns(body, [[math.nan, 0.0, 0.0, 0.0]], [[0.0, 0.0, 1.0]])
+    with pytest.raises(InvalidStateError, match="not rotating"), np.errstate(invalid="ignore"):
+        table_columns(body, [[1.0, 0.0, 0.0, 0.0]], [[0.0, 0.0, 0.0]], motion="rows")
+    with pytest.raises(ValueError, match="motion expects"):
+        table_columns(body, [[1.0, 0.0, 0.0, 0.0]], [[0.0, 0.0, 1.0]], motion="each")
+
+
+def test_one_way_table_rows_are_their_rotation_states_and_osculate():
+    """Under a torque the mode, E/E0 and periods of each row are that row's own (osculating) values."""
+    from astropy.time import Time
+
+    from spinorbit.core.perturbers import fixed_source
+    from spinorbit.coupling.one_way import propagate_one_way
+    from spinorbit.scene import _NoSamples
+    from spinorbit.time import tdb_days
+
+    state = STATES[0][1]
+    epoch = Time("2020-01-01", scale="tdb")
+    times = epoch + np.linspace(0.1, 2.0, 40) * u.day
+    start = float(sum(tdb_days(epoch)))
+    # A strong nearby mass (GM 1e-3 au³/day² at 0.01 au) changes the periods visibly within 2 d.
+    table = propagate_one_way(state, epoch, times, _NoSamples(start, start + 2.0),
+                              extra_sources=[fixed_source(1e-3, [0.01, 0.004, 0.002])])
+    rows = [RotationState(state.body, q, w) for q, w in zip(table["quaternion"], table["omega"].to_value(u.rad / u.day))]
+    assert np.abs(table["quaternion"] - [s.quaternion for s in rows]).max() <= EPS  # re-normalisation: ≤ 1 ulp
+    assert np.abs(table["momentum_direction"] - [s.angular_momentum_direction for s in rows]).max() <= 4 * EPS
+    assert list(table["mode"]) == [s.mode for s in rows]
+    assert np.array_equal(table["energy_ratio"], [s.energy_ratio for s in rows])
+    assert np.array_equal(table["P_psi"].to_value(u.day), [s.periods[0].to_value(u.day) for s in rows])
+    assert np.array_equal(table["P_phi"].to_value(u.day), [s.periods[1].to_value(u.day) for s in rows])
+    assert np.ptp(table["P_psi"].to_value(u.day)) > 1e-6 * table["P_psi"][0].to_value(u.day)  # they do vary

@@ -25,7 +25,44 @@ attitudes, |N| ≤ (3μ / 2r³) (C − A) (the unit vector r̂ at 45° between t
 REBOUND orbit at the run's own tolerance, and kept for the run), which still tightens its grid around
 close encounters. SAFETY = 2 covers the trapezoid rule between survey
 samples and the linearisation. ``tests/test_scene.py`` checks the bound against full runs: the
-measured effect of a dropped torque must stay below it.
+measured effect of a dropped torque must stay below it. This *worst-attitude* bound is 20–2400×
+above the measured effect: the real torque turns with the body, and its integral cancels.
+
+The free-motion bound (what the planner uses where it applies)
+---------------------------------------------------------------
+The same linear response, with the cancellation kept. The torque vector N(s) of each perturber is
+evaluated along the exact free motion (:func:`free_motion_grid`: the torque-free solution on a grid of
+:data:`POINTS_PER_TURN` points per turn at |ω| ≤ |L|/A, plus every survey interval cut in
+:data:`SURVEY_SUBDIVISION`; the perturber positions are the survey's Hermite interpolants, through the
+one torque definition :func:`spinorbit.core.dynamics.inertial_torques_along`) and integrated as a
+vector in the inertial frame, δL(s) = ∫₀ˢ N ds' (:func:`momentum_change_over_a`). Since
+∫₀ᵀ (T − s)|N| ds = ∫₀ᵀ ∫₀ˢ |N| ≥ ∫₀ᵀ |∫₀ˢ N|, the worst-attitude sum becomes
+
+    bound = SAFETY · [ κ ∫₀ᵀ D(s) ds + 2 max_s D(s) / (|L|/A) ],
+    D(s) = |δL(s)|/A + ATTITUDE_GRADIENT · Θ · ∫₀ˢ |N|_max/A ds'      (:func:`free_motion_torque_bound`),
+
+taken at most equal to the worst-attitude bound. What it assumes:
+
+- **The run stays near the free motion.** The torque of the run is evaluated along the *run's*
+  attitude, which every torque (kept and dropped) moves off the free motion by some Θ; an attitude
+  error ε changes the degree-2 torque by at most ATTITUDE_GRADIENT · |N|_max · ε (3: 2 from turning r̂
+  in the body, 1 from turning N into the inertial frame), which is the second term of D. Θ is the
+  smallest self-consistent total of the perturbers' bounds (:func:`self_consistent_deviation`), plus
+  the survey's relative position error (it enters like an attitude error). When Θ exceeds
+  :data:`LINEAR_LIMIT` = 0.1 rad (e.g. the Earth at an Apophis flyby, which turns the spin by
+  radians) the torque along the free motion says nothing about the run's, and every perturber gets the
+  worst-attitude bound.
+- **The response to a momentum change depends on the accumulated δL.** Integrating the kicks'
+  responses by parts replaces Σ (per-kick bound)·|N| ds by the accumulated vector; this neglects
+  that the response to an inertial kick varies with the kick's time (the body has turned). A torque
+  whose body-frame frequency sits at the free nutation frequency could accumulate a nutation that
+  δL does not show; the degree-2 torque's body-frame frequencies are ω and 2ω (above the nutation
+  frequency except for a flat disc, C = A + B), and the tests check the bound against full runs of a
+  short-axis, a long-axis, a near-separatrix and a slowly rotating state and an Apophis-like flyby;
+  SAFETY = 2 covers the rest.
+- **Resolution.** The grid resolves the rotation and the survey's grid; beyond
+  :data:`MAX_EVALUATIONS` = 2e6 torque evaluations (grid points × perturbers) the worst-attitude bound
+  is used, and the plan's reason says which bound was taken and why.
 
 Back-reaction (one-way coupling against the fully coupled run)
 --------------------------------------------------------------
@@ -74,6 +111,12 @@ __all__ = [
     "attitude_sensitivity",
     "back_reaction_bound",
     "dropped_torque_bound",
+    "FreeMotion",
+    "action_changes",
+    "action_sensitivities",
+    "free_motion_grid",
+    "free_motion_torque_bound",
+    "self_consistent_deviation",
     "initial_rtol",
     "max_torque_over_a",
 ]
@@ -97,6 +140,21 @@ ARCSEC_PER_RAD = 180.0 * 3600.0 / math.pi
 #: Largest orbit displacement per unit impulse and elapsed time (module docstring: 3.91 for a circular
 #: orbit, computed from Hill's equations; rounded up).
 ORBIT_RESPONSE = 4.0
+#: Free-motion bound: grid points per turn of the fastest rotation the free motion can reach (|ω| ≤ |L|/A);
+#: the degree-2 torque, quadratic in the perturber's body direction, then has ≥ 16 points per cycle.
+POINTS_PER_TURN = 32
+#: Free-motion bound: each survey interval is cut into this many (the survey grid is dense where the
+#: perturbers move fast, e.g. close encounters).
+SURVEY_SUBDIVISION = 4
+#: Free-motion bound: largest number of torque evaluations (grid points × perturbers; ≈ 0.1 µs each);
+#: beyond it the worst-attitude bound is used.
+MAX_EVALUATIONS = 2_000_000
+#: Free-motion bound: largest deviation (rad) of the run from the free motion for which the torques
+#: are evaluated along the free motion; beyond it the worst-attitude bound is used.
+LINEAR_LIMIT = 0.1
+#: |δN| ≤ ATTITUDE_GRADIENT · |N|_max · ε when the attitude is off by ε: 2 from turning r̂ in the body
+#: (|δ(r̂ × I′r̂)| ≤ (C − A)|δr̂|), 1 from turning N into the inertial frame.
+ATTITUDE_GRADIENT = 3.0
 #: |∇U| of a degree-2 figure ≤ FIGURE_FORCE · G (C − A) / r⁴ (module docstring).
 FIGURE_FORCE = 6.0
 #: |δN| ≤ TORQUE_GRADIENT · |N|_max · |δr|/r for a change δr of the perturber vector (module docstring).
@@ -156,6 +214,187 @@ def dropped_torque_bound(days, torque_over_a, span_end, kappa, momentum_over_a):
     drift = _trapezoid(lever * n, days)
     tilt = _trapezoid(n, days)
     return SAFETY * (kappa * drift + 2.0 * tilt / momentum_over_a)
+
+
+@dataclass
+class FreeMotion:
+    """The exact free motion on the grid of the free-motion bound (:func:`free_motion_grid`).
+
+    Attributes
+    ----------
+    days : ndarray (n,)
+        TDB days, increasing, from the epoch to the span's end.
+    quaternions : ndarray (n, 4)
+        Principal-axis attitudes (body → ICRF).
+    omega : ndarray (n, 3)
+        Angular velocity in ICRF, rad/day.
+    momentum_over_a : ndarray (3,)
+        L/A in ICRF (constant on the free motion), rad/day.
+    energy_over_a : float
+        Kinetic energy E/A = ½ L·ω / A, rad²/day².
+    """
+
+    days: np.ndarray
+    quaternions: np.ndarray
+    omega: np.ndarray
+    momentum_over_a: np.ndarray
+    energy_over_a: float
+
+
+def free_motion_grid(state, epoch_day, span_end, survey_days=(), perturbers=1):
+    """The exact free motion of ``state`` on the grid of the free-motion bound, or why not.
+
+    The grid takes :data:`POINTS_PER_TURN` points per 2π A/|L| (a turn at the largest angular velocity
+    the free motion can reach, |ω| ≤ |L|/A) and every survey interval cut into
+    :data:`SURVEY_SUBDIVISION` (the survey tightened its grid where the perturbers move fast, e.g. at
+    a close encounter). Returns ``(FreeMotion, None)``, or ``(None, why)`` when the grid times
+    ``perturbers`` would exceed :data:`MAX_EVALUATIONS` torque evaluations.
+    """
+    from .core.rotations import attitude_to_quat, quat_to_attitude_many
+    from .core.torque_free import torque_free_states
+
+    attitude, momentum = state._principal()
+    moments = np.array(state.body.principal_moments, dtype=float)
+    turn = 2.0 * math.pi * moments[0] / float(np.linalg.norm(momentum))
+    uniform = int(math.ceil((span_end - epoch_day) / turn * POINTS_PER_TURN)) + 1
+    survey_days = np.asarray(survey_days, dtype=float)
+    total = uniform + SURVEY_SUBDIVISION * max(survey_days.size - 1, 0)
+    if total * perturbers > MAX_EVALUATIONS:
+        return None, (f"the free-motion grid would take {total * perturbers:.3g} torque evaluations "
+                      f"(> {MAX_EVALUATIONS:.0e}: {POINTS_PER_TURN} per turn of a {turn * 24:.3g} h rotation), "
+                      "so the worst-attitude bound is used")
+    pieces = [np.linspace(epoch_day, span_end, max(uniform, 2))]
+    if survey_days.size > 1:
+        fractions = np.arange(SURVEY_SUBDIVISION) / SURVEY_SUBDIVISION
+        pieces.append((survey_days[:-1, None] + np.diff(survey_days)[:, None] * fractions).ravel())
+    days = np.unique(np.clip(np.concatenate(pieces), epoch_day, span_end))
+    quaternions, body_momenta = torque_free_states(attitude_to_quat(np.ascontiguousarray(attitude)), momentum,
+                                                   *moments, days - epoch_day)
+    quaternions = np.ascontiguousarray(quaternions)
+    # ω_inertial = M(q) ω_body, M(q) the transpose of the attitude matrix.
+    omega = np.einsum("nji,nj->ni", quat_to_attitude_many(quaternions), body_momenta / moments)
+    momentum_over_a = attitude.T @ momentum / moments[0]
+    energy_over_a = 0.5 * float(momentum @ (momentum / moments)) / moments[0]
+    return FreeMotion(days, quaternions, omega, momentum_over_a, energy_over_a), None
+
+
+def action_changes(free, source, moments):
+    """δ|L|/A and δE/A along the free motion from the torque of ``source``, cancellation kept.
+
+    δL(s) = ∫₀ˢ N ds' is integrated as a vector (ICRF) along ``free``; δ|L| = L̂·δL and the kinetic
+    energy change δE(s) = ∫₀ˢ ω·N ds' are the first-order changes of the free motion's two actions
+    (its frequencies depend on |L| and E only). Trapezoid rule on ``free.days``.
+
+    Parameters
+    ----------
+    free : FreeMotion
+    source : ndarray
+        One :mod:`spinorbit.core.perturbers` source (sampled, fixed or Kepler), evaluated through the one
+        torque definition (:func:`spinorbit.core.dynamics.inertial_torques_along`).
+    moments : (A, B, C)
+        Principal moments (only ratios enter).
+
+    Returns
+    -------
+    momentum : ndarray (n,)
+        δ|L|/A, rad/day.
+    energy : ndarray (n,)
+        δE/A, rad²/day².
+    """
+    from .core.dynamics import inertial_torques_along, make_model
+
+    torque = inertial_torques_along(free.days, free.quaternions, make_model(moments, [source])) / moments[0]
+    direction = free.momentum_over_a / np.linalg.norm(free.momentum_over_a)
+    return (_cumulative_trapezoid(torque @ direction, free.days),
+            _cumulative_trapezoid(np.einsum("ni,ni->n", free.omega, torque), free.days))
+
+
+def action_sensitivities(state, span_days):
+    """(κ_L, κ_E): the largest attitude change per unit action change and time of the exact free motion.
+
+    κ_L: ω scaled by 1 + ε (δ|L| = ε|L| and δE = 2εE: the free motion runs faster), per δ|L|/A · τ.
+    κ_E: the body momentum turned in the body at fixed |L| towards the component of ω across L (E changes
+    fastest), per |δE|/|L| · τ (δE measured exactly, so a state with ω along L, where E changes only to
+    second order, is measured too). Horizons τ and probe size as in :func:`attitude_sensitivity`.
+    """
+    from .core.rotations import rotation_angle_between_many
+    from .state import RotationState
+
+    horizons = np.array(SENSITIVITY_HORIZONS) * span_days
+    base = np.ascontiguousarray(state.propagate_torque_free(horizons)[0])
+    _, momentum = state._principal()
+    moments = np.array(state.body.principal_moments, dtype=float)
+    p = state.body._to_principal
+    size = float(np.linalg.norm(momentum))
+    omega = momentum / moments
+    energy = 0.5 * float(momentum @ omega)
+
+    def response(kicked_momentum):
+        kicked = RotationState(state.body, state.quaternion, p.T @ (kicked_momentum / moments))
+        other = np.ascontiguousarray(kicked.propagate_torque_free(horizons)[0])
+        return rotation_angle_between_many(base, other) / horizons
+
+    eps = SENSITIVITY_PROBE_RAD / (span_days * float(np.linalg.norm(omega)))
+    kappa_l = float(np.max(response(momentum * (1.0 + eps)) / (eps * size / moments[0])))
+    across = omega - (omega @ momentum) / size**2 * momentum
+    across_size = float(np.linalg.norm(across))
+    if across_size < 1e-9 * np.linalg.norm(omega):  # ω along L: E changes at second order, any direction across
+        across = np.cross(momentum, np.eye(3)[int(np.argmin(np.abs(momentum)))])
+    across /= np.linalg.norm(across)
+    # Turn by an angle whose energy change is the probe's, δE/|L| · T ≈ SENSITIVITY_PROBE_RAD (δE ≈ |L| |ω⊥| angle).
+    angle = min(SENSITIVITY_PROBE_RAD / (span_days * max(across_size, 1e-300)), 1e-3)
+    turned = math.cos(angle) * momentum + math.sin(angle) * size * across
+    change = abs(0.5 * float(turned @ (turned / moments)) - energy)
+    kappa_e = float(np.max(response(turned) / (change / size))) if change > 0.0 else 1.0
+    return kappa_l, kappa_e
+
+
+def free_motion_torque_bound(free, momentum, energy, envelope, kappa_l, kappa_e, deviation):
+    """The attitude bound (rad) at ``free.days[-1]`` of leaving out a torque, from its action changes.
+
+    bound = SAFETY · [ κ_L ∫₀ᵀ (|δ|L||/A + 3Θ Ē) ds + κ_E ∫₀ᵀ (|δE − (2E/|L|) δ|L||/|L| + 6Θ Ē) ds
+                       + 2 Ē(T) / (|L|/A) ],       Ē(s) = ∫₀ˢ |N|_max/A ds'  (module docstring).
+
+    Parameters
+    ----------
+    free : FreeMotion
+    momentum, energy : ndarray (n,)
+        δ|L|/A and δE/A from :func:`action_changes`.
+    envelope : ndarray (n,)
+        Ē at ``free.days`` (worst attitude), rad/day.
+    kappa_l, kappa_e : float
+        From :func:`action_sensitivities`.
+    deviation : float
+        Θ: bound (rad) on how far the run's attitude strays from the free motion over the span.
+    """
+    days = free.days
+    size = float(np.linalg.norm(free.momentum_over_a))
+    envelope = np.asarray(envelope, dtype=float)
+    rest = energy - 2.0 * free.energy_over_a / size * momentum  # δE not explained by the change of |L|
+    drift = (kappa_l * _trapezoid(np.abs(momentum) + ATTITUDE_GRADIENT * deviation * envelope, days)
+             + kappa_e * _trapezoid(np.abs(rest) / size + 2.0 * ATTITUDE_GRADIENT * deviation * envelope, days))
+    return SAFETY * (drift + 2.0 * float(envelope[-1]) / size)
+
+
+def self_consistent_deviation(free_motion, worst_attitude, gradient):
+    """Smallest Θ with Θ = Σᵢ min(bᵢ + gradient · Θ · wᵢ, wᵢ), or None when it exceeds :data:`LINEAR_LIMIT`.
+
+    ``free_motion`` are the bounds bᵢ of :func:`free_motion_torque_bound` at Θ = 0, ``worst_attitude``
+    the bounds wᵢ of :func:`dropped_torque_bound` (rad). The torques move the run off the free motion
+    by Θ, and the Θ terms of the free-motion bound are at most ``gradient`` · Θ · wᵢ (the same integrals
+    as wᵢ; ``gradient`` = 3 max(1, (κ_L + 2κ_E)/κ)), so the iteration from Θ = Σ min(bᵢ, wᵢ) increases
+    monotonically to the smallest fixed point.
+    """
+    b, w = np.asarray(free_motion, dtype=float), np.asarray(worst_attitude, dtype=float)
+    theta = float(np.sum(np.minimum(b, w)))
+    for _ in range(200):
+        if theta > LINEAR_LIMIT:
+            return None
+        new = float(np.sum(np.minimum(b + gradient * theta * w, w)))
+        if new <= theta * (1.0 + 1e-9):
+            return max(new, theta)
+        theta = new
+    return theta if theta <= LINEAR_LIMIT else None
 
 
 def back_reaction_bound(days, distances, gm, gm_body, figure_per_mass, moments, span_end, kappa,
@@ -231,12 +470,17 @@ class Decision:
 
 @dataclass
 class PerturberEstimate:
-    """Survey result for one perturber: closest distance (au) and the bound (rad) of leaving it out."""
+    """Survey result for one perturber: closest distance (au) and the bound (rad) of leaving it out.
+
+    ``bound_rad`` is the free-motion bound where it applies (module docstring), never above
+    ``worst_attitude_rad``, the worst-attitude bound of :func:`dropped_torque_bound`.
+    """
 
     name: str
     closest_au: float
     bound_rad: float
     kept: bool
+    worst_attitude_rad: float | None = None
 
 
 @dataclass

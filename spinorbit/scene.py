@@ -54,9 +54,18 @@ from .planner import (
     Plan,
     attitude_sensitivity,
     back_reaction_bound,
+    ATTITUDE_GRADIENT,
+    LINEAR_LIMIT,
+    POINTS_PER_TURN,
+    _cumulative_trapezoid,
+    action_changes,
+    action_sensitivities,
     dropped_torque_bound,
+    free_motion_grid,
+    free_motion_torque_bound,
     initial_rtol,
     max_torque_over_a,
+    self_consistent_deviation,
 )
 from .state import RotationState
 from .time import tdb_days, time_from_tdb_days
@@ -594,11 +603,10 @@ class Scene:
         source = self._orbit_source(skip, decisions)
         kappa = attitude_sensitivity(self.state, span)
         momentum = np.linalg.norm(self.state.angular_momentum.value) / moments[0]
-        estimates, samples = self._survey(source, kappa, momentum, moments, keep=skip)
+        estimates, survey, survey_note = self._survey(source, kappa, momentum, moments, keep=skip)
+        samples = survey if self._keeps_survey(source, skip) else None
         total = sum(e.bound_rad for e in estimates.values())
         names = list(estimates)
-        survey_note = (f"bound = 2 [κ ∫(T-s)|N|/A ds + 2∫|N| ds/|L|], |N| ≤ 3μ(C-A)/2r³, κ = {kappa:.3g} "
-                       f"(measured on the free motion), T = {span:.6g} d")
         if skip and total <= tolerance:
             decisions.append(Decision(
                 "route", "exact torque-free solution, no sampling, no integration",
@@ -609,7 +617,7 @@ class Scene:
                 e.kept = False
             return Plan("torque-free", source, (), tuple(names), estimates, "exact", None, self.end_only,
                         tolerance, kappa, total, False, decisions)
-        route, back_reaction, bound, coupling = self._coupling(skip, source, kappa, momentum, moments)
+        route, back_reaction, bound, coupling = self._coupling(skip, source, kappa, momentum, moments, survey)
         dropped, used = [], 0.0
         if skip and route == "one-way":
             for name in sorted(names, key=lambda n: estimates[n].bound_rad):
@@ -691,10 +699,14 @@ class Scene:
     def _survey(self, source, kappa, momentum, moments, keep=True):
         """Per-perturber bounds (planner module docstring) from a survey of the distances.
 
-        ``keep``: for a REBOUND orbit, survey at the run's tolerance and return the samples for the run
-        (the reference plan, ``keep=False``, keeps nothing, so a full run pays its own sampling).
+        ``keep``: for a REBOUND orbit, survey at the run's tolerance so that the run can reuse it
+        (:meth:`_keeps_survey`; the reference plan, ``keep=False``, keeps nothing, so a full run pays its
+        own sampling). Returns the estimates, the survey of the named perturbers (None without any; the
+        back-reaction bound reads the same survey) and what the bound was (the free-motion bound, or why
+        the worst-attitude one).
         """
-        estimates = {}
+        from .core.perturbers import fixed_source
+
         t_end = self.output_days[-1]
         survey = None
         surveys = []
@@ -707,19 +719,55 @@ class Scene:
             surveys.append(survey)
         if self.moving:  # user ephemerides: like an ephemeris, surveyed loosely, the kept sampled for the run
             surveys.append(self._sampler("user", [p.name for p in self.moving], SURVEY_TOLERANCE))
+        # Per perturber: (name, closest, its source, its survey days, |N|_max/A on them).
+        rows = []
         for samples in surveys:
             distances = np.linalg.norm(samples.states[:, :, :3], axis=2)
-            for i, name in enumerate(samples.names):
-                n = max_torque_over_a(moments, samples.gm[i], distances[:, i])
-                bound = dropped_torque_bound(samples.days, n, t_end, kappa, momentum)
-                estimates[name] = PerturberEstimate(name, float(distances[:, i].min()), bound, True)
-        days = np.array([self.epoch_day, t_end])
+            for i, (name, source) in enumerate(zip(samples.names, samples.sources())):
+                rows.append((name, float(distances[:, i].min()), source, samples.days,
+                             max_torque_over_a(moments, samples.gm[i], distances[:, i])))
+        ends = np.array([self.epoch_day, t_end])
         for fixed in self.fixed:
             r = float(np.linalg.norm(fixed.position_au))
-            n = max_torque_over_a(moments, fixed.gm_au3_day2, np.array([r, r]))
-            estimates[fixed.name] = PerturberEstimate(fixed.name, r, dropped_torque_bound(days, n, t_end, kappa,
-                                                                                          momentum), True)
-        return estimates, (survey if keep else None)
+            rows.append((fixed.name, r, fixed_source(fixed.gm_au3_day2, fixed.position_au), ends,
+                         max_torque_over_a(moments, fixed.gm_au3_day2, np.array([r, r]))))
+        worst = [dropped_torque_bound(days, n, t_end, kappa, momentum) for _, _, _, days, n in rows]
+        bounds, note = self._free_motion_bounds(rows, worst, [s.tolerance for s in surveys], kappa, momentum, moments)
+        estimates = {name: PerturberEstimate(name, closest, bound, True, w)
+                     for (name, closest, *_), bound, w in zip(rows, bounds, worst)}
+        return estimates, survey, note
+
+    def _free_motion_bounds(self, rows, worst, tolerances, kappa, momentum, moments):
+        """The free-motion bounds of the survey's perturbers (planner: *free-motion bound*), each at most its
+        worst-attitude bound in ``worst``; with the words for the plan. Falls back to ``worst`` when the
+        grid is too large or the torques move the run too far from the free motion."""
+        formula = (f"worst attitude: 2 [κ ∫(T-s)|N|/A ds + 2∫|N| ds/|L|], |N| ≤ 3μ(C-A)/2r³, κ = {kappa:.3g} "
+                   f"(measured on the free motion), T = {self.span_days:.6g} d")
+        free, why = free_motion_grid(self.state, self.epoch_day, self.output_days[-1],
+                                     np.unique(np.concatenate([r[3] for r in rows])), len(rows))
+        if free is None:
+            return worst, f"{formula}; {why}"
+        kappa_l, kappa_e = action_sensitivities(self.state, self.span_days)
+        changes = [action_changes(free, source, moments) for _, _, source, _, _ in rows]
+        envelopes = [np.interp(free.days, days, _cumulative_trapezoid(n, days)) for *_, days, n in rows]
+
+        def bounds_at(deviation):
+            return [free_motion_torque_bound(free, dl, de, e, kappa_l, kappa_e, deviation)
+                    for (dl, de), e in zip(changes, envelopes)]
+
+        gradient = ATTITUDE_GRADIENT * max(1.0, (kappa_l + 2.0 * kappa_e) / kappa)
+        deviation = self_consistent_deviation(bounds_at(0.0), worst, gradient)
+        if deviation is None:
+            return worst, (f"{formula}; the perturbers move the attitude by more than {LINEAR_LIMIT:g} rad from "
+                           "the free motion (worst-attitude bounds), so the torque along the free motion is not "
+                           "the torque of the run: the worst-attitude bound is used")
+        deviation += max(tolerances, default=0.0)  # the survey's relative position error enters like an attitude error
+        bounds = [min(b, w) for b, w in zip(bounds_at(deviation), worst)]
+        return bounds, (f"free motion: 2 [κ_L ∫|δ|L||/A ds + κ_E ∫|δE - 2E δ|L|/|L||/|L| ds + 2∫|N|_max ds/|L|], "
+                        f"δ|L| and δE the action changes of the torque integrated along the exact free motion "
+                        f"({free.days.size} points, {POINTS_PER_TURN} per turn), κ_L = {kappa_l:.3g}, "
+                        f"κ_E = {kappa_e:.3g}, the run within {deviation:.2g} rad of the free motion; at most the "
+                        f"{formula}")
 
     def _keeps_survey(self, source, skip):
         """Whether the survey is taken at the run's tolerance and kept for it: a planned one-way run on
@@ -736,10 +784,11 @@ class Scene:
         """The survey's sampling tolerance: the run's when the survey is kept for the run."""
         return self.sample_tolerance if keep else SURVEY_TOLERANCE
 
-    def _coupling(self, skip, source, kappa, momentum, moments):
+    def _coupling(self, skip, source, kappa, momentum, moments, survey):
         """One-way or fully coupled: (route, back-reaction left out (rad), its bound (rad or None), decisions).
 
-        The bound (:func:`spinorbit.planner.back_reaction_bound`) needs the figure's absolute size and
+        ``survey`` is the planning survey of the named perturbers (:meth:`_survey`), read here rather
+        than sampled again. The bound (:func:`spinorbit.planner.back_reaction_bound`) needs the figure's absolute size and
         the body's mass; a massless body in the orbit model has none to estimate.
         """
         choice = "one-way (the rotation does not act on the orbits)"
@@ -757,7 +806,8 @@ class Scene:
                 "RigidBody the moments in kg m² and the mass for the estimate); for the Moon the back-reaction was "
                 "measured at ≈ 0.1 arcsec over a year (docs/coupling.md: 0.305 one-way vs 0.207 arcsec coupled)")]
         big_a, _, big_c = self.moments_per_mass
-        survey = self._sampler(source, self.named, self._survey_tolerance(self._keeps_survey(source, skip)))
+        if survey is None:  # no named perturbers surveyed (only user ones): as before, sample the (empty) set
+            survey = self._sampler(source, self.named, self._survey_tolerance(self._keeps_survey(source, skip)))
         distances = np.linalg.norm(survey.states[:, :, :3], axis=2)
         bound, displacement = back_reaction_bound(survey.days, distances, survey.gm, gm_body, big_c - big_a, moments,
                                                   self.output_days[-1], kappa, momentum)

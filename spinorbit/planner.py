@@ -30,39 +30,51 @@ above the measured effect: the real torque turns with the body, and its integral
 
 The free-motion bound (what the planner uses where it applies)
 ---------------------------------------------------------------
-The same linear response, with the cancellation kept. The torque vector N(s) of each perturber is
-evaluated along the exact free motion (:func:`free_motion_grid`: the torque-free solution on a grid of
-:data:`POINTS_PER_TURN` points per turn at |ω| ≤ |L|/A, plus every survey interval cut in
+The same linear response, with the cancellation kept where it is sound. The torque vector N(s) of each
+perturber is evaluated along the exact free motion (:func:`free_motion_grid`: the torque-free solution
+on a grid of :data:`POINTS_PER_TURN` points per turn at |ω| ≤ |L|/A plus every survey interval cut in
 :data:`SURVEY_SUBDIVISION`; the perturber positions are the survey's Hermite interpolants, through the
-one torque definition :func:`spinorbit.core.dynamics.inertial_torques_along`) and integrated as a
-vector in the inertial frame, δL(s) = ∫₀ˢ N ds' (:func:`momentum_change_over_a`). Since
-∫₀ᵀ (T − s)|N| ds = ∫₀ᵀ ∫₀ˢ |N| ≥ ∫₀ᵀ |∫₀ˢ N|, the worst-attitude sum becomes
+one torque definition :func:`spinorbit.core.dynamics.inertial_torques_along`). The response to a kick
+splits in two:
 
-    bound = SAFETY · [ κ ∫₀ᵀ D(s) ds + 2 max_s D(s) / (|L|/A) ],
-    D(s) = |δL(s)|/A + ATTITUDE_GRADIENT · Θ · ∫₀ˢ |N|_max/A ds'      (:func:`free_motion_torque_bound`),
+- a **secular drift**, from the change of the free motion's frequencies, which depend on its two
+  actions |L| and E only. Its kernel is (T − s) times constant derivatives of the frequencies, so
+  integrating by parts is exact: the drift is ∫₀ᵀ (Ω_L δ|L|(s) + Ω_E δE(s)) ds with the first-order
+  action changes δ|L|(s) = L̂·∫₀ˢ N ds' (the momentum change as a vector, in ICRF) and
+  δE(s) = ∫₀ˢ ω·N ds' (the power), both integrated along the free motion with their cancellation
+  (:func:`action_changes`). Ω_L, Ω_E are measured like κ (:func:`action_sensitivities`): κ_L with
+  ω scaled by 1 + ε, κ_E with L turned in the body at fixed |L|, each the largest attitude change per
+  unit action change and time;
+- a **bounded part** (the tilt of L and the changed nutation: 2|δL|/|L| per kick). Its kernel turns
+  with the body and shares the torque's frequencies (both live on the free motion's torus: the averaged
+  potential shifts the phases without changing any action), so it does not cancel: it stays
+  2 ∫|N|_max ds / |L| as in the worst-attitude bound.
 
-taken at most equal to the worst-attitude bound. What it assumes:
+So, with Ē(s) = ∫₀ˢ |N|_max/A ds' and Θ below (:func:`free_motion_torque_bound`),
 
-- **The run stays near the free motion.** The torque of the run is evaluated along the *run's*
-  attitude, which every torque (kept and dropped) moves off the free motion by some Θ; an attitude
-  error ε changes the degree-2 torque by at most ATTITUDE_GRADIENT · |N|_max · ε (3: 2 from turning r̂
-  in the body, 1 from turning N into the inertial frame), which is the second term of D. Θ is the
-  smallest self-consistent total of the perturbers' bounds (:func:`self_consistent_deviation`), plus
-  the survey's relative position error (it enters like an attitude error). When Θ exceeds
-  :data:`LINEAR_LIMIT` = 0.1 rad (e.g. the Earth at an Apophis flyby, which turns the spin by
-  radians) the torque along the free motion says nothing about the run's, and every perturber gets the
-  worst-attitude bound.
-- **The response to a momentum change depends on the accumulated δL.** Integrating the kicks'
-  responses by parts replaces Σ (per-kick bound)·|N| ds by the accumulated vector; this neglects
-  that the response to an inertial kick varies with the kick's time (the body has turned). A torque
-  whose body-frame frequency sits at the free nutation frequency could accumulate a nutation that
-  δL does not show; the degree-2 torque's body-frame frequencies are ω and 2ω (above the nutation
-  frequency except for a flat disc, C = A + B), and the tests check the bound against full runs of a
-  short-axis, a long-axis, a near-separatrix and a slowly rotating state and an Apophis-like flyby;
-  SAFETY = 2 covers the rest.
-- **Resolution.** The grid resolves the rotation and the survey's grid; beyond
-  :data:`MAX_EVALUATIONS` = 2e6 torque evaluations (grid points × perturbers) the worst-attitude bound
-  is used, and the plan's reason says which bound was taken and why.
+    bound = SAFETY · [ κ_L ∫₀ᵀ (|δ|L||/A + 3Θ Ē) ds + κ_E ∫₀ᵀ (|δE − 2E δ|L|/|L|| / |L| + 6Θ Ē) ds
+                       + 2 Ē(T) / (|L|/A) ],
+
+taken at most equal to the worst-attitude bound (δE − 2E δ|L|/|L| is the energy change that the ω
+scaling of κ_L does not account for). What it assumes:
+
+- **The run stays near the free motion.** The run's torque is evaluated along the *run's* attitude,
+  which every torque (kept and dropped) moves off the free motion by some Θ; an attitude error ε changes
+  the degree-2 torque by at most ATTITUDE_GRADIENT · |N|_max · ε (3: 2 from turning r̂ in the body,
+  1 from turning N into the inertial frame), hence the Θ terms (the power's carries |ω| ≤ |L|/A and
+  2E/|L|² ≤ 1/A, so 6). Θ is the smallest self-consistent total of the perturbers' bounds
+  (:func:`self_consistent_deviation`), plus the survey's relative position error (it enters like an
+  attitude error). Above :data:`LINEAR_LIMIT` = 0.1 rad (e.g. the Earth at an Apophis flyby, which
+  turns the spin by radians; the Earth's torque on the Moon) the torque along the free motion says
+  nothing about the run's, and every perturber gets the worst-attitude bound.
+- **Linear response**, as the worst-attitude bound: κ_L, κ_E are measured for kicks at the epoch and
+  taken for every s; the trapezoid rule on the grid and the rest are left to SAFETY = 2. Checked
+  against full runs (``tests/test_scene.py``): short-axis, long-axis, near-separatrix, slowly rotating
+  and flat-disc (C ≈ A + B: the torque's body frequency at the nutation frequency) states, and a close
+  flyby; 3.7–39× above the measured effect where the worst-attitude bound was 19–2600×
+  (``docs/scenes.md``).
+- **Resolution.** Beyond :data:`MAX_EVALUATIONS` = 2e6 torque evaluations (grid points × perturbers)
+  the worst-attitude bound is used; the plan's reason says which bound was taken and why.
 
 Back-reaction (one-way coupling against the fully coupled run)
 --------------------------------------------------------------
@@ -85,7 +97,9 @@ and the changed perturber vector changes the torque by at most 5 |N|_max(r) |δr
 same attitude bound as a dropped torque (:func:`dropped_torque_bound`); :func:`back_reaction_bound`
 is their sum over the perturbers. Eccentric orbits respond more strongly near pericentre than the
 circular 3.91: that is left to SAFETY (moderate e), and the bound is tested against the fully coupled
-REBOUND run (``CoupledRigidBody``, ``tests/test_scene.py``).
+REBOUND run (``CoupledRigidBody``, ``tests/test_scene.py``). It keeps the worst-attitude form: the chain
+bounds only the *size* of the displacement, not its direction, so there is no torque-change vector to
+integrate along the free motion.
 
 Budget: a scene's tolerance (an attitude angle) is shared: up to :data:`DROP_SHARE` of it for the
 perturbers dropped and the back-reaction left out (one-way coupling), the rest for the integrator (whose error is estimated a posteriori by a second

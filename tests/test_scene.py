@@ -205,7 +205,7 @@ def test_dropped_torque_bound_holds_against_full_runs(which, span, tighter):
 
 
 def test_worst_attitude_bound_kept_where_the_free_motion_bound_does_not_apply():
-    # 20000 d of a 5.4-hour turn: 2.3e6 grid points > 2e6, so the worst-attitude bound, said in the plan.
+    # 20000 d of a 5.5-hour turn (2π A/|L|): 2.8e6 grid points > 2e6, so the worst-attitude bound, said in the plan.
     mass = FixedPerturber("p", 1e-7 * u.au**3 / u.day**2, [0.3, 0.5, 0.8] * u.au)
     plan = Scene(sam_state(), EPOCH, EPOCH + 2e4 * u.day, perturbers=(mass,), tolerance=1e-3 * u.rad).plan()
     estimate = plan.estimates["p"]

@@ -128,6 +128,7 @@ __all__ = [
     "FreeMotion",
     "action_changes",
     "action_sensitivities",
+    "free_motion_bounds",
     "free_motion_grid",
     "free_motion_torque_bound",
     "self_consistent_deviation",
@@ -409,6 +410,65 @@ def self_consistent_deviation(free_motion, worst_attitude, gradient):
             return max(new, theta)
         theta = new
     return theta if theta <= LINEAR_LIMIT else None
+
+
+def free_motion_bounds(state, epoch_day, span_end, perturbers, worst, position_error, kappa):
+    """The free-motion bounds (rad) of a scene's perturbers, each at most its worst-attitude bound; and the words.
+
+    Parameters
+    ----------
+    state : spinorbit.RotationState
+        The body at ``epoch_day``.
+    epoch_day, span_end : float
+        TDB days.
+    perturbers : sequence of (source, days, torque_over_a)
+        Per perturber: its :mod:`spinorbit.core.perturbers` source, its survey times (TDB days) and
+        |N|_max/A on them (rad/day², :func:`max_torque_over_a`).
+    worst : sequence of float
+        Their worst-attitude bounds (:func:`dropped_torque_bound`), rad.
+    position_error : float
+        The survey's relative position error (it enters like an attitude error).
+    kappa : float
+        :func:`attitude_sensitivity`.
+
+    Returns
+    -------
+    bounds : list of float
+        ``worst`` itself where the free-motion bound does not apply (module docstring: the grid above
+        :data:`MAX_EVALUATIONS`, or the run more than :data:`LINEAR_LIMIT` off the free motion).
+    note : str
+        Which bound was taken, with its numbers, for the plan.
+    """
+    span = span_end - epoch_day
+    formula = (f"worst attitude: 2 [κ ∫(T-s)|N|/A ds + 2∫|N| ds/|L|], |N| ≤ 3μ(C-A)/2r³, κ = {kappa:.3g} "
+               f"(measured on the free motion), T = {span:.6g} d")
+    free, why = free_motion_grid(state, epoch_day, span_end, np.unique(np.concatenate([p[1] for p in perturbers])),
+                                 len(perturbers))
+    if free is None:
+        return list(worst), f"{formula}; {why}"
+    kappa_l, kappa_e = action_sensitivities(state, span)
+    moments = state.body.principal_moments
+    changes = [action_changes(free, source, moments) for source, _, _ in perturbers]
+    envelopes = [np.interp(free.days, days, _cumulative_trapezoid(np.asarray(n, dtype=float), days))
+                 for _, days, n in perturbers]
+
+    def bounds_at(deviation):
+        return [free_motion_torque_bound(free, dl, de, e, kappa_l, kappa_e, deviation)
+                for (dl, de), e in zip(changes, envelopes)]
+
+    deviation = self_consistent_deviation(bounds_at(0.0), worst,
+                                          ATTITUDE_GRADIENT * max(1.0, (kappa_l + 2.0 * kappa_e) / kappa))
+    if deviation is None:
+        return list(worst), (f"{formula}; the perturbers move the attitude by more than {LINEAR_LIMIT:g} rad from "
+                             "the free motion (worst-attitude bounds), so the torque along the free motion is not "
+                             "the torque of the run: the worst-attitude bound is used")
+    deviation += position_error
+    bounds = [min(b, w) for b, w in zip(bounds_at(deviation), worst)]
+    return bounds, (f"free motion: 2 [κ_L ∫|δ|L||/A ds + κ_E ∫|δE - 2E δ|L|/|L||/|L| ds + 2∫|N|_max ds/|L|], "
+                    f"δ|L| and δE the action changes of the torque integrated along the exact free motion "
+                    f"({free.days.size} points, {POINTS_PER_TURN} per turn), κ_L = {kappa_l:.3g}, "
+                    f"κ_E = {kappa_e:.3g}, the run within {deviation:.2g} rad of the free motion; at most the "
+                    f"{formula}")
 
 
 def back_reaction_bound(days, distances, gm, gm_body, figure_per_mass, moments, span_end, kappa,

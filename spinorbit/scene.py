@@ -54,18 +54,10 @@ from .planner import (
     Plan,
     attitude_sensitivity,
     back_reaction_bound,
-    ATTITUDE_GRADIENT,
-    LINEAR_LIMIT,
-    POINTS_PER_TURN,
-    _cumulative_trapezoid,
-    action_changes,
-    action_sensitivities,
     dropped_torque_bound,
-    free_motion_grid,
-    free_motion_torque_bound,
+    free_motion_bounds,
     initial_rtol,
     max_torque_over_a,
-    self_consistent_deviation,
 )
 from .state import RotationState
 from .time import tdb_days, time_from_tdb_days
@@ -732,42 +724,11 @@ class Scene:
             rows.append((fixed.name, r, fixed_source(fixed.gm_au3_day2, fixed.position_au), ends,
                          max_torque_over_a(moments, fixed.gm_au3_day2, np.array([r, r]))))
         worst = [dropped_torque_bound(days, n, t_end, kappa, momentum) for _, _, _, days, n in rows]
-        bounds, note = self._free_motion_bounds(rows, worst, [s.tolerance for s in surveys], kappa, momentum, moments)
+        bounds, note = free_motion_bounds(self.state, self.epoch_day, t_end, [row[2:] for row in rows], worst,
+                                          max((s.tolerance for s in surveys), default=0.0), kappa)
         estimates = {name: PerturberEstimate(name, closest, bound, True, w)
                      for (name, closest, *_), bound, w in zip(rows, bounds, worst)}
         return estimates, survey, note
-
-    def _free_motion_bounds(self, rows, worst, tolerances, kappa, momentum, moments):
-        """The free-motion bounds of the survey's perturbers (planner: *free-motion bound*), each at most its
-        worst-attitude bound in ``worst``; with the words for the plan. Falls back to ``worst`` when the
-        grid is too large or the torques move the run too far from the free motion."""
-        formula = (f"worst attitude: 2 [κ ∫(T-s)|N|/A ds + 2∫|N| ds/|L|], |N| ≤ 3μ(C-A)/2r³, κ = {kappa:.3g} "
-                   f"(measured on the free motion), T = {self.span_days:.6g} d")
-        free, why = free_motion_grid(self.state, self.epoch_day, self.output_days[-1],
-                                     np.unique(np.concatenate([r[3] for r in rows])), len(rows))
-        if free is None:
-            return worst, f"{formula}; {why}"
-        kappa_l, kappa_e = action_sensitivities(self.state, self.span_days)
-        changes = [action_changes(free, source, moments) for _, _, source, _, _ in rows]
-        envelopes = [np.interp(free.days, days, _cumulative_trapezoid(n, days)) for *_, days, n in rows]
-
-        def bounds_at(deviation):
-            return [free_motion_torque_bound(free, dl, de, e, kappa_l, kappa_e, deviation)
-                    for (dl, de), e in zip(changes, envelopes)]
-
-        gradient = ATTITUDE_GRADIENT * max(1.0, (kappa_l + 2.0 * kappa_e) / kappa)
-        deviation = self_consistent_deviation(bounds_at(0.0), worst, gradient)
-        if deviation is None:
-            return worst, (f"{formula}; the perturbers move the attitude by more than {LINEAR_LIMIT:g} rad from "
-                           "the free motion (worst-attitude bounds), so the torque along the free motion is not "
-                           "the torque of the run: the worst-attitude bound is used")
-        deviation += max(tolerances, default=0.0)  # the survey's relative position error enters like an attitude error
-        bounds = [min(b, w) for b, w in zip(bounds_at(deviation), worst)]
-        return bounds, (f"free motion: 2 [κ_L ∫|δ|L||/A ds + κ_E ∫|δE - 2E δ|L|/|L||/|L| ds + 2∫|N|_max ds/|L|], "
-                        f"δ|L| and δE the action changes of the torque integrated along the exact free motion "
-                        f"({free.days.size} points, {POINTS_PER_TURN} per turn), κ_L = {kappa_l:.3g}, "
-                        f"κ_E = {kappa_e:.3g}, the run within {deviation:.2g} rad of the free motion; at most the "
-                        f"{formula}")
 
     def _keeps_survey(self, source, skip):
         """Whether the survey is taken at the run's tolerance and kept for it: a planned one-way run on

@@ -275,7 +275,7 @@ class SceneResult:
     error_parts : dict of Quantity
         ``dropped`` (bound of the perturbers the plan left out), ``integration`` (a posteriori: the run
         against one at 10× its rtol or BS eps; conservative), ``sampling`` (3ε × the kept torques'
-        bound; 0 on the coupled route, which has no sampling), ``back_reaction`` (bound of the
+        worst-attitude bound; 0 on the coupled route, which has no sampling), ``back_reaction`` (bound of the
         figure's force on the orbits that a one-way route leaves out).
     plan : Plan
     wall_seconds : float
@@ -925,7 +925,9 @@ class Scene:
             if integration <= 0.5 * share or rtol <= 1e-13:
                 break
             rtol = max(rtol / 100.0, 1e-13)
-        kept_bound = sum(plan.estimates[n].bound_rad for n in plan.kept)
+        # The sampling error is a torque error of relative size 3ε in no particular direction: it does not
+        # share the torque's cancellation, so it is bounded with the worst-attitude bound.
+        kept_bound = sum(_worst_attitude(plan.estimates[n]) for n in plan.kept)
         sampling = 3.0 * self.sample_tolerance * kept_bound if named or moving else 0.0
         if "omega" not in self.quantities:
             run.remove_column("omega")
@@ -957,6 +959,11 @@ class Scene:
         table.meta["rtol"] = eps
         stats.update(rtol=eps)
         return table, {"dropped": 0.0, "integration": integration, "sampling": 0.0}, stats
+
+
+def _worst_attitude(estimate):
+    """The worst-attitude bound of a PerturberEstimate (``bound_rad`` for one made without it)."""
+    return estimate.bound_rad if estimate.worst_attitude_rad is None else estimate.worst_attitude_rad
 
 
 def _subset(samples, names):

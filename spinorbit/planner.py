@@ -25,7 +25,56 @@ attitudes, |N| ≤ (3μ / 2r³) (C − A) (the unit vector r̂ at 45° between t
 REBOUND orbit at the run's own tolerance, and kept for the run), which still tightens its grid around
 close encounters. SAFETY = 2 covers the trapezoid rule between survey
 samples and the linearisation. ``tests/test_scene.py`` checks the bound against full runs: the
-measured effect of a dropped torque must stay below it.
+measured effect of a dropped torque must stay below it. This *worst-attitude* bound is 20–2400×
+above the measured effect: the real torque turns with the body, and its integral cancels.
+
+The free-motion bound (what the planner uses where it applies)
+---------------------------------------------------------------
+The same linear response, with the cancellation kept where it is sound. The torque vector N(s) of each
+perturber is evaluated along the exact free motion (:func:`free_motion_grid`: the torque-free solution
+on a grid of :data:`POINTS_PER_TURN` points per turn at |ω| ≤ |L|/A plus every survey interval cut in
+:data:`SURVEY_SUBDIVISION`; the perturber positions are the survey's Hermite interpolants, through the
+one torque definition :func:`spinorbit.core.dynamics.inertial_torques_along`). The response to a kick
+splits in two:
+
+- a **secular drift**, from the change of the free motion's frequencies, which depend on its two
+  actions |L| and E only. Its kernel is (T − s) times constant derivatives of the frequencies, so
+  integrating by parts is exact: the drift is ∫₀ᵀ (Ω_L δ|L|(s) + Ω_E δE(s)) ds with the first-order
+  action changes δ|L|(s) = L̂·∫₀ˢ N ds' (the momentum change as a vector, in ICRF) and
+  δE(s) = ∫₀ˢ ω·N ds' (the power), both integrated along the free motion with their cancellation
+  (:func:`action_changes`). Ω_L, Ω_E are measured like κ (:func:`action_sensitivities`): κ_L with
+  ω scaled by 1 + ε, κ_E with L turned in the body at fixed |L|, each the largest attitude change per
+  unit action change and time;
+- a **bounded part** (the tilt of L and the changed nutation: 2|δL|/|L| per kick). Its kernel turns
+  with the body and shares the torque's frequencies (both live on the free motion's torus: the averaged
+  potential shifts the phases without changing any action), so it does not cancel: it stays
+  2 ∫|N|_max ds / |L| as in the worst-attitude bound.
+
+So, with Ē(s) = ∫₀ˢ |N|_max/A ds' and Θ below (:func:`free_motion_torque_bound`),
+
+    bound = SAFETY · [ κ_L ∫₀ᵀ (|δ|L||/A + 3Θ Ē) ds + κ_E ∫₀ᵀ (|δE − 2E δ|L|/|L|| / |L| + 6Θ Ē) ds
+                       + 2 Ē(T) / (|L|/A) ],
+
+taken at most equal to the worst-attitude bound (δE − 2E δ|L|/|L| is the energy change that the ω
+scaling of κ_L does not account for). What it assumes:
+
+- **The run stays near the free motion.** The run's torque is evaluated along the *run's* attitude,
+  which every torque (kept and dropped) moves off the free motion by some Θ; an attitude error ε changes
+  the degree-2 torque by at most ATTITUDE_GRADIENT · |N|_max · ε (3: 2 from turning r̂ in the body,
+  1 from turning N into the inertial frame), hence the Θ terms (the power's carries |ω| ≤ |L|/A and
+  2E/|L|² ≤ 1/A, so 6). Θ is the smallest self-consistent total of the perturbers' bounds
+  (:func:`self_consistent_deviation`), plus the survey's relative position error (it enters like an
+  attitude error). Above :data:`LINEAR_LIMIT` = 0.1 rad (e.g. the Earth at an Apophis flyby, which
+  turns the spin by radians; the Earth's torque on the Moon) the torque along the free motion says
+  nothing about the run's, and every perturber gets the worst-attitude bound.
+- **Linear response**, as the worst-attitude bound: κ_L, κ_E are measured for kicks at the epoch and
+  taken for every s; the trapezoid rule on the grid and the rest are left to SAFETY = 2. Checked
+  against full runs (``tests/test_scene.py``): short-axis, long-axis, near-separatrix, slowly rotating
+  and flat-disc (C ≈ A + B: the torque's body frequency at the nutation frequency) states, and a close
+  flyby; 3.7–39× above the measured effect where the worst-attitude bound was 19–2600×
+  (``docs/scenes.md``).
+- **Resolution.** Beyond :data:`MAX_EVALUATIONS` = 2e6 torque evaluations (grid points × perturbers)
+  the worst-attitude bound is used; the plan's reason says which bound was taken and why.
 
 Back-reaction (one-way coupling against the fully coupled run)
 --------------------------------------------------------------
@@ -48,7 +97,9 @@ and the changed perturber vector changes the torque by at most 5 |N|_max(r) |δr
 same attitude bound as a dropped torque (:func:`dropped_torque_bound`); :func:`back_reaction_bound`
 is their sum over the perturbers. Eccentric orbits respond more strongly near pericentre than the
 circular 3.91: that is left to SAFETY (moderate e), and the bound is tested against the fully coupled
-REBOUND run (``CoupledRigidBody``, ``tests/test_scene.py``).
+REBOUND run (``CoupledRigidBody``, ``tests/test_scene.py``). It keeps the worst-attitude form: the chain
+bounds only the *size* of the displacement, not its direction, so there is no torque-change vector to
+integrate along the free motion.
 
 Budget: a scene's tolerance (an attitude angle) is shared: up to :data:`DROP_SHARE` of it for the
 perturbers dropped and the back-reaction left out (one-way coupling), the rest for the integrator (whose error is estimated a posteriori by a second
@@ -74,6 +125,13 @@ __all__ = [
     "attitude_sensitivity",
     "back_reaction_bound",
     "dropped_torque_bound",
+    "FreeMotion",
+    "action_changes",
+    "action_sensitivities",
+    "free_motion_bounds",
+    "free_motion_grid",
+    "free_motion_torque_bound",
+    "self_consistent_deviation",
     "initial_rtol",
     "max_torque_over_a",
 ]
@@ -97,6 +155,21 @@ ARCSEC_PER_RAD = 180.0 * 3600.0 / math.pi
 #: Largest orbit displacement per unit impulse and elapsed time (module docstring: 3.91 for a circular
 #: orbit, computed from Hill's equations; rounded up).
 ORBIT_RESPONSE = 4.0
+#: Free-motion bound: grid points per turn of the fastest rotation the free motion can reach (|ω| ≤ |L|/A);
+#: the degree-2 torque, quadratic in the perturber's body direction, then has ≥ 16 points per cycle.
+POINTS_PER_TURN = 32
+#: Free-motion bound: each survey interval is cut into this many (the survey grid is dense where the
+#: perturbers move fast, e.g. close encounters).
+SURVEY_SUBDIVISION = 4
+#: Free-motion bound: largest number of torque evaluations (grid points × perturbers; ≈ 0.1 µs each);
+#: beyond it the worst-attitude bound is used.
+MAX_EVALUATIONS = 2_000_000
+#: Free-motion bound: largest deviation (rad) of the run from the free motion for which the torques
+#: are evaluated along the free motion; beyond it the worst-attitude bound is used.
+LINEAR_LIMIT = 0.1
+#: |δN| ≤ ATTITUDE_GRADIENT · |N|_max · ε when the attitude is off by ε: 2 from turning r̂ in the body
+#: (|δ(r̂ × I′r̂)| ≤ (C − A)|δr̂|), 1 from turning N into the inertial frame.
+ATTITUDE_GRADIENT = 3.0
 #: |∇U| of a degree-2 figure ≤ FIGURE_FORCE · G (C − A) / r⁴ (module docstring).
 FIGURE_FORCE = 6.0
 #: |δN| ≤ TORQUE_GRADIENT · |N|_max · |δr|/r for a change δr of the perturber vector (module docstring).
@@ -156,6 +229,246 @@ def dropped_torque_bound(days, torque_over_a, span_end, kappa, momentum_over_a):
     drift = _trapezoid(lever * n, days)
     tilt = _trapezoid(n, days)
     return SAFETY * (kappa * drift + 2.0 * tilt / momentum_over_a)
+
+
+@dataclass
+class FreeMotion:
+    """The exact free motion on the grid of the free-motion bound (:func:`free_motion_grid`).
+
+    Attributes
+    ----------
+    days : ndarray (n,)
+        TDB days, increasing, from the epoch to the span's end.
+    quaternions : ndarray (n, 4)
+        Principal-axis attitudes (body → ICRF).
+    omega : ndarray (n, 3)
+        Angular velocity in ICRF, rad/day.
+    momentum_over_a : ndarray (3,)
+        L/A in ICRF (constant on the free motion), rad/day.
+    energy_over_a : float
+        Kinetic energy E/A = ½ L·ω / A, rad²/day².
+    """
+
+    days: np.ndarray
+    quaternions: np.ndarray
+    omega: np.ndarray
+    momentum_over_a: np.ndarray
+    energy_over_a: float
+
+
+def free_motion_grid(state, epoch_day, span_end, survey_days=(), perturbers=1):
+    """The exact free motion of ``state`` on the grid of the free-motion bound, or why not.
+
+    The grid takes :data:`POINTS_PER_TURN` points per 2π A/|L| (a turn at the largest angular velocity
+    the free motion can reach, |ω| ≤ |L|/A) and every survey interval cut into
+    :data:`SURVEY_SUBDIVISION` (the survey tightened its grid where the perturbers move fast, e.g. at
+    a close encounter). Returns ``(FreeMotion, None)``, or ``(None, why)`` when the grid times
+    ``perturbers`` would exceed :data:`MAX_EVALUATIONS` torque evaluations.
+    """
+    from .core.rotations import attitude_to_quat, quat_to_attitude_many
+    from .core.torque_free import torque_free_states
+
+    attitude, momentum = state._principal()
+    moments = np.array(state.body.principal_moments, dtype=float)
+    turn = 2.0 * math.pi * moments[0] / float(np.linalg.norm(momentum))
+    uniform = int(math.ceil((span_end - epoch_day) / turn * POINTS_PER_TURN)) + 1
+    survey_days = np.asarray(survey_days, dtype=float)
+    total = uniform + SURVEY_SUBDIVISION * max(survey_days.size - 1, 0)
+    if total * perturbers > MAX_EVALUATIONS:
+        return None, (f"the free-motion grid would take {total * perturbers:.3g} torque evaluations "
+                      f"(> {MAX_EVALUATIONS:.0e}: {POINTS_PER_TURN} per turn of a {turn * 24:.3g} h rotation), "
+                      "so the worst-attitude bound is used")
+    pieces = [np.linspace(epoch_day, span_end, max(uniform, 2))]
+    if survey_days.size > 1:
+        fractions = np.arange(SURVEY_SUBDIVISION) / SURVEY_SUBDIVISION
+        pieces.append((survey_days[:-1, None] + np.diff(survey_days)[:, None] * fractions).ravel())
+    days = np.unique(np.clip(np.concatenate(pieces), epoch_day, span_end))
+    quaternions, body_momenta = torque_free_states(attitude_to_quat(np.ascontiguousarray(attitude)), momentum,
+                                                   *moments, days - epoch_day)
+    quaternions = np.ascontiguousarray(quaternions)
+    # ω_inertial = M(q) ω_body, M(q) the transpose of the attitude matrix.
+    omega = np.einsum("nji,nj->ni", quat_to_attitude_many(quaternions), body_momenta / moments)
+    momentum_over_a = attitude.T @ momentum / moments[0]
+    energy_over_a = 0.5 * float(momentum @ (momentum / moments)) / moments[0]
+    return FreeMotion(days, quaternions, omega, momentum_over_a, energy_over_a), None
+
+
+def action_changes(free, source, moments):
+    """δ|L|/A and δE/A along the free motion from the torque of ``source``, cancellation kept.
+
+    δL(s) = ∫₀ˢ N ds' is integrated as a vector (ICRF) along ``free``; δ|L| = L̂·δL and the kinetic
+    energy change δE(s) = ∫₀ˢ ω·N ds' are the first-order changes of the free motion's two actions
+    (its frequencies depend on |L| and E only). Trapezoid rule on ``free.days``.
+
+    Parameters
+    ----------
+    free : FreeMotion
+    source : ndarray
+        One :mod:`spinorbit.core.perturbers` source (sampled, fixed or Kepler), evaluated through the one
+        torque definition (:func:`spinorbit.core.dynamics.inertial_torques_along`).
+    moments : (A, B, C)
+        Principal moments (only ratios enter).
+
+    Returns
+    -------
+    momentum : ndarray (n,)
+        δ|L|/A, rad/day.
+    energy : ndarray (n,)
+        δE/A, rad²/day².
+    """
+    from .core.dynamics import inertial_torques_along, make_model
+
+    torque = inertial_torques_along(free.days, free.quaternions, make_model(moments, [source])) / moments[0]
+    direction = free.momentum_over_a / np.linalg.norm(free.momentum_over_a)
+    return (_cumulative_trapezoid(torque @ direction, free.days),
+            _cumulative_trapezoid(np.einsum("ni,ni->n", free.omega, torque), free.days))
+
+
+def action_sensitivities(state, span_days):
+    """(κ_L, κ_E): the largest attitude change per unit action change and time of the exact free motion.
+
+    κ_L: ω scaled by 1 + ε (δ|L| = ε|L| and δE = 2εE: the free motion runs faster), per δ|L|/A · τ.
+    κ_E: the body momentum turned in the body at fixed |L| towards the component of ω across L (E changes
+    fastest), per |δE|/|L| · τ (δE measured exactly, so a state with ω along L, where E changes only to
+    second order, is measured too). Horizons τ and probe size as in :func:`attitude_sensitivity`.
+    """
+    from .core.rotations import rotation_angle_between_many
+    from .state import RotationState
+
+    horizons = np.array(SENSITIVITY_HORIZONS) * span_days
+    base = np.ascontiguousarray(state.propagate_torque_free(horizons)[0])
+    _, momentum = state._principal()
+    moments = np.array(state.body.principal_moments, dtype=float)
+    p = state.body._to_principal
+    size = float(np.linalg.norm(momentum))
+    omega = momentum / moments
+    energy = 0.5 * float(momentum @ omega)
+
+    def response(kicked_momentum):
+        kicked = RotationState(state.body, state.quaternion, p.T @ (kicked_momentum / moments))
+        other = np.ascontiguousarray(kicked.propagate_torque_free(horizons)[0])
+        return rotation_angle_between_many(base, other) / horizons
+
+    eps = SENSITIVITY_PROBE_RAD / (span_days * float(np.linalg.norm(omega)))
+    kappa_l = float(np.max(response(momentum * (1.0 + eps)) / (eps * size / moments[0])))
+    across = omega - (omega @ momentum) / size**2 * momentum
+    across_size = float(np.linalg.norm(across))
+    if across_size < 1e-9 * np.linalg.norm(omega):  # ω along L: E changes at second order, any direction across
+        across = np.cross(momentum, np.eye(3)[int(np.argmin(np.abs(momentum)))])
+    across /= np.linalg.norm(across)
+    # Turn by an angle whose energy change is the probe's, δE/|L| · T ≈ SENSITIVITY_PROBE_RAD (δE ≈ |L| |ω⊥| angle).
+    angle = min(SENSITIVITY_PROBE_RAD / (span_days * max(across_size, 1e-300)), 1e-3)
+    turned = math.cos(angle) * momentum + math.sin(angle) * size * across
+    change = abs(0.5 * float(turned @ (turned / moments)) - energy)
+    kappa_e = float(np.max(response(turned) / (change / size))) if change > 0.0 else 1.0
+    return kappa_l, kappa_e
+
+
+def free_motion_torque_bound(free, momentum, energy, envelope, kappa_l, kappa_e, deviation):
+    """The attitude bound (rad) at ``free.days[-1]`` of leaving out a torque, from its action changes.
+
+    bound = SAFETY · [ κ_L ∫₀ᵀ (|δ|L||/A + 3Θ Ē) ds + κ_E ∫₀ᵀ (|δE − (2E/|L|) δ|L||/|L| + 6Θ Ē) ds
+                       + 2 Ē(T) / (|L|/A) ],       Ē(s) = ∫₀ˢ |N|_max/A ds'  (module docstring).
+
+    Parameters
+    ----------
+    free : FreeMotion
+    momentum, energy : ndarray (n,)
+        δ|L|/A and δE/A from :func:`action_changes`.
+    envelope : ndarray (n,)
+        Ē at ``free.days`` (worst attitude), rad/day.
+    kappa_l, kappa_e : float
+        From :func:`action_sensitivities`.
+    deviation : float
+        Θ: bound (rad) on how far the run's attitude strays from the free motion over the span.
+    """
+    days = free.days
+    size = float(np.linalg.norm(free.momentum_over_a))
+    envelope = np.asarray(envelope, dtype=float)
+    rest = energy - 2.0 * free.energy_over_a / size * momentum  # δE not explained by the change of |L|
+    drift = (kappa_l * _trapezoid(np.abs(momentum) + ATTITUDE_GRADIENT * deviation * envelope, days)
+             + kappa_e * _trapezoid(np.abs(rest) / size + 2.0 * ATTITUDE_GRADIENT * deviation * envelope, days))
+    return SAFETY * (drift + 2.0 * float(envelope[-1]) / size)
+
+
+def self_consistent_deviation(free_motion, worst_attitude, gradient):
+    """Smallest Θ with Θ = Σᵢ min(bᵢ + gradient · Θ · wᵢ, wᵢ), or None when it exceeds :data:`LINEAR_LIMIT`.
+
+    ``free_motion`` are the bounds bᵢ of :func:`free_motion_torque_bound` at Θ = 0, ``worst_attitude``
+    the bounds wᵢ of :func:`dropped_torque_bound` (rad). The torques move the run off the free motion
+    by Θ, and the Θ terms of the free-motion bound are at most ``gradient`` · Θ · wᵢ (the same integrals
+    as wᵢ; ``gradient`` = 3 max(1, (κ_L + 2κ_E)/κ)), so the iteration from Θ = Σ min(bᵢ, wᵢ) increases
+    monotonically to the smallest fixed point.
+    """
+    b, w = np.asarray(free_motion, dtype=float), np.asarray(worst_attitude, dtype=float)
+    theta = float(np.sum(np.minimum(b, w)))
+    for _ in range(200):
+        if theta > LINEAR_LIMIT:
+            return None
+        new = float(np.sum(np.minimum(b + gradient * theta * w, w)))
+        if new <= theta * (1.0 + 1e-9):
+            return max(new, theta)
+        theta = new
+    return theta if theta <= LINEAR_LIMIT else None
+
+
+def free_motion_bounds(state, epoch_day, span_end, perturbers, worst, position_error, kappa):
+    """The free-motion bounds (rad) of a scene's perturbers, each at most its worst-attitude bound; and the words.
+
+    Parameters
+    ----------
+    state : spinorbit.RotationState
+        The body at ``epoch_day``.
+    epoch_day, span_end : float
+        TDB days.
+    perturbers : sequence of (source, days, torque_over_a)
+        Per perturber: its :mod:`spinorbit.core.perturbers` source, its survey times (TDB days) and
+        |N|_max/A on them (rad/day², :func:`max_torque_over_a`).
+    worst : sequence of float
+        Their worst-attitude bounds (:func:`dropped_torque_bound`), rad.
+    position_error : float
+        The survey's relative position error (it enters like an attitude error).
+    kappa : float
+        :func:`attitude_sensitivity`.
+
+    Returns
+    -------
+    bounds : list of float
+        ``worst`` itself where the free-motion bound does not apply (module docstring: the grid above
+        :data:`MAX_EVALUATIONS`, or the run more than :data:`LINEAR_LIMIT` off the free motion).
+    note : str
+        Which bound was taken, with its numbers, for the plan.
+    """
+    span = span_end - epoch_day
+    formula = (f"worst attitude: 2 [κ ∫(T-s)|N|/A ds + 2∫|N| ds/|L|], |N| ≤ 3μ(C-A)/2r³, κ = {kappa:.3g} "
+               f"(measured on the free motion), T = {span:.6g} d")
+    free, why = free_motion_grid(state, epoch_day, span_end, np.unique(np.concatenate([p[1] for p in perturbers])),
+                                 len(perturbers))
+    if free is None:
+        return list(worst), f"{formula}; {why}"
+    kappa_l, kappa_e = action_sensitivities(state, span)
+    moments = state.body.principal_moments
+    changes = [action_changes(free, source, moments) for source, _, _ in perturbers]
+    envelopes = [np.interp(free.days, days, _cumulative_trapezoid(np.asarray(n, dtype=float), days))
+                 for _, days, n in perturbers]
+
+    def bounds_at(deviation):
+        return [free_motion_torque_bound(free, dl, de, e, kappa_l, kappa_e, deviation)
+                for (dl, de), e in zip(changes, envelopes)]
+
+    deviation = self_consistent_deviation(bounds_at(0.0), worst,
+                                          ATTITUDE_GRADIENT * max(1.0, (kappa_l + 2.0 * kappa_e) / kappa))
+    if deviation is None:
+        return list(worst), (f"{formula}; the perturbers move the attitude by more than {LINEAR_LIMIT:g} rad from "
+                             "the free motion (worst-attitude bounds), so the torque along the free motion is not "
+                             "the torque of the run: the worst-attitude bound is used")
+    deviation += position_error
+    bounds = [min(b, w) for b, w in zip(bounds_at(deviation), worst)]
+    return bounds, (f"free motion: 2 [κ_L ∫|δ|L||/A ds + κ_E ∫|δE - 2E δ|L|/|L||/|L| ds + 2∫|N|_max ds/|L|], "
+                    f"δ|L| and δE the action changes of the torque integrated along the exact free motion "
+                    f"({free.days.size} points, {POINTS_PER_TURN} per turn), κ_L = {kappa_l:.3g}, "
+                    f"κ_E = {kappa_e:.3g}, the run within {deviation:.2g} rad of the free motion; at most the "
+                    f"{formula}")
 
 
 def back_reaction_bound(days, distances, gm, gm_body, figure_per_mass, moments, span_end, kappa,
@@ -231,12 +544,17 @@ class Decision:
 
 @dataclass
 class PerturberEstimate:
-    """Survey result for one perturber: closest distance (au) and the bound (rad) of leaving it out."""
+    """Survey result for one perturber: closest distance (au) and the bound (rad) of leaving it out.
+
+    ``bound_rad`` is the free-motion bound where it applies (module docstring), never above
+    ``worst_attitude_rad``, the worst-attitude bound of :func:`dropped_torque_bound`.
+    """
 
     name: str
     closest_au: float
     bound_rad: float
     kept: bool
+    worst_attitude_rad: float | None = None
 
 
 @dataclass

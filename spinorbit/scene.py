@@ -55,6 +55,7 @@ from .planner import (
     attitude_sensitivity,
     back_reaction_bound,
     dropped_torque_bound,
+    free_motion_bounds,
     initial_rtol,
     max_torque_over_a,
 )
@@ -277,7 +278,7 @@ class SceneResult:
     error_parts : dict of Quantity
         ``dropped`` (bound of the perturbers the plan left out), ``integration`` (a posteriori: the run
         against one at 10× its rtol or BS eps; conservative), ``sampling`` (3ε × the kept torques'
-        bound; 0 on the coupled route, which has no sampling), ``back_reaction`` (bound of the
+        worst-attitude bound; 0 on the coupled route, which has no sampling), ``back_reaction`` (bound of the
         figure's force on the orbits that a one-way route leaves out).
     plan : Plan
     wall_seconds : float
@@ -597,11 +598,10 @@ class Scene:
         source = self._orbit_source(skip, decisions)
         kappa = attitude_sensitivity(self.state, span)
         momentum = np.linalg.norm(self.state.angular_momentum.value) / moments[0]
-        estimates, samples = self._survey(source, kappa, momentum, moments, keep=skip)
+        estimates, survey, survey_note = self._survey(source, kappa, momentum, moments, keep=skip)
+        samples = survey if self._keeps_survey(source, skip) else None
         total = sum(e.bound_rad for e in estimates.values())
         names = list(estimates)
-        survey_note = (f"bound = 2 [κ ∫(T-s)|N|/A ds + 2∫|N| ds/|L|], |N| ≤ 3μ(C-A)/2r³, κ = {kappa:.3g} "
-                       f"(measured on the free motion), T = {span:.6g} d")
         if skip and total <= tolerance:
             decisions.append(Decision(
                 "route", "exact torque-free solution, no sampling, no integration",
@@ -612,7 +612,7 @@ class Scene:
                 e.kept = False
             return Plan("torque-free", source, (), tuple(names), estimates, "exact", None, self.end_only,
                         tolerance, kappa, total, False, decisions)
-        route, back_reaction, bound, coupling = self._coupling(skip, source, kappa, momentum, moments)
+        route, back_reaction, bound, coupling = self._coupling(skip, source, kappa, momentum, moments, survey)
         dropped, used = [], 0.0
         if skip and route == "one-way":
             for name in sorted(names, key=lambda n: estimates[n].bound_rad):
@@ -694,10 +694,14 @@ class Scene:
     def _survey(self, source, kappa, momentum, moments, keep=True):
         """Per-perturber bounds (planner module docstring) from a survey of the distances.
 
-        ``keep``: for a REBOUND orbit, survey at the run's tolerance and return the samples for the run
-        (the reference plan, ``keep=False``, keeps nothing, so a full run pays its own sampling).
+        ``keep``: for a REBOUND orbit, survey at the run's tolerance so that the run can reuse it
+        (:meth:`_keeps_survey`; the reference plan, ``keep=False``, keeps nothing, so a full run pays its
+        own sampling). Returns the estimates, the survey of the named perturbers (None without any; the
+        back-reaction bound reads the same survey) and what the bound was (the free-motion bound, or why
+        the worst-attitude one).
         """
-        estimates = {}
+        from .core.perturbers import fixed_source
+
         t_end = self.output_days[-1]
         survey = None
         surveys = []
@@ -710,19 +714,24 @@ class Scene:
             surveys.append(survey)
         if self.moving:  # user ephemerides: like an ephemeris, surveyed loosely, the kept sampled for the run
             surveys.append(self._sampler("user", [p.name for p in self.moving], SURVEY_TOLERANCE))
+        # Per perturber: (name, closest, its source, its survey days, |N|_max/A on them).
+        rows = []
         for samples in surveys:
             distances = np.linalg.norm(samples.states[:, :, :3], axis=2)
-            for i, name in enumerate(samples.names):
-                n = max_torque_over_a(moments, samples.gm[i], distances[:, i])
-                bound = dropped_torque_bound(samples.days, n, t_end, kappa, momentum)
-                estimates[name] = PerturberEstimate(name, float(distances[:, i].min()), bound, True)
-        days = np.array([self.epoch_day, t_end])
+            for i, (name, source) in enumerate(zip(samples.names, samples.sources())):
+                rows.append((name, float(distances[:, i].min()), source, samples.days,
+                             max_torque_over_a(moments, samples.gm[i], distances[:, i])))
+        ends = np.array([self.epoch_day, t_end])
         for fixed in self.fixed:
             r = float(np.linalg.norm(fixed.position_au))
-            n = max_torque_over_a(moments, fixed.gm_au3_day2, np.array([r, r]))
-            estimates[fixed.name] = PerturberEstimate(fixed.name, r, dropped_torque_bound(days, n, t_end, kappa,
-                                                                                          momentum), True)
-        return estimates, (survey if keep else None)
+            rows.append((fixed.name, r, fixed_source(fixed.gm_au3_day2, fixed.position_au), ends,
+                         max_torque_over_a(moments, fixed.gm_au3_day2, np.array([r, r]))))
+        worst = [dropped_torque_bound(days, n, t_end, kappa, momentum) for _, _, _, days, n in rows]
+        bounds, note = free_motion_bounds(self.state, self.epoch_day, t_end, [row[2:] for row in rows], worst,
+                                          max((s.tolerance for s in surveys), default=0.0), kappa)
+        estimates = {name: PerturberEstimate(name, closest, bound, True, w)
+                     for (name, closest, *_), bound, w in zip(rows, bounds, worst)}
+        return estimates, survey, note
 
     def _keeps_survey(self, source, skip):
         """Whether the survey is taken at the run's tolerance and kept for it: a planned one-way run on
@@ -739,10 +748,11 @@ class Scene:
         """The survey's sampling tolerance: the run's when the survey is kept for the run."""
         return self.sample_tolerance if keep else SURVEY_TOLERANCE
 
-    def _coupling(self, skip, source, kappa, momentum, moments):
+    def _coupling(self, skip, source, kappa, momentum, moments, survey):
         """One-way or fully coupled: (route, back-reaction left out (rad), its bound (rad or None), decisions).
 
-        The bound (:func:`spinorbit.planner.back_reaction_bound`) needs the figure's absolute size and
+        ``survey`` is the planning survey of the named perturbers (:meth:`_survey`), read here rather
+        than sampled again. The bound (:func:`spinorbit.planner.back_reaction_bound`) needs the figure's absolute size and
         the body's mass; a massless body in the orbit model has none to estimate.
         """
         choice = "one-way (the rotation does not act on the orbits)"
@@ -760,7 +770,8 @@ class Scene:
                 "RigidBody the moments in kg m² and the mass for the estimate); for the Moon the back-reaction was "
                 "measured at ≈ 0.1 arcsec over a year (docs/coupling.md: 0.305 one-way vs 0.207 arcsec coupled)")]
         big_a, _, big_c = self.moments_per_mass
-        survey = self._sampler(source, self.named, self._survey_tolerance(self._keeps_survey(source, skip)))
+        if survey is None:  # no named perturbers surveyed (only user ones): as before, sample the (empty) set
+            survey = self._sampler(source, self.named, self._survey_tolerance(self._keeps_survey(source, skip)))
         distances = np.linalg.norm(survey.states[:, :, :3], axis=2)
         bound, displacement = back_reaction_bound(survey.days, distances, survey.gm, gm_body, big_c - big_a, moments,
                                                   self.output_days[-1], kappa, momentum)
@@ -911,7 +922,9 @@ class Scene:
             if integration <= 0.5 * share or rtol <= 1e-13:
                 break
             rtol = max(rtol / 100.0, 1e-13)
-        kept_bound = sum(plan.estimates[n].bound_rad for n in plan.kept)
+        # The sampling error is a torque error of relative size 3ε in no particular direction: it does not
+        # share the torque's cancellation, so it is bounded with the worst-attitude bound.
+        kept_bound = sum(_worst_attitude(plan.estimates[n]) for n in plan.kept)
         sampling = 3.0 * self.sample_tolerance * kept_bound if named or moving else 0.0
         if "omega" not in self.quantities:
             run.remove_column("omega")
@@ -943,6 +956,11 @@ class Scene:
         table.meta["rtol"] = eps
         stats.update(rtol=eps)
         return table, {"dropped": 0.0, "integration": integration, "sampling": 0.0}, stats
+
+
+def _worst_attitude(estimate):
+    """The worst-attitude bound of a PerturberEstimate (``bound_rad`` for one made without it)."""
+    return estimate.bound_rad if estimate.worst_attitude_rad is None else estimate.worst_attitude_rad
 
 
 def _subset(samples, names):

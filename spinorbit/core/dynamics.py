@@ -161,6 +161,23 @@ def total_force_function_and_torque(t, q, model):
 
 
 @jit
+def inertial_torques_along(times, quaternions, model):
+    """Inertial torque M(q) N(t, q) (energy units, (n, 3)) at each (times[j], quaternions[j]).
+
+    The scene planner's free-motion bound (:mod:`spinorbit.planner`) evaluates the one torque
+    definition, :func:`force_function_and_torque_xyz`, along a given attitude history; M(q)ᵀ of the
+    conjugate quaternion is M(q), so :func:`body_frame_xyz` turns the body torque into the inertial one.
+    """
+    n = times.shape[0]
+    out = np.empty((n, 3))
+    for j in range(n):
+        q0, q1, q2, q3 = quaternions[j, 0], quaternions[j, 1], quaternions[j, 2], quaternions[j, 3]
+        _, nx, ny, nz = force_function_and_torque_xyz(times[j], q0, q1, q2, q3, model)
+        out[j, 0], out[j, 1], out[j, 2] = body_frame_xyz(q0, -q1, -q2, -q3, nx, ny, nz)
+    return out
+
+
+@jit
 def total_torque(t, q, model):
     """Body-frame torque N(t, q) of all perturbers (energy units)."""
     return total_force_function_and_torque(t, q, model)[1]

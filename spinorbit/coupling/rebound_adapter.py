@@ -49,6 +49,7 @@ __all__ = [
     "install_extra_forces",
     "set_nongravitational",
     "reinstall_extra_forces",
+    "extra_forces_in_effect",
     "body_index",
     "perturber_positions",
     "RotationCallbackError",
@@ -325,6 +326,24 @@ class ExtraForces:
     _function_pointer: object = None
     _cfunc: object = None
 
+    @classmethod
+    def from_parameters(cls, parameters) -> ExtraForces:
+        """A description (not installed) of the forces a parameter block switches on; the block is copied.
+
+        What :func:`reinstall_extra_forces` needs to put the same forces on another simulation, e.g.
+        the block stored in a checkpoint (``CoupledRigidBody.checkpoint``).
+
+        Raises
+        ------
+        ValueError
+            ``parameters`` is not a block of ``_N_PARAMETERS`` finite floats.
+        """
+        block = np.array(parameters, dtype=float)
+        if block.shape != (_N_PARAMETERS,) or not np.all(np.isfinite(block)):
+            raise ValueError(f"parameters: expected the {_N_PARAMETERS} finite floats of an install_extra_forces "
+                             f"block, got an array of shape {block.shape}.")
+        return cls(block, bool(block[_P_USE_J2]), bool(block[_P_USE_GR]))
+
 
 def _rebound_name(body: str) -> str:
     return body.strip().capitalize()
@@ -470,10 +489,11 @@ def install_extra_forces(sim, earth_j2: bool = True, gr: bool = True, earth_pole
 def reinstall_extra_forces(sim, handle: ExtraForces) -> ExtraForces:
     """Install on ``sim`` the same forces, with the same parameters, as ``handle`` (from another sim).
 
-    For rebuilt copies of a simulation (the raw pointer does not survive ``sim.copy()`` or a
-    Simulationarchive): ``sim`` must hold the same particles in the same order, since the parameter
-    block refers to particles by index (Earth for J2, the body and the Sun for the
-    non-gravitational terms).
+    For rebuilt copies of a simulation (the raw pointer does not survive ``sim.copy()``, REBOUND's
+    binary or a Simulationarchive): ``sim`` must hold the same particles in the same order, since
+    the parameter block refers to particles by index (Earth for J2, the body and the Sun for the
+    non-gravitational terms). ``handle`` may come from :func:`extra_forces_in_effect` or
+    :meth:`ExtraForces.from_parameters`.
     """
     copy = install_extra_forces(sim, earth_j2=handle.earth_j2, gr=handle.gr,
                                 earth_pole=handle.parameters[_P_POLE:_P_POLE + 3])
@@ -781,6 +801,17 @@ class RotationHooks:
         y[:] = np.asarray(value, dtype=float)
 
     @property
+    def extra_forces(self) -> ExtraForces | None:
+        """The extra-force block folded into the combined force (a copy), or None if none is on.
+
+        Whatever installed it (``earth_j2``/``gr`` when attaching, or :func:`install_extra_forces`
+        and :func:`set_nongravitational` before): this block, not the attach arguments, is what acts.
+        """
+        if self.parameters[_R_USE_EXTRA] == 0.0:
+            return None
+        return ExtraForces.from_parameters(self.parameters[_R_EXTRA:_R_EXTRA + _N_PARAMETERS])
+
+    @property
     def perturber_degrees(self) -> tuple:
         """Highest degree of the figure's field each perturber sees (in perturber order)."""
         count = int(self.parameters[_R_N_PERTURBERS])
@@ -801,6 +832,52 @@ class RotationHooks:
                 f"rotation callback stopped the run at t = {when!r} (TDB days since J2000 for DE421 "
                 f"simulations): {ERROR_MESSAGES.get(code, f'unknown error code {code}')}."
             )
+
+
+def extra_forces_in_effect(sim) -> ExtraForces | None:
+    """The extra forces (EIH, Earth J2, non-gravitational) acting on ``sim``'s orbits now, as a copy.
+
+    From :func:`install_extra_forces` (and :func:`set_nongravitational`) directly, or folded into a
+    rigid body's combined force by :func:`attach_rotation_hooks`. For rebuilding ``sim`` elsewhere
+    (:func:`reinstall_extra_forces`): a copy or a checkpoint that took only the attach arguments
+    would lose the forces installed before the body.
+
+    Raises
+    ------
+    ForceInstallError
+        ``sim`` has forces spinorbit did not install (a Python ``additional_forces``, REBOUNDx, a
+        pre/post-timestep hook): they cannot be carried to a rebuilt simulation.
+    """
+    handle = getattr(sim, "_afp", None)
+    if isinstance(handle, ExtraForces):
+        return ExtraForces.from_parameters(handle.parameters)
+    if isinstance(handle, RotationHooks):
+        return handle.extra_forces
+    if handle is not None or sim._additional_forces or sim._pre_timestep_modifications \
+            or sim._post_timestep_modifications or sim.extras:
+        raise ForceInstallError(
+            "the simulation has forces or hooks spinorbit did not install (a Python additional_forces, "
+            "REBOUNDx or a timestep hook); a rebuilt copy would run without them. Use install_extra_forces "
+            "and set_nongravitational for the forces, or sample the orbit yourself (one_way.sample_states)."
+        )
+    return None
+
+
+def _check_folded_request(block, earth_j2, gr, earth_pole) -> None:
+    """Refuse ``earth_j2``/``gr``/``earth_pole`` asked of :func:`attach_rotation_hooks` that the block
+    installed earlier does not have: the fold uses that block as it is, and would silently ignore them."""
+    missing = [name for name, asked, on in (("earth_j2", earth_j2, block[_P_USE_J2]), ("gr", gr, block[_P_USE_GR]))
+               if asked and on == 0.0]
+    pole = np.asarray(earth_pole, dtype=float)
+    if earth_j2 and block[_P_USE_J2] != 0.0 and not np.array_equal(pole / np.linalg.norm(pole),
+                                                                    block[_P_POLE:_P_POLE + 3]):
+        missing.append(f"earth_pole={tuple(pole.tolist())} (installed: {tuple(block[_P_POLE:_P_POLE + 3].tolist())})")
+    if missing:
+        raise ForceInstallError(
+            f"install_extra_forces was called on this simulation before the body was attached, without "
+            f"{', '.join(missing)}; attaching folds in that block unchanged. Ask for these forces in "
+            "install_extra_forces instead (or leave earth_j2/gr off when attaching)."
+        )
 
 
 def attach_rotation_hooks(sim, body: str, perturbers, figure, state, coupled: bool = True,
@@ -881,6 +958,7 @@ def attach_rotation_hooks(sim, body: str, perturbers, figure, state, coupled: bo
     parameters[_R_DEGREES:_R_DEGREES + len(indices)] = [min(d, n_max) for d in degrees]
     extra = None
     if isinstance(previous, ExtraForces):
+        _check_folded_request(previous.parameters, earth_j2, gr, earth_pole)
         # Fold the forces installed earlier into the combined cfunc: their whole block (it indexes
         # this simulation's particles), so that non-gravitational terms carry over with J2 and EIH.
         extra = previous

@@ -637,7 +637,10 @@ _R_PERTURBERS = _R_EXTRA + _N_PARAMETERS
 _R_DEGREES = _R_PERTURBERS + MAX_PERTURBERS  # highest field degree each perturber sees
 _R_MODEL = _R_DEGREES + MAX_PERTURBERS  # the figure array (gravity_field.make_body)
 _R_PSEUDO = _R_MODEL + FIGURE_SIZE  # IAS15 route only: index of the first pseudo-particle
-_R_SIZE = _R_PSEUDO + 1
+# Restore only (RotationHooks.resume_bs_controller): a pending flag, the value of BS's
+# first_or_last_step to write at the next step, and that field's address (bits of a uint64).
+_R_BS_PENDING, _R_BS_FLAG, _R_BS_FLAG_ADDRESS = _R_PSEUDO + 1, _R_PSEUDO + 2, _R_PSEUDO + 3
+_R_SIZE = _R_PSEUDO + 4
 
 #: Error codes the cfuncs write into the parameter block (0: no error).
 ERROR_PARTICLE_COUNT = 1.0
@@ -766,6 +769,26 @@ def _coupled_forces_cfunc(simulation):
 
 
 _ODE_DERIVATIVES_TYPE = dict(_ODE._fields_)["_derivatives"]
+_ODE_PRE_TIMESTEP_TYPE = dict(_ODE._fields_)["_pre_timestep"]
+
+
+@cfunc(types.void(types.CPointer(types.uint64), types.CPointer(types.float64)), cache=True)
+def _resume_bs_controller_cfunc(ode, y):
+    """User-ODE ``pre_timestep``: once after a restore, give BS back its ``first_or_last_step``.
+
+    rebound 5.2.2 sets ``first_or_last_step = 1`` whenever an ODE is created: the user ODE when the
+    body is attached, and the N-body part's internal ODE at the first step of a simulation rebuilt
+    from its binary (which does not hold that ODE). The binary's value is thereby lost, and the
+    restored run's first step, allowed to stop its extrapolation early, left the uninterrupted run by
+    ~1e-14 (measured, ``tests/test_checkpoint_runs.py``). ``pre_timestep`` runs inside the BS step,
+    after both resets and before the extrapolation, so the value written here is the one it uses.
+    """
+    ode_words = carray(ode, _ODE_WORDS)
+    p = carray(_as_float64_pointer(ode_words[_ODE_REF_WORD]), _R_SIZE)
+    if p[_R_BS_PENDING] != 0.0:
+        flag = carray(_as_int32_pointer(_float64_bits(p[_R_BS_FLAG_ADDRESS])), 1)
+        flag[0] = np.int32(p[_R_BS_FLAG])
+        p[_R_BS_PENDING] = 0.0
 
 
 @dataclass
@@ -821,6 +844,19 @@ class RotationHooks:
     def figure(self) -> np.ndarray:
         """The figure array (``gravity_field.make_body`` layout) in simulation units (view)."""
         return self.parameters[_R_MODEL:_R_MODEL + FIGURE_SIZE]
+
+    def resume_bs_controller(self, sim, first_or_last_step: int) -> None:
+        """Have the next BS step of ``sim`` start with ``first_or_last_step`` (a restore's value).
+
+        For a simulation rebuilt from REBOUND's binary: read ``sim.integrator.first_or_last_step``
+        before attaching (attaching resets it) and pass it here (``_resume_bs_controller_cfunc``).
+        """
+        fields = sim.integrator.callbacks.field_descriptor_list
+        address = sim.integrator.state + fields.field_descriptor_for_name("first_or_last_step").offset
+        self.parameters[_R_BS_FLAG_ADDRESS:_R_BS_FLAG_ADDRESS + 1] = np.array([address], dtype=np.uint64).view(
+            np.float64)
+        self.parameters[_R_BS_FLAG] = int(first_or_last_step)
+        self.parameters[_R_BS_PENDING] = 1.0
 
     def raise_if_failed(self) -> None:
         """Raise :class:`RotationCallbackError` if a cfunc recorded an error during the last run."""
@@ -979,10 +1015,13 @@ def attach_rotation_hooks(sim, body: str, perturbers, figure, state, coupled: bo
     parameters[_R_ODE:_R_ODE + 1] = np.array([ctypes.addressof(ode)], dtype=np.uint64).view(np.float64)
     derivatives = _ODE_DERIVATIVES_TYPE(_rotation_derivatives_cfunc.address)
     forces = _ADDITIONAL_FORCES_TYPE(_coupled_forces_cfunc.address)
+    pre_timestep = _ODE_PRE_TIMESTEP_TYPE(_resume_bs_controller_cfunc.address)
     hooks = RotationHooks(parameters, ode, bool(coupled), extra,
-                          (derivatives, forces, _rotation_derivatives_cfunc, _coupled_forces_cfunc))
+                          (derivatives, forces, pre_timestep, _rotation_derivatives_cfunc, _coupled_forces_cfunc,
+                           _resume_bs_controller_cfunc))
     ode.ref = parameters.ctypes.data
     ode._derivatives = derivatives
+    ode._pre_timestep = pre_timestep  # does nothing unless resume_bs_controller was called
     sim._afp = hooks  # keep-alive in REBOUND's own slots (see install_extra_forces)
     sim._extras_ref = parameters
     sim.extras = parameters.ctypes.data

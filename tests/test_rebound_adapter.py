@@ -259,8 +259,9 @@ def test_a_rebuilt_copy_integrates_bit_for_bit_like_the_original(integrator, set
 
     The old copy (particles, G, integrator name) ran BS at the default eps 1e-8 and IAS15 at epsilon
     1e-9. IAS15 is also copied mid-run (dt and its predictor are in REBOUND's binary). BS mid-run is
-    not: rebound 5.2.2 keeps part of its state outside the binary (its internal N-body ODE; a copy,
-    also ``sim.copy()``, starts that afresh), measured 3.5e-14 au apart after 30 days.
+    not: rebound 5.2.2 keeps its internal N-body ODE outside the binary, and creating it again at the
+    copy's first step resets ``first_or_last_step`` (also with ``sim.copy()``); copied at day 10.3,
+    measured 3.5e-14 au apart at day 40 (docs/coupling.md).
     """
     from spinorbit.coupling.one_way import _Snapshot
 

@@ -213,3 +213,10 @@ def test_attach_refuses_forces_the_earlier_block_does_not_have():
         CoupledRigidBody(sim, "Moon", figure, state, earth_j2=True)
     body = CoupledRigidBody(sim, "Moon", figure, state, earth_j2=True, earth_pole=(0.0, 0.6, 0.8))
     assert body.earth_j2 and not body.gr
+
+
+def test_bs_flag_restore_is_refused_for_other_integrators():
+    body = _system()
+    body.sim.integrator = "ias15"
+    with pytest.raises(ForceInstallError, match="needs the 'bs' integrator, got"):
+        body.hooks.resume_bs_controller(body.sim, 0)

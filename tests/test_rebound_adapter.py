@@ -284,6 +284,7 @@ def test_a_copy_keeps_the_forces_folded_into_a_rigid_body_and_refuses_foreign_on
     a copy must still carry them (the old copy saw no ExtraForces handle and dropped them)."""
     from spinorbit.core.gravity_field import make_body
     from spinorbit.coupling.one_way import _Snapshot
+    from spinorbit.coupling.rebound_adapter import _P_NG_BODY
     from spinorbit.coupling.rigid_body import CoupledRigidBody
 
     plain, with_body = _three_bodies("bs"), _three_bodies("bs")
@@ -295,16 +296,10 @@ def test_a_copy_keeps_the_forces_folded_into_a_rigid_body_and_refuses_foreign_on
     for copy in copies:
         copy.integrate(30.0)
     assert copies[0].particles["Body"].xyz == copies[1].particles["Body"].xyz
-    assert copies[1]._afp.parameters[_ng_body_word()] == body_index(with_body, "Body")
+    assert copies[1]._afp.parameters[_P_NG_BODY] == body_index(with_body, "Body")  # the A1-A3 term is on
 
     foreign = rebound.Simulation()
     foreign.add(m=1.0, name="Sun")
     foreign.additional_forces = lambda simulation: None
     with pytest.raises(ForceInstallError, match="did not install"):
         _Snapshot.of(foreign)
-
-
-def _ng_body_word():
-    from spinorbit.coupling import rebound_adapter
-
-    return rebound_adapter._P_NG_BODY

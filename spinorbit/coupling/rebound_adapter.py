@@ -609,6 +609,7 @@ def perturber_positions(sim, body: str, perturbers=None):
 # Both call :func:`_figure_torque_and_reaction`, so torque and back-reaction come from the same
 # gravity-field kernel (``gravity_field.figure_force_function_and_gradient_xyz``).
 # --------------------------------------------------------------------------------------------
+from rebound.integrator import IntegratorConfiguration as _IntegratorConfiguration  # noqa: E402
 from rebound.ode import ODE as _ODE  # noqa: E402  (kept next to the code that reads its layout)
 
 from ..core.dynamics import body_frame_xyz, kinematics_and_euler_into  # noqa: E402
@@ -638,9 +639,10 @@ _R_DEGREES = _R_PERTURBERS + MAX_PERTURBERS  # highest field degree each perturb
 _R_MODEL = _R_DEGREES + MAX_PERTURBERS  # the figure array (gravity_field.make_body)
 _R_PSEUDO = _R_MODEL + FIGURE_SIZE  # IAS15 route only: index of the first pseudo-particle
 # Restore only (RotationHooks.resume_bs_controller): a pending flag, the value of BS's
-# first_or_last_step to write at the next step, and that field's address (bits of a uint64).
-_R_BS_PENDING, _R_BS_FLAG, _R_BS_FLAG_ADDRESS = _R_PSEUDO + 1, _R_PSEUDO + 2, _R_PSEUDO + 3
-_R_SIZE = _R_PSEUDO + 4
+# first_or_last_step to write at the next step, the integrator state's address and the field's byte
+# offset in it (addresses as the bits of a uint64).
+_R_BS_PENDING, _R_BS_FLAG, _R_BS_STATE, _R_BS_FLAG_OFFSET = range(_R_PSEUDO + 1, _R_PSEUDO + 5)
+_R_SIZE = _R_PSEUDO + 5
 
 #: Error codes the cfuncs write into the parameter block (0: no error).
 ERROR_PARTICLE_COUNT = 1.0
@@ -770,6 +772,10 @@ def _coupled_forces_cfunc(simulation):
 
 _ODE_DERIVATIVES_TYPE = dict(_ODE._fields_)["_derivatives"]
 _ODE_PRE_TIMESTEP_TYPE = dict(_ODE._fields_)["_pre_timestep"]
+#: Word of the simulation struct holding the integrator's state pointer (``sim.integrator.state``).
+_SIM_INTEGRATOR_STATE_BYTE = rebound.Simulation.integrator.offset + _IntegratorConfiguration.state.offset
+assert _SIM_INTEGRATOR_STATE_BYTE % _WORD == 0, "sim.integrator.state is not on an 8-byte word"
+_SIM_INTEGRATOR_STATE_WORD = _SIM_INTEGRATOR_STATE_BYTE // _WORD
 
 
 @cfunc(types.void(types.CPointer(types.uint64), types.CPointer(types.float64)), cache=True)
@@ -786,9 +792,12 @@ def _resume_bs_controller_cfunc(ode, y):
     ode_words = carray(ode, _ODE_WORDS)
     p = carray(_as_float64_pointer(ode_words[_ODE_REF_WORD]), _R_SIZE)
     if p[_R_BS_PENDING] != 0.0:
-        flag = carray(_as_int32_pointer(_float64_bits(p[_R_BS_FLAG_ADDRESS])), 1)
-        flag[0] = np.int32(p[_R_BS_FLAG])
         p[_R_BS_PENDING] = 0.0
+        words = carray(_as_uint64_pointer(ode_words[_ODE_SIM_WORD]), _SIM_INTEGRATOR_STATE_WORD + 1)
+        state = words[_SIM_INTEGRATOR_STATE_WORD]
+        if state == _float64_bits(p[_R_BS_STATE]):  # the same BS state as at the restore: write
+            flag = carray(_as_int32_pointer(state + _float64_bits(p[_R_BS_FLAG_OFFSET])), 1)
+            flag[0] = np.int32(p[_R_BS_FLAG])
 
 
 @dataclass
@@ -851,10 +860,13 @@ class RotationHooks:
         For a simulation rebuilt from REBOUND's binary: read ``sim.integrator.first_or_last_step``
         before attaching (attaching resets it) and pass it here (``_resume_bs_controller_cfunc``).
         """
-        fields = sim.integrator.callbacks.field_descriptor_list
-        address = sim.integrator.state + fields.field_descriptor_for_name("first_or_last_step").offset
-        self.parameters[_R_BS_FLAG_ADDRESS:_R_BS_FLAG_ADDRESS + 1] = np.array([address], dtype=np.uint64).view(
-            np.float64)
+        if str(sim.integrator) != "bs":
+            raise ForceInstallError(f"resume_bs_controller needs the 'bs' integrator, got {sim.integrator!r}.")
+        offset = sim.integrator.callbacks.field_descriptor_list.field_descriptor_for_name("first_or_last_step").offset
+        # Kept with the state's address: if the integrator is replaced before the next step, the
+        # cfunc sees another state pointer and writes nothing (no write into freed memory).
+        words = np.array([sim.integrator.state, offset], dtype=np.uint64).view(np.float64)
+        self.parameters[_R_BS_STATE], self.parameters[_R_BS_FLAG_OFFSET] = words
         self.parameters[_R_BS_FLAG] = int(first_or_last_step)
         self.parameters[_R_BS_PENDING] = 1.0
 

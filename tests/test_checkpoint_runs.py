@@ -182,6 +182,67 @@ def test_coupled_run_resumed_from_file_ends_bit_for_bit(tmp_path):
         integrate_to_outputs(None, times, _record, 10, resume=path, settings={"case": 2})
 
 
+def _system_with_earlier_forces():
+    """Sun, Earth and a small rotating body (au, day, Msun) with EIH, Earth J2 and A1/A2/A3 installed
+    *before* the body is attached, as ``asteroids`` sets them up: the fold carries them into the
+    body's combined force, and a checkpoint must carry them back."""
+    import rebound
+
+    from spinorbit.coupling.rebound_adapter import install_extra_forces, set_nongravitational
+
+    sim = rebound.Simulation()
+    sim.units = ("AU", "day", "Msun")
+    sim.integrator = "bs"
+    sim.integrator.eps_abs = sim.integrator.eps_rel = 1e-12
+    sim.add(m=1.0, name="Sun")
+    sim.add(m=3e-6, a=1.0, e=0.0167, name="Earth")
+    sim.add(m=1e-18, a=1.1, e=0.3, inc=0.2, name="Asteroid")
+    sim.move_to_com()
+    sim.exact_finish_time = 1
+    install_extra_forces(sim, earth_j2=True, gr=True, earth_pole=(0.0, 0.6, 0.8))
+    set_nongravitational(sim, "Asteroid", 3e-10, -2e-11, 1e-11)
+    figure = make_body((4e-35, 5e-35, 6e-35), mass=1e-18, reference_radius=1e-8)
+    return CoupledRigidBody(sim, "Asteroid", figure, [1.0, 0.0, 0.0, 0.0, 0.05, 0.1, 1.3],
+                            perturbers=["Sun", "Earth"])
+
+
+def test_resume_keeps_the_forces_installed_before_the_body_was_attached(tmp_path):
+    """The checkpoint held only the constructor's earth_j2/gr (both off here): a resume ran without
+    EIH, J2 and the non-gravitational terms (measured: 8.2e-8 au off the uninterrupted run 18 days
+    after the restore at day 12). Also needs BS's first_or_last_step given back after the restore
+    (``rebound_adapter._resume_bs_controller_cfunc``): without it this run left the uninterrupted one
+    by ~1e-14 even with the forces right."""
+    times = np.linspace(0.0, 30.0, 31)[1:]
+    path = tmp_path / "forces.ckpt"
+    record = lambda body: np.concatenate([body.state, body.sim.particles["Asteroid"].xyz])  # noqa: E731
+    body, rows, _ = integrate_to_outputs(_system_with_earlier_forces(), times, record, 10)
+    schedule = CheckpointSchedule(path, every_seconds=None, every_chunks=4, stop_after_chunks=12)
+    with pytest.raises(RunStopped):
+        integrate_to_outputs(_system_with_earlier_forces(), times, record, 10, schedule=schedule)
+    resumed, resumed_rows, _ = integrate_to_outputs(None, times, record, 10, resume=path)
+    assert np.array_equal(resumed_rows, rows)
+    assert resumed.earth_j2 and resumed.gr  # the constructor was given neither
+    assert np.array_equal(resumed.extra_forces.parameters, body.extra_forces.parameters)
+    for name in ("Sun", "Earth", "Asteroid"):
+        a, b = body.sim.particles[name], resumed.sim.particles[name]
+        assert a.xyz == b.xyz and a.vxyz == b.vxyz
+
+
+def test_checkpoints_of_the_old_content_refused_saying_why(tmp_path):
+    """Version-1 body checkpoints (constructor flags only) cannot tell whether earlier forces acted."""
+    from spinorbit.coupling.rigid_body import RestoreError
+
+    current = _system_with_earlier_forces().checkpoint()
+    arrays = {k: v for k, v in current.arrays.items() if k != "extra_forces"}
+    arrays["earth_pole"] = np.array([0.0, 0.0, 1.0])
+    meta = {k: v for k, v in current.meta.items() if k != "content_version"}
+    meta.update(earth_j2=False, gr=False)
+    Checkpoint(current.kind, arrays, meta).write(tmp_path / "old.ckpt")
+    with pytest.raises(RestoreError, match="content version 1.*could silently drop forces.*Start the run again"):
+        CoupledRigidBody.restore(tmp_path / "old.ckpt")
+    assert issubclass(RestoreError, CheckpointError)
+
+
 def _cli(*args):
     env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
     return subprocess.Popen([sys.executable, "-m", "spinorbit", "moon", *args], cwd=ROOT, env=env,

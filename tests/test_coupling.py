@@ -138,13 +138,19 @@ def test_refuses_integrators_that_decouple_user_odes():
         CoupledRigidBody(sim, "Body", make_body((1, 2, 3)), [1, 0, 0, 0, 0, 0, 1])
 
 
-def test_refuses_a_second_body_and_folds_in_earlier_extra_forces():
+def _sun_earth_moon(moon_a):
+    """Sun, Earth and Moon (au, day, Msun) under BS, with the Moon at ``moon_a`` au from Earth."""
     sim = rebound.Simulation()
     sim.units = ("AU", "day", "Msun")
     sim.integrator = "bs"
     sim.add(m=1.0, name="Sun")
     sim.add(m=3e-6, a=1.0, name="Earth")
-    sim.add(m=3.7e-8, a=1.0026, primary=sim.particles[1], name="Moon")
+    sim.add(m=3.7e-8, a=moon_a, primary=sim.particles[1], name="Moon")
+    return sim
+
+
+def test_refuses_a_second_body_and_folds_in_earlier_extra_forces():
+    sim = _sun_earth_moon(1.0026)
     install_extra_forces(sim, earth_j2=True, gr=True)
     body = CoupledRigidBody(sim, "Moon", make_body((1e-20, 1.1e-20, 1.2e-20)), [1, 0, 0, 0, 0, 0, 0.23])
     assert body.hooks.extra is not None and body.hooks.extra.earth_j2 and body.hooks.extra.gr
@@ -193,3 +199,24 @@ def test_attaching_a_body_keeps_earlier_non_gravitational_forces():
         body.integrate(10.0)
         positions.append(np.array(sim.particles["Moon"].xyz))
     assert np.linalg.norm(positions[1] - positions[0]) > 1e-9
+
+
+def test_attach_refuses_forces_the_earlier_block_does_not_have():
+    """Attaching folds an earlier install_extra_forces block unchanged: asking the constructor for J2,
+    EIH or another pole on top of it would be silently ignored, so it raises instead."""
+    sim = _sun_earth_moon(0.00257)
+    install_extra_forces(sim, earth_j2=True, gr=False, earth_pole=(0.0, 0.6, 0.8))
+    figure, state = make_body((1e-20, 1.1e-20, 1.2e-20)), [1, 0, 0, 0, 0, 0, 0.23]
+    with pytest.raises(ForceInstallError, match="without gr; attaching folds in that block unchanged"):
+        CoupledRigidBody(sim, "Moon", figure, state, gr=True)
+    with pytest.raises(ForceInstallError, match=r"without earth_pole=\(0.0, 0.0, 1.0\)"):
+        CoupledRigidBody(sim, "Moon", figure, state, earth_j2=True)
+    body = CoupledRigidBody(sim, "Moon", figure, state, earth_j2=True, earth_pole=(0.0, 0.6, 0.8))
+    assert body.earth_j2 and not body.gr
+
+
+def test_bs_flag_restore_is_refused_for_other_integrators():
+    body = _system()
+    body.sim.integrator = "ias15"
+    with pytest.raises(ForceInstallError, match="needs the 'bs' integrator, got"):
+        body.hooks.resume_bs_controller(body.sim, 0)

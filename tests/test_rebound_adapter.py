@@ -230,3 +230,76 @@ def test_reinstalled_forces_carry_every_parameter():
     for sim in (original, copy):
         sim.integrate(5.0)
     assert original.particles["Body"].xyz == copy.particles["Body"].xyz
+
+
+# ------------------------------------------------------------------------------------- rebuilt copies
+def _three_bodies(integrator, **settings):
+    """Sun, Earth-like and an eccentric body (au, day, Msun), EIH and a non-gravitational term on."""
+    sim = rebound.Simulation()
+    sim.units = ("AU", "day", "Msun")
+    sim.integrator = integrator
+    for name, value in settings.items():
+        setattr(sim.integrator, name, value)
+    sim.add(m=1.0, name="Sun")
+    sim.add(m=3e-6, a=1.0, e=0.0167, name="Earth")
+    sim.add(m=0.0, a=1.3, e=0.4, inc=0.2, name="Body")
+    sim.move_to_com()
+    install_extra_forces(sim, earth_j2=True, gr=True)
+    set_nongravitational(sim, "Body", 1e-9, -2e-10, 5e-11)
+    return sim
+
+
+@pytest.mark.parametrize("integrator, settings, warm", [
+    ("bs", {"eps_abs": 1e-11, "eps_rel": 1e-10, "min_dt": 1e-4}, False),  # BS defaults: 1e-8, 1e-8, 0
+    ("ias15", {"epsilon": 1e-5, "adaptive_mode": "global", "min_dt": 1e-4}, False),  # 1e-9, PRS23, 0
+    ("ias15", {"epsilon": 1e-5, "adaptive_mode": "global", "min_dt": 1e-4}, True),
+])
+def test_a_rebuilt_copy_integrates_bit_for_bit_like_the_original(integrator, settings, warm):
+    """The one-way sampler's copies (``one_way._Snapshot``) keep every integrator setting (and state).
+
+    The old copy (particles, G, integrator name) ran BS at the default eps 1e-8 and IAS15 at epsilon
+    1e-9. IAS15 is also copied mid-run (dt and its predictor are in REBOUND's binary). BS mid-run is
+    not: rebound 5.2.2 keeps its internal N-body ODE outside the binary, and creating it again at the
+    copy's first step resets ``first_or_last_step`` (also with ``sim.copy()``); copied at day 10.3,
+    measured 3.5e-14 au apart at day 40 (docs/coupling.md).
+    """
+    from spinorbit.coupling.one_way import _Snapshot
+
+    original = _three_bodies(integrator, **settings)
+    if warm:
+        original.integrate(10.3)
+    copy = _Snapshot.of(original).build()
+    for name, value in settings.items():
+        assert getattr(copy.integrator, name) == getattr(original.integrator, name)
+    for t in (11.0, 17.5, 40.0):
+        original.integrate(t)
+        copy.integrate(t)
+        for name in ("Sun", "Earth", "Body"):
+            assert copy.particles[name].xyz == original.particles[name].xyz, (t, name)
+    assert copy.steps_done == original.steps_done
+
+
+def test_a_copy_keeps_the_forces_folded_into_a_rigid_body_and_refuses_foreign_ones():
+    """A simulation with a body attached holds its earlier extra forces in the body's combined force:
+    a copy must still carry them (the old copy saw no ExtraForces handle and dropped them)."""
+    from spinorbit.core.gravity_field import make_body
+    from spinorbit.coupling.one_way import _Snapshot
+    from spinorbit.coupling.rebound_adapter import _P_NG_BODY
+    from spinorbit.coupling.rigid_body import CoupledRigidBody
+
+    plain, with_body = _three_bodies("bs"), _three_bodies("bs")
+    with_body.particles["Body"].m = 1e-18
+    plain.particles["Body"].m = 1e-18
+    CoupledRigidBody(with_body, "Body", make_body((4e-35, 5e-35, 6e-35), mass=1e-18), [1, 0, 0, 0, 0, 0, 1.0],
+                     coupled=False)
+    copies = [_Snapshot.of(sim).build() for sim in (plain, with_body)]
+    for copy in copies:
+        copy.integrate(30.0)
+    assert copies[0].particles["Body"].xyz == copies[1].particles["Body"].xyz
+    assert copies[1]._afp.parameters[_P_NG_BODY] == body_index(with_body, "Body")  # the A1-A3 term is on
+
+    foreign = rebound.Simulation()
+    foreign.add(m=1.0, name="Sun")
+    foreign.additional_forces = lambda simulation: None
+    with pytest.raises(ForceInstallError, match="did not install"):
+        _Snapshot.of(foreign)

@@ -46,7 +46,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-import rebound
 from astropy import units as u
 from astropy.table import QTable
 from astropy.time import Time
@@ -59,7 +58,13 @@ from ..ephemeris import DE421_SPAN_JD_TDB, EphemerisRangeError, _resolve_body, b
 from ..state import RotationState
 from ..state_table import from_principal, table_columns
 from ..time import J2000_JD_TDB, tdb_days, time_from_tdb_days
-from .rebound_adapter import ExtraForces, body_index, reinstall_extra_forces
+from .rebound_adapter import (
+    ExtraForces,
+    body_index,
+    extra_forces_in_effect,
+    reinstall_extra_forces,
+    simulation_from_binary,
+)
 
 __all__ = [
     "DEFAULT_PERTURBERS",
@@ -422,36 +427,32 @@ def rebound_orbit(sim, body):
 
 @dataclass
 class _Snapshot:
-    """Everything needed to rebuild a REBOUND simulation at one instant (each pass re-runs it)."""
+    """Everything needed to rebuild a REBOUND simulation at one instant (each pass re-runs it).
 
-    t: float
-    G: float
-    integrator: str
+    REBOUND's own binary of the simulation, so that a copy has *all* of its settings, not a list of
+    them that falls behind: particles, ``t``, ``G``, units, ``dt``, ``N_active``, softening, the
+    integrator and its settings (BS ``eps_abs``, ``eps_rel``, ``min_dt``, ``max_dt``; IAS15
+    ``epsilon``, ``min_dt``, ``adaptive_mode``) and its running state (the BS controller's flags,
+    IAS15's predictor), so that a copy integrates bit for bit like the original
+    (``tests/test_rebound_adapter.py``). REBOUND does not store names reliably nor function pointers:
+    the names are kept beside the binary, and the extra forces in effect (also those folded into an
+    attached rigid body's force) are reinstalled on each copy. The rigid body itself (its user ODE and
+    back-reaction) is not copied: copies are the orbits under point-mass gravity and the extra forces.
+    """
+
+    binary: bytes
     names: tuple
-    masses: np.ndarray
-    xyz: np.ndarray
-    vxvyvz: np.ndarray
     extra_forces: ExtraForces | None
 
     @classmethod
     def of(cls, sim):
-        n = sim.N
-        xyz, vel, mass = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n)
-        sim.serialize_particle_data(xyz=xyz, vxvyvz=vel, m=mass)
-        handle = getattr(sim, "_afp", None)
-        name = sim.integrator.name
-        name = name.decode() if isinstance(name, bytes) else str(name)  # REBOUND 5 gives bytes
-        return cls(sim.t, sim.G, name, tuple(p.name for p in sim.particles), mass, xyz, vel,
-                   handle if isinstance(handle, ExtraForces) else None)
+        """The snapshot of ``sim`` now (ForceInstallError for forces spinorbit cannot carry over)."""
+        extra = extra_forces_in_effect(sim)
+        return cls(sim.__reduce__()[1][0], tuple(p.name for p in sim.particles), extra)
 
     def build(self):
-        sim = rebound.Simulation()
-        sim.units = ("AU", "day", "Msun")
-        sim.G = self.G
-        sim.integrator = self.integrator
-        sim.t = self.t
-        for name, m, r, v in zip(self.names, self.masses, self.xyz, self.vxvyvz):
-            sim.add(m=m, x=r[0], y=r[1], z=r[2], vx=v[0], vy=v[1], vz=v[2], name=name)
+        """A new simulation at the snapshot, with ``exact_finish_time = 1`` (samples hit their times)."""
+        sim = simulation_from_binary(self.binary, self.names)
         sim.exact_finish_time = 1
         if self.extra_forces is not None:
             # The raw force pointer does not survive a copy; reinstall the same forces (same
@@ -464,10 +465,13 @@ def sample_from_rebound(sim, body, start, end, perturbers=DEFAULT_PERTURBERS,
                         tolerance=DEFAULT_SAMPLE_TOLERANCE):
     """Sample perturbers relative to ``body`` from a REBOUND simulation (IAS15, exact_finish_time).
 
-    The simulation is not modified: its state is copied, and every pass rebuilds it from the copy,
-    integrates it to ``start`` (backwards if ``sim.t`` is later) and then forwards through the
-    sorted sample times with ``exact_finish_time = 1``. Extra forces installed by
-    :func:`~spinorbit.coupling.rebound_adapter.install_extra_forces` are reinstalled on each copy.
+    The simulation is not modified: its state is copied (REBOUND's binary: integrator and its
+    settings included), and every pass rebuilds it from the copy, integrates it to ``start``
+    (backwards if ``sim.t`` is later) and then forwards through the sorted sample times with
+    ``exact_finish_time = 1``. Extra forces installed by
+    :func:`~spinorbit.coupling.rebound_adapter.install_extra_forces` (also when folded into an
+    attached rigid body's force) are reinstalled on each copy; other forces are refused
+    (``ForceInstallError``), since a copy would run without them.
 
     Parameters
     ----------
@@ -490,6 +494,8 @@ def sample_from_rebound(sim, body, start, end, perturbers=DEFAULT_PERTURBERS,
     ------
     spinorbit.coupling.rebound_adapter.MissingBodyError
         ``body`` or a perturber is not in the simulation.
+    spinorbit.coupling.rebound_adapter.ForceInstallError
+        ``sim`` has forces spinorbit did not install (they would be missing from the copies).
     SamplingError
     """
     if not perturbers:

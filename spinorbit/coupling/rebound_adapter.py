@@ -49,6 +49,7 @@ __all__ = [
     "install_extra_forces",
     "set_nongravitational",
     "reinstall_extra_forces",
+    "extra_forces_in_effect",
     "body_index",
     "perturber_positions",
     "RotationCallbackError",
@@ -325,6 +326,24 @@ class ExtraForces:
     _function_pointer: object = None
     _cfunc: object = None
 
+    @classmethod
+    def from_parameters(cls, parameters) -> ExtraForces:
+        """A description (not installed) of the forces a parameter block switches on; the block is copied.
+
+        What :func:`reinstall_extra_forces` needs to put the same forces on another simulation, e.g.
+        the block stored in a checkpoint (``CoupledRigidBody.checkpoint``).
+
+        Raises
+        ------
+        ValueError
+            ``parameters`` is not a block of ``_N_PARAMETERS`` finite floats.
+        """
+        block = np.array(parameters, dtype=float)
+        if block.shape != (_N_PARAMETERS,) or not np.all(np.isfinite(block)):
+            raise ValueError(f"parameters: expected the {_N_PARAMETERS} finite floats of an install_extra_forces "
+                             f"block, got an array of shape {block.shape}.")
+        return cls(block, bool(block[_P_USE_J2]), bool(block[_P_USE_GR]))
+
 
 def _rebound_name(body: str) -> str:
     return body.strip().capitalize()
@@ -470,10 +489,11 @@ def install_extra_forces(sim, earth_j2: bool = True, gr: bool = True, earth_pole
 def reinstall_extra_forces(sim, handle: ExtraForces) -> ExtraForces:
     """Install on ``sim`` the same forces, with the same parameters, as ``handle`` (from another sim).
 
-    For rebuilt copies of a simulation (the raw pointer does not survive ``sim.copy()`` or a
-    Simulationarchive): ``sim`` must hold the same particles in the same order, since the parameter
-    block refers to particles by index (Earth for J2, the body and the Sun for the
-    non-gravitational terms).
+    For rebuilt copies of a simulation (the raw pointer does not survive ``sim.copy()``, REBOUND's
+    binary or a Simulationarchive): ``sim`` must hold the same particles in the same order, since
+    the parameter block refers to particles by index (Earth for J2, the body and the Sun for the
+    non-gravitational terms). ``handle`` may come from :func:`extra_forces_in_effect` or
+    :meth:`ExtraForces.from_parameters`.
     """
     copy = install_extra_forces(sim, earth_j2=handle.earth_j2, gr=handle.gr,
                                 earth_pole=handle.parameters[_P_POLE:_P_POLE + 3])
@@ -589,6 +609,7 @@ def perturber_positions(sim, body: str, perturbers=None):
 # Both call :func:`_figure_torque_and_reaction`, so torque and back-reaction come from the same
 # gravity-field kernel (``gravity_field.figure_force_function_and_gradient_xyz``).
 # --------------------------------------------------------------------------------------------
+from rebound.integrator import IntegratorConfiguration as _IntegratorConfiguration  # noqa: E402
 from rebound.ode import ODE as _ODE  # noqa: E402  (kept next to the code that reads its layout)
 
 from ..core.dynamics import body_frame_xyz, kinematics_and_euler_into  # noqa: E402
@@ -617,7 +638,11 @@ _R_PERTURBERS = _R_EXTRA + _N_PARAMETERS
 _R_DEGREES = _R_PERTURBERS + MAX_PERTURBERS  # highest field degree each perturber sees
 _R_MODEL = _R_DEGREES + MAX_PERTURBERS  # the figure array (gravity_field.make_body)
 _R_PSEUDO = _R_MODEL + FIGURE_SIZE  # IAS15 route only: index of the first pseudo-particle
-_R_SIZE = _R_PSEUDO + 1
+# Restore only (RotationHooks.resume_bs_controller): a pending flag, the value of BS's
+# first_or_last_step to write at the next step, the integrator state's address and the field's byte
+# offset in it (addresses as the bits of a uint64).
+_R_BS_PENDING, _R_BS_FLAG, _R_BS_STATE, _R_BS_FLAG_OFFSET = range(_R_PSEUDO + 1, _R_PSEUDO + 5)
+_R_SIZE = _R_PSEUDO + 5
 
 #: Error codes the cfuncs write into the parameter block (0: no error).
 ERROR_PARTICLE_COUNT = 1.0
@@ -746,6 +771,33 @@ def _coupled_forces_cfunc(simulation):
 
 
 _ODE_DERIVATIVES_TYPE = dict(_ODE._fields_)["_derivatives"]
+_ODE_PRE_TIMESTEP_TYPE = dict(_ODE._fields_)["_pre_timestep"]
+#: Word of the simulation struct holding the integrator's state pointer (``sim.integrator.state``).
+_SIM_INTEGRATOR_STATE_BYTE = rebound.Simulation.integrator.offset + _IntegratorConfiguration.state.offset
+assert _SIM_INTEGRATOR_STATE_BYTE % _WORD == 0, "sim.integrator.state is not on an 8-byte word"
+_SIM_INTEGRATOR_STATE_WORD = _SIM_INTEGRATOR_STATE_BYTE // _WORD
+
+
+@cfunc(types.void(types.CPointer(types.uint64), types.CPointer(types.float64)), cache=True)
+def _resume_bs_controller_cfunc(ode, y):
+    """User-ODE ``pre_timestep``: once after a restore, give BS back its ``first_or_last_step``.
+
+    rebound 5.2.2 sets ``first_or_last_step = 1`` whenever an ODE is created: the user ODE when the
+    body is attached, and the N-body part's internal ODE at the first step of a simulation rebuilt
+    from its binary (which does not hold that ODE). The binary's value is thereby lost, and the
+    restored run's first step, allowed to stop its extrapolation early, left the uninterrupted run by
+    ~1e-14 (measured, ``tests/test_checkpoint_runs.py``). ``pre_timestep`` runs inside the BS step,
+    after both resets and before the extrapolation, so the value written here is the one it uses.
+    """
+    ode_words = carray(ode, _ODE_WORDS)
+    p = carray(_as_float64_pointer(ode_words[_ODE_REF_WORD]), _R_SIZE)
+    if p[_R_BS_PENDING] != 0.0:
+        p[_R_BS_PENDING] = 0.0
+        words = carray(_as_uint64_pointer(ode_words[_ODE_SIM_WORD]), _SIM_INTEGRATOR_STATE_WORD + 1)
+        state = words[_SIM_INTEGRATOR_STATE_WORD]
+        if state == _float64_bits(p[_R_BS_STATE]):  # the same BS state as at the restore: write
+            flag = carray(_as_int32_pointer(state + _float64_bits(p[_R_BS_FLAG_OFFSET])), 1)
+            flag[0] = np.int32(p[_R_BS_FLAG])
 
 
 @dataclass
@@ -781,6 +833,17 @@ class RotationHooks:
         y[:] = np.asarray(value, dtype=float)
 
     @property
+    def extra_forces(self) -> ExtraForces | None:
+        """The extra-force block folded into the combined force (a copy), or None if none is on.
+
+        Whatever installed it (``earth_j2``/``gr`` when attaching, or :func:`install_extra_forces`
+        and :func:`set_nongravitational` before): this block, not the attach arguments, is what acts.
+        """
+        if self.parameters[_R_USE_EXTRA] == 0.0:
+            return None
+        return ExtraForces.from_parameters(self.parameters[_R_EXTRA:_R_EXTRA + _N_PARAMETERS])
+
+    @property
     def perturber_degrees(self) -> tuple:
         """Highest degree of the figure's field each perturber sees (in perturber order)."""
         count = int(self.parameters[_R_N_PERTURBERS])
@@ -790,6 +853,22 @@ class RotationHooks:
     def figure(self) -> np.ndarray:
         """The figure array (``gravity_field.make_body`` layout) in simulation units (view)."""
         return self.parameters[_R_MODEL:_R_MODEL + FIGURE_SIZE]
+
+    def resume_bs_controller(self, sim, first_or_last_step: int) -> None:
+        """Have the next BS step of ``sim`` start with ``first_or_last_step`` (a restore's value).
+
+        For a simulation rebuilt from REBOUND's binary: read ``sim.integrator.first_or_last_step``
+        before attaching (attaching resets it) and pass it here (``_resume_bs_controller_cfunc``).
+        """
+        if str(sim.integrator) != "bs":
+            raise ForceInstallError(f"resume_bs_controller needs the 'bs' integrator, got {sim.integrator!r}.")
+        offset = sim.integrator.callbacks.field_descriptor_list.field_descriptor_for_name("first_or_last_step").offset
+        # Kept with the state's address: if the integrator is replaced before the next step, the
+        # cfunc sees another state pointer and writes nothing (no write into freed memory).
+        words = np.array([sim.integrator.state, offset], dtype=np.uint64).view(np.float64)
+        self.parameters[_R_BS_STATE], self.parameters[_R_BS_FLAG_OFFSET] = words
+        self.parameters[_R_BS_FLAG] = int(first_or_last_step)
+        self.parameters[_R_BS_PENDING] = 1.0
 
     def raise_if_failed(self) -> None:
         """Raise :class:`RotationCallbackError` if a cfunc recorded an error during the last run."""
@@ -801,6 +880,52 @@ class RotationHooks:
                 f"rotation callback stopped the run at t = {when!r} (TDB days since J2000 for DE421 "
                 f"simulations): {ERROR_MESSAGES.get(code, f'unknown error code {code}')}."
             )
+
+
+def extra_forces_in_effect(sim) -> ExtraForces | None:
+    """The extra forces (EIH, Earth J2, non-gravitational) acting on ``sim``'s orbits now, as a copy.
+
+    From :func:`install_extra_forces` (and :func:`set_nongravitational`) directly, or folded into a
+    rigid body's combined force by :func:`attach_rotation_hooks`. For rebuilding ``sim`` elsewhere
+    (:func:`reinstall_extra_forces`): a copy or a checkpoint that took only the attach arguments
+    would lose the forces installed before the body.
+
+    Raises
+    ------
+    ForceInstallError
+        ``sim`` has forces spinorbit did not install (a Python ``additional_forces``, REBOUNDx, a
+        pre/post-timestep hook): they cannot be carried to a rebuilt simulation.
+    """
+    handle = getattr(sim, "_afp", None)
+    if isinstance(handle, ExtraForces):
+        return ExtraForces.from_parameters(handle.parameters)
+    if isinstance(handle, RotationHooks):
+        return handle.extra_forces
+    if handle is not None or sim._additional_forces or sim._pre_timestep_modifications \
+            or sim._post_timestep_modifications or sim.extras:
+        raise ForceInstallError(
+            "the simulation has forces or hooks spinorbit did not install (a Python additional_forces, "
+            "REBOUNDx or a timestep hook); a rebuilt copy would run without them. Use install_extra_forces "
+            "and set_nongravitational for the forces, or sample the orbit yourself (one_way.sample_states)."
+        )
+    return None
+
+
+def _check_folded_request(block, earth_j2, gr, earth_pole) -> None:
+    """Refuse ``earth_j2``/``gr``/``earth_pole`` asked of :func:`attach_rotation_hooks` that the block
+    installed earlier does not have: the fold uses that block as it is, and would silently ignore them."""
+    missing = [name for name, asked, on in (("earth_j2", earth_j2, block[_P_USE_J2]), ("gr", gr, block[_P_USE_GR]))
+               if asked and on == 0.0]
+    pole = np.asarray(earth_pole, dtype=float)
+    if earth_j2 and block[_P_USE_J2] != 0.0 and not np.array_equal(pole / np.linalg.norm(pole),
+                                                                    block[_P_POLE:_P_POLE + 3]):
+        missing.append(f"earth_pole={tuple(pole.tolist())} (installed: {tuple(block[_P_POLE:_P_POLE + 3].tolist())})")
+    if missing:
+        raise ForceInstallError(
+            f"install_extra_forces was called on this simulation before the body was attached, without "
+            f"{', '.join(missing)}; attaching folds in that block unchanged. Ask for these forces in "
+            "install_extra_forces instead (or leave earth_j2/gr off when attaching)."
+        )
 
 
 def attach_rotation_hooks(sim, body: str, perturbers, figure, state, coupled: bool = True,
@@ -881,6 +1006,7 @@ def attach_rotation_hooks(sim, body: str, perturbers, figure, state, coupled: bo
     parameters[_R_DEGREES:_R_DEGREES + len(indices)] = [min(d, n_max) for d in degrees]
     extra = None
     if isinstance(previous, ExtraForces):
+        _check_folded_request(previous.parameters, earth_j2, gr, earth_pole)
         # Fold the forces installed earlier into the combined cfunc: their whole block (it indexes
         # this simulation's particles), so that non-gravitational terms carry over with J2 and EIH.
         extra = previous
@@ -901,10 +1027,13 @@ def attach_rotation_hooks(sim, body: str, perturbers, figure, state, coupled: bo
     parameters[_R_ODE:_R_ODE + 1] = np.array([ctypes.addressof(ode)], dtype=np.uint64).view(np.float64)
     derivatives = _ODE_DERIVATIVES_TYPE(_rotation_derivatives_cfunc.address)
     forces = _ADDITIONAL_FORCES_TYPE(_coupled_forces_cfunc.address)
+    pre_timestep = _ODE_PRE_TIMESTEP_TYPE(_resume_bs_controller_cfunc.address)
     hooks = RotationHooks(parameters, ode, bool(coupled), extra,
-                          (derivatives, forces, _rotation_derivatives_cfunc, _coupled_forces_cfunc))
+                          (derivatives, forces, pre_timestep, _rotation_derivatives_cfunc, _coupled_forces_cfunc,
+                           _resume_bs_controller_cfunc))
     ode.ref = parameters.ctypes.data
     ode._derivatives = derivatives
+    ode._pre_timestep = pre_timestep  # does nothing unless resume_bs_controller was called
     sim._afp = hooks  # keep-alive in REBOUND's own slots (see install_extra_forces)
     sim._extras_ref = parameters
     sim.extras = parameters.ctypes.data

@@ -17,17 +17,25 @@ from ..core.dynamics import (
 )
 from ..core.gravity_field import figure_force_function_and_gradient
 from .rebound_adapter import (
+    ExtraForces,
     RotationHooks,
     attach_rotation_hooks,
     body_index,
     integrate_interruptibly,
+    reinstall_extra_forces,
     simulation_from_binary,
 )
 
-__all__ = ["CHECKPOINT_KIND", "SAVE_FORMAT_VERSION", "CoupledRigidBody", "RestoreError", "coupled_run"]
+__all__ = ["CHECKPOINT_KIND", "CONTENT_VERSION", "SAVE_FORMAT_VERSION", "CoupledRigidBody", "RestoreError",
+           "coupled_run"]
 
 #: Version of the file format written by :meth:`CoupledRigidBody.save` (:mod:`spinorbit.checkpoint`).
 SAVE_FORMAT_VERSION = CHECKPOINT_FORMAT_VERSION
+#: Version of what a body's checkpoint holds (``meta["content_version"]``). 2: the extra-force block
+#: in effect (array ``extra_forces``). Version 1 (no ``content_version``) held only the ``earth_j2``/
+#: ``gr`` arguments of the constructor and is refused: it cannot tell whether forces installed before
+#: the body was attached (non-gravitational terms, J2, EIH) were acting.
+CONTENT_VERSION = 2
 #: ``kind`` of the checkpoints written by :meth:`CoupledRigidBody.checkpoint`.
 CHECKPOINT_KIND = "coupled-rigid-body"
 
@@ -57,6 +65,8 @@ class CoupledRigidBody:
         (energy and total angular momentum conserved). False: one-way (orbits ignore the figure).
     earth_j2, gr : bool, optional
         EIH 1PN and Earth J2 on the orbits, in the same compiled force (see ``install_extra_forces``).
+        If ``install_extra_forces`` was called on ``sim`` before, its whole block (with any
+        non-gravitational terms) is folded in instead; asking here for a force it lacks raises.
     earth_pole : array_like, shape (3,), optional
         Earth's figure axis for J2 (inertial unit vector).
     perturber_degrees : sequence of int, optional
@@ -67,7 +77,8 @@ class CoupledRigidBody:
     spinorbit.coupling.rebound_adapter.MissingBodyError
         ``body`` or a perturber is not in the simulation.
     spinorbit.coupling.rebound_adapter.ForceInstallError
-        The integrator is not BS, or something else owns ``additional_forces``.
+        The integrator is not BS, something else owns ``additional_forces``, or ``earth_j2``/``gr``
+        asked for a force the block installed earlier does not have.
     """
 
     def __init__(self, sim, body, figure, state, perturbers=None, coupled=True, earth_j2=False, gr=False,
@@ -78,8 +89,6 @@ class CoupledRigidBody:
         self.sim = sim
         self.body = sim.particles[centre].name
         self.perturbers = tuple(perturbers)
-        self.earth_j2, self.gr = bool(earth_j2), bool(gr)
-        self.earth_pole = tuple(float(v) for v in earth_pole)
         self.hooks: RotationHooks = attach_rotation_hooks(
             sim, body, self.perturbers, figure, state, coupled=coupled, earth_j2=earth_j2, gr=gr,
             earth_pole=earth_pole, degrees=perturber_degrees,
@@ -91,6 +100,27 @@ class CoupledRigidBody:
     def coupled(self) -> bool:
         """True if the figure acts back on the orbits."""
         return self.hooks.coupled
+
+    @property
+    def extra_forces(self) -> ExtraForces | None:
+        """The extra forces acting on the orbits (a copy of their parameter block), or None.
+
+        Those asked for here or installed with ``install_extra_forces`` before attaching: the
+        forces in effect, which :meth:`checkpoint` stores.
+        """
+        return self.hooks.extra_forces
+
+    @property
+    def earth_j2(self) -> bool:
+        """True if Earth's J2 acts on the orbits (whoever installed it)."""
+        extra = self.extra_forces
+        return extra is not None and extra.earth_j2
+
+    @property
+    def gr(self) -> bool:
+        """True if the EIH 1PN accelerations act on the orbits (whoever installed them)."""
+        extra = self.extra_forces
+        return extra is not None and extra.gr
 
     @property
     def state(self) -> np.ndarray:
@@ -163,13 +193,18 @@ class CoupledRigidBody:
 
     # ---------------------------------------------------------------------------------------
     def checkpoint(self) -> Checkpoint:
-        """Orbits + rotation + coupling settings as one :class:`~spinorbit.checkpoint.Checkpoint`.
+        """Orbits + rotation + the forces in effect as one :class:`~spinorbit.checkpoint.Checkpoint`.
 
-        The REBOUND simulation in its binary form (``t``, particles, ``dt`` and the BS controller's
-        state: ``first_or_last_step``, ``previous_rejected``, ``target_iter``) and the rotation state
-        travel together, so they cannot get out of step. REBOUND's own binary does not hold user
-        ODEs; the rotation state is stored next to it and :meth:`from_checkpoint` re-attaches it.
+        The REBOUND simulation in its binary form (``t``, particles, ``dt``, the integrator's
+        settings and the BS controller's state: ``first_or_last_step``, ``previous_rejected``,
+        ``target_iter``) and the rotation state travel together, so they cannot get out of step.
+        REBOUND's binary holds neither user ODEs nor function pointers: the rotation state is stored
+        next to it, and so is the extra-force parameter block acting on the orbits (EIH, Earth J2,
+        non-gravitational terms), whether asked for in the constructor or installed before the body
+        was attached; :meth:`from_checkpoint` re-installs both (meta ``content_version`` =
+        :data:`CONTENT_VERSION`).
         """
+        extra = self.extra_forces
         return Checkpoint(
             kind=CHECKPOINT_KIND,
             arrays={
@@ -177,23 +212,46 @@ class CoupledRigidBody:
                 "rotation_state": self.state,
                 "figure": self.figure,
                 "perturber_degrees": np.array(self.perturber_degrees, dtype=np.int64),
-                "earth_pole": np.array(self.earth_pole),
+                # empty: no extra forces
+                "extra_forces": np.zeros(0) if extra is None else extra.parameters,
             },
-            meta={"body": self.body, "perturbers": list(self.perturbers), "coupled": self.coupled,
-                  "earth_j2": self.earth_j2, "gr": self.gr,
+            meta={"content_version": CONTENT_VERSION, "body": self.body, "perturbers": list(self.perturbers),
+                  "coupled": self.coupled,
                   # REBOUND's binary does not restore names reliably (simulation_from_binary)
                   "particle_names": [particle.name for particle in self.sim.particles]},
         )
 
     @classmethod
     def from_checkpoint(cls, checkpoint: Checkpoint) -> CoupledRigidBody:
-        """Rebuild the simulation and its attached body from :meth:`checkpoint`; continues bit-for-bit."""
+        """Rebuild the simulation and its attached body from :meth:`checkpoint`; continues bit-for-bit.
+
+        Raises
+        ------
+        RestoreError
+            A checkpoint of another content version (message says why and what to do).
+        """
         arrays, meta = checkpoint.arrays, checkpoint.meta
-        # The constructor below re-attaches the ODE and the forces (REBOUND does not store them).
+        version = meta.get("content_version", 1)
+        if version != CONTENT_VERSION:
+            why = ("it records only the earth_j2/gr arguments of the constructor, not the forces installed "
+                   "with install_extra_forces/set_nongravitational before the body was attached, so a resume "
+                   "could silently drop forces" if version == 1 else "this spinorbit does not know that layout")
+            raise RestoreError(
+                f"the coupled-body checkpoint has content version {version!r}, this spinorbit reads version "
+                f"{CONTENT_VERSION} ({why}). Start the run again with this spinorbit, or resume with the "
+                "version that wrote the checkpoint."
+            )
+        # REBOUND does not store function pointers or user ODEs: the extra forces in effect are
+        # re-installed first, then the constructor attaches the ODE and folds them in, as the
+        # uninterrupted run's combined force holds them (the same parameter block, bit for bit).
         sim = simulation_from_binary(arrays["simulation"].tobytes(), meta["particle_names"])
-        return cls(sim, meta["body"], arrays["figure"], arrays["rotation_state"], perturbers=meta["perturbers"],
-                   coupled=meta["coupled"], earth_j2=meta["earth_j2"], gr=meta["gr"],
-                   earth_pole=arrays["earth_pole"], perturber_degrees=[int(d) for d in arrays["perturber_degrees"]])
+        first_or_last_step = sim.integrator.first_or_last_step  # the binary's; attaching resets it
+        if arrays["extra_forces"].size:
+            reinstall_extra_forces(sim, ExtraForces.from_parameters(arrays["extra_forces"]))
+        body = cls(sim, meta["body"], arrays["figure"], arrays["rotation_state"], perturbers=meta["perturbers"],
+                   coupled=meta["coupled"], perturber_degrees=[int(d) for d in arrays["perturber_degrees"]])
+        body.hooks.resume_bs_controller(sim, first_or_last_step)
+        return body
 
     def save(self, path) -> None:
         """Write :meth:`checkpoint` to ``path`` atomically (temporary file, fsync, rename)."""
@@ -206,7 +264,8 @@ class CoupledRigidBody:
         Raises
         ------
         RestoreError
-            Missing, unreadable, truncated or corrupted file, or a checkpoint of another kind.
+            Missing, unreadable, truncated or corrupted file, a checkpoint of another kind, or one
+            of an older content version (:data:`CONTENT_VERSION`).
         """
         try:
             checkpoint = Checkpoint.read(path, kind=CHECKPOINT_KIND)

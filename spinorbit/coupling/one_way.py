@@ -4,7 +4,8 @@ The rotating body's translational motion and its perturbers' positions come from
 the planets, a user ephemeris or a REBOUND run for the body). They are sampled once, onto an
 adaptive time grid, into cubic-Hermite :func:`spinorbit.core.perturbers.sampled_source` s; the
 rotation is then integrated entirely in numba by
-:func:`spinorbit.core.integrate_quaternion.integrate_quaternion`. Neglecting the back-reaction is
+:func:`spinorbit.core.integrate_quaternion.integrate_quaternion` (or the Taylor method,
+:func:`spinorbit.core.integrate_taylor.integrate_taylor`, or the canonical elements). Neglecting the back-reaction is
 exact to the ratio of the rotational to the orbital angular momentum of the body (≈ 1e-13 for a
 300 m asteroid at 1 au), far below everything else here.
 

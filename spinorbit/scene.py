@@ -97,8 +97,10 @@ TAYLOR_TOL_PER_ERROR = 0.3 / 60.0
 #: alone at their first tolerances, Taylor/DOP853 CPU 0.75-0.97 up to 0.4, 1.15 at 0.96, 1.7-2.1 at
 #: 2.5-3.2, 5.1-12.9 at 7.5-90, the Taylor error ≥ 37× smaller throughout; whole Scene.run 0.53-0.60
 #: up to 0.96 (DOP853's a posteriori check asked for its retry at rtol/100 there, the Taylor run's did
-#: not), 0.71 at 2.5, 1.07-1.18 at 3.2-7.5, 3.2 at 90. 1.0 is where the integrators alone break even:
-#: conservative where DOP853 would retry, ≤ 1.15× lost where it would not.
+#: not), 0.71 at 2.5, 1.07-1.18 at 3.2-7.5, 3.2 at 90 (and 0.88 at 44, the DE421 Moon, whose sampling
+#: dominates the run: noise, the row 'DOP853 instead of Taylor' of the same run gave 1.54 the other way).
+#: 1.0 is where the integrators alone break even: conservative where DOP853 would retry, ≤ 1.15× lost
+#: where it would not.
 TAYLOR_KNOT_SHARE = 1.0
 #: The rotation steps are counted by a Taylor run of the free motion over at most this many rotations
 #: (2π/|ω|), scaled to the span: a few hundred steps, ~0.1 ms.

@@ -7,6 +7,13 @@ included), best of ``--repeat`` in the same process, and the attitude difference
 (the error the skip made) next to the tolerance and the planned run's error estimate. Timings on a
 shared machine are noisy: the ratio of the two runs in the same process is what to read.
 
+Two rows compare integrators rather than skips: 'Taylor instead of DOP853' and 'DOP853 instead of
+Taylor' time ``scene.plan()`` + ``scene.run(plan)`` against the same for the same scene forced to the
+other integrator, so only the integrator (and the planner's Taylor probe) differs. A second table, 'Taylor against DOP853 by knots', times
+the two integrators alone (``time.process_time``, alternated, best of ``--repeat``) on every one-way
+scene's model at tol = rtol = 1e-10 with the counts the planner's rule uses (``Scene._integrator_choice``:
+rotation steps of the free motion, knots inside the span).
+
 Usage::
 
     python benchmarks/bench_scene_skips.py            # writes the 'scene_skips' section of docs/performance.md
@@ -15,6 +22,7 @@ Usage::
 
 from __future__ import annotations
 
+import copy as _copy
 import math
 import sys
 import time
@@ -33,7 +41,7 @@ from _report import machine_line, repeat_main
 from spinorbit import RigidBody, RotationState, asteroids
 from spinorbit.coupling.rebound_adapter import body_index, simulation_from_de421
 from spinorbit.ephemeris import de421_constants, moon_orientation
-from spinorbit.scene import Orbit, Scene, _angles
+from spinorbit.scene import EphemerisPerturber, Orbit, Scene, _angles
 from spinorbit.time import tdb_days
 
 EPOCH = Time("2020-01-01", scale="tdb")
@@ -102,6 +110,10 @@ def scenes():
     drop = Scene(sam_state(), EPOCH, dense, perturbers=planets, orbit=Orbit.circular(2.5 * u.au),
                  tolerance=1 * u.arcsec)
     out.append(("drop perturbers", "same body, Sun + 5 planets, 20 d, 200 outputs", drop, drop))
+    out.append(("Taylor instead of DOP853", "the same scene, planned (Taylor) against planned with "
+                "integrator='quaternion'", drop, Scene(sam_state(), EPOCH, dense, perturbers=planets,
+                                                       orbit=Orbit.circular(2.5 * u.au), tolerance=1 * u.arcsec,
+                                                       integrator="quaternion")))
     end = Scene(sam_state(), EPOCH, dense[-1], perturbers=("sun",), orbit=Orbit.circular(2.5 * u.au),
                 tolerance=1 * u.arcsec)
     end_full = Scene(sam_state(), EPOCH, dense, perturbers=("sun",), orbit=Orbit.circular(2.5 * u.au),
@@ -113,6 +125,11 @@ def scenes():
                   orbit=Orbit.rebound(simulation_from_de421(EPOCH), "Moon"), tolerance=1 * u.arcsec)
     out.append(("DE421 instead of N-body", "the Moon (degree 2), Earth + Sun, 10 d, given as a REBOUND particle",
                 known, known))
+    out.append(("DOP853 instead of Taylor", "the same Moon scene (224 samples in 10 d), planned (DOP853) against "
+                "planned with integrator='taylor'", known,
+                Scene(moon, EPOCH, EPOCH + np.linspace(0.5, 10.0, 20) * u.day, perturbers=("earth", "sun"),
+                      orbit=Orbit.rebound(simulation_from_de421(EPOCH), "Moon"), tolerance=1 * u.arcsec,
+                      integrator="taylor")))
     start = asteroids.APOPHIS_2029.time_tdb - 1 * u.day
     flyby = Scene(asteroids.apophis_rotation_state(), start, start + np.linspace(0.02, 2.0, 100) * u.day,
                   perturbers=("sun", "earth", "moon", "venus", "mars", "jupiter"),
@@ -152,14 +169,107 @@ def interleaved_best_of(repeat, first, second):
     return (best[0], values[0]), (best[1], values[1])
 
 
+#: Periods (d) of the moonlet sweep of the 'by knots' table: its relative circle sets the sample
+#: spacing (∝ period), so the knots per rotation step run from ≈ 0.1 to ≈ 3.
+MOONLET_PERIODS = (300.0, 100.0, 40.0, 15.0, 5.0)
+
+
+def moonlet_scene(period_days):
+    """The SAM body on the 2.5 au circle with the Sun and a 'moonlet' on a 0.01 au circle about it (a
+    relative EphemerisPerturber, G·M 1e-12 au³/day²: its torque ≈ 1/20 of the Sun's, so it is kept) of
+    the given period, 20 d, 200 outputs, 1 arcsec."""
+    radius, rate = 0.01, 2 * math.pi / period_days
+
+    def circle(days):
+        days = np.atleast_1d(np.asarray(days, dtype=float))
+        c, s, zero = np.cos(rate * days), np.sin(rate * days), np.zeros(days.shape)
+        return radius * np.stack([c, zero, s], axis=1), radius * rate * np.stack([-s, zero, c], axis=1)
+
+    moonlet = EphemerisPerturber("moonlet", 1e-12 * u.au**3 / u.day**2, circle, relative=True)
+    return Scene(sam_state(), EPOCH, EPOCH + np.linspace(0.1, 20.0, 200) * u.day, perturbers=("sun", moonlet),
+                 orbit=Orbit.circular(2.5 * u.au), tolerance=1 * u.arcsec)
+
+
+#: Rows whose peer is the same scene planned too (skip=True) with the other integrator forced.
+INTEGRATOR_ROWS = ("Taylor instead of DOP853", "DOP853 instead of Taylor")
+
+
+def knot_rows(scene_rows, repeat):
+    """Taylor against DOP853 on each one-way scene's model, each at the first tolerance the planner would
+    give it, with the rule's counts (``Scene._taylor_steps``) and the true ones."""
+    from spinorbit.core.dynamics import make_model
+    from spinorbit.core.integrate_quaternion import integrate_quaternion
+    from spinorbit.core.integrate_taylor import integrate_taylor
+    from spinorbit.coupling.one_way import _to_core
+    from spinorbit.scene import _first_tolerance
+
+    rows, seen = [], set()
+    sweep = [(f"moonlet, period {period:g} d", None, moonlet_scene(period), None) for period in MOONLET_PERIODS]
+    for skip, _, scene, _ in [*scene_rows, *sweep]:
+        if skip in INTEGRATOR_ROWS or skip == "end only":  # the same models as other rows
+            continue
+        plan = scene.plan()
+        if plan.route != "one-way" or id(scene) in seen:
+            continue
+        seen.add(id(scene))
+        named = [n for n in plan.kept if n in scene.named]
+        moving = [p.name for p in scene.moving if p.name in plan.kept]
+        groups = ([scene._sampler(plan.orbit_source, named, scene.sample_tolerance)] if named else []) + (
+            [scene._sampler("user", moving, scene.sample_tolerance)] if moving else [])
+        model = make_model(scene.state.body.principal_moments, [s for g in groups for s in g.sources()])
+        y0, t0, t_out = _to_core(scene.state), scene.epoch_day, scene.output_days
+        share = plan.integration_share_rad
+        tol, rtol = _first_tolerance("taylor", share), _first_tolerance("quaternion", share)
+        steps, estimate, _ = scene._taylor_steps(plan.orbit_source, plan.kept, True, tol)
+        days = np.unique(np.concatenate([g.days for g in groups]))
+        knots = int(np.count_nonzero((days > t0) & (days < t_out[-1])))
+        reference = integrate_quaternion(y0, t0, t_out, model, rtol=1e-14)
+        yt, taylor_stats = integrate_taylor(y0, t0, t_out, model, tol=tol, return_stats=True)
+        yd, dop_stats = integrate_quaternion(y0, t0, t_out, model, rtol=rtol, return_stats=True)
+        # The whole scene forced to each integrator (planned, skip=True): the run pair, the a posteriori
+        # check and its retries included, which is what the planner's choice decides.
+        forced = []
+        for name in ("taylor", "quaternion"):
+            copy = _copy.copy(scene)
+            copy.integrator = name
+            forced.append((copy, copy.plan()))
+        (scene_taylor, taylor_result), (scene_dop, dop_result) = interleaved_best_of(
+            repeat, *(lambda s=s, p=p: s.run(p) for s, p in forced))
+        best = [math.inf, math.inf]
+        for _ in range(max(repeat, 5)):
+            for i, run in enumerate((lambda: integrate_taylor(y0, t0, t_out, model, tol=tol),
+                                     lambda: integrate_quaternion(y0, t0, t_out, model, rtol=rtol))):
+                clock = time.process_time()
+                run()
+                best[i] = min(best[i], time.process_time() - clock)
+        rows.append({"skip": skip, "kept": ", ".join(plan.kept), "knots": knots, "estimate": estimate,
+                     "rotation": steps, "tol": tol, "rtol": rtol, "taylor_steps": taylor_stats["steps"],
+                     "dop_steps": dop_stats["accepted"] + dop_stats["rejected"], "taylor": best[0], "dop": best[1],
+                     "taylor_error": float(np.max(_angles(reference[:, :4], yt[:, :4]))),
+                     "dop_error": float(np.max(_angles(reference[:, :4], yd[:, :4]))), "choice": plan.integrator,
+                     "scene_taylor": scene_taylor, "scene_dop": scene_dop, "final_tol": taylor_result.stats["rtol"],
+                     "final_rtol": dop_result.stats["rtol"]})
+        r = rows[-1]
+        print(f"{skip[:26]:26s} knots {knots:5d} (est. {estimate:6.0f}) rotation {steps:6.0f} est. ratio "
+              f"{estimate / steps:6.3g}  Taylor tol {tol:.1e} {r['taylor_steps']:5d} steps {best[0] * 1e3:6.3f} ms "
+              f"err {r['taylor_error']:.1e}  DOP853 rtol {rtol:.1e} {r['dop_steps']:5d} steps {best[1] * 1e3:6.3f} ms "
+              f"err {r['dop_error']:.1e}  Taylor/DOP853 {best[0] / best[1]:5.2f}  scene {scene_taylor * 1e3:6.2f} / "
+              f"{scene_dop * 1e3:6.2f} ms = {scene_taylor / scene_dop:5.2f} (final tol {r['final_tol']:.1e}, rtol "
+              f"{r['final_rtol']:.1e})  (plan: {plan.integrator})", flush=True)
+    return rows
+
+
 def measure(repeat):
     rows = []
-    for skip, description, planned_scene, full_scene in scenes():
-        full_plan = full_scene.plan(skip=False)
+    all_scenes = scenes()
+    for skip, description, planned_scene, full_scene in all_scenes:
+        same_plan = skip in INTEGRATOR_ROWS  # the peer is planned too: time its plan() as well
+        full_plan = full_scene.plan(skip=same_plan)
         full_scene.run(full_plan)  # warm-up: numba compilation, DE421 pages
         planned_scene.run(planned_scene.plan())
         (full_time, full), (planned_time, planned) = interleaved_best_of(
-            repeat, lambda s=full_scene, p=full_plan: s.run(p), lambda s=planned_scene: s.run(s.plan()))
+            repeat, (lambda s=full_scene: s.run(s.plan())) if same_plan else (lambda s=full_scene, p=full_plan: s.run(p)),
+            lambda s=planned_scene: s.run(s.plan()))
         n = len(planned.table)
         error = float(np.max(_angles(planned.table["quaternion"], full.table["quaternion"][-n:])))
         rows.append({"skip": skip, "description": description, "full": full_time, "planned": planned_time,
@@ -170,25 +280,54 @@ def measure(repeat):
         print(f"{skip:26s} full {full_time * 1e3:8.1f} ms  planned {planned_time * 1e3:8.1f} ms  "
               f"x{full_time / planned_time:6.2f}  error {rows[-1]['error']:.2e} arcsec  "
               f"estimate {rows[-1]['estimate']:.2e}  ({planned.plan.route}, dropped {rows[-1]['dropped']})")
-    return rows
+        rows[-1].update(integrator=planned.plan.integrator, full_integrator=full_plan.integrator)
+    return {"skips": rows, "knots": knot_rows(all_scenes, repeat)}
 
 
-def markdown(rows, repeat):
+def markdown(results, repeat):
+    rows = results["skips"]
     lines = ["## What the scene planner's skips save (`benchmarks/bench_scene_skips.py`)", "",
              machine_line(), "",
              (f"Wall time of the full run (`Scene.run(scene.plan(skip=False))`, plan built beforehand) against the "
              f"planned run (`scene.plan()` + `scene.run(plan)`, the planner's survey and sensitivity probe included), "
              f"best of {repeat} in one process, the two runs alternated; error = largest attitude angle between the two runs' outputs "
              "(the planned run's times), next to the tolerance and the planned run's own error estimate. Both runs "
-             "include the a posteriori integration check (a second run at 10× rtol)."), "",
+             "include the a posteriori integration check (a second run at 10× rtol). In the rows 'Taylor instead of "
+             "DOP853' and 'DOP853 instead of Taylor' the 'full' run is the same scene with the other integrator "
+             "forced (`integrator=...`), planned (skip=True) and timed with its `plan()` like the planned one."), "",
              ("| skip | scene | full (ms) | planned (ms) | full / planned | error (arcsec) | estimate (arcsec) "
              "| tolerance (arcsec) | plan |"),
              "|---|---|---:|---:|---:|---:|---:|---:|---|"]
     for r in rows:
-        plan = f"{r['route']}, orbits {r['source']}, dropped {r['dropped']} (full: {r['full_route']})"
+        plan = (f"{r['route']}, orbits {r['source']}, dropped {r['dropped']}, {r['integrator']} (full: "
+                f"{r['full_route']}, {r['full_integrator']})")
         lines.append(f"| {r['skip']} | {r['description']} | {r['full'] * 1e3:.1f} | {r['planned'] * 1e3:.1f} | "
                      f"{r['full'] / r['planned']:.2f} | {r['error']:.2e} | {r['estimate']:.2e} | {r['tolerance']:g} "
                      f"| {plan} |")
+    lines += ["", "### Taylor against DOP853 by knots", "",
+              (f"The two integrators alone on each one-way scene's model (the kept perturbers' samples at the run's "
+               "sample tolerance), each at the first tolerance the planner gives it for the scene's integration "
+               "share (Taylor tol = share × 0.3/60, DOP853 rtol = share / 1000), CPU (`time.process_time`) best of "
+               f"{max(repeat, 5)}, the two alternated; error = largest attitude angle against DOP853 at rtol 1e-14. "
+               "Rotation steps and estimated knots: the planner's counts (`Scene._taylor_steps`: the Taylor method "
+               "on the free motion over ≤ 20 rotations, scaled; knots from the survey's a priori grid); knots: the "
+               "true sample times strictly inside the span (each ends a Taylor step). The planner takes Taylor while "
+               "estimated knots ≤ `spinorbit.scene.TAYLOR_KNOT_SHARE` × rotation steps. The moonlet rows: the SAM "
+               "body at 2.5 au with the Sun and a relative circle of 0.01 au (G·M 1e-12 au³/day²) of the given "
+               "period, 20 d, 200 outputs, 1 arcsec. Scene run: the whole `Scene.run` of the scene planned (skip=True) "
+               "with `integrator` forced to 'taylor' and to 'quaternion', alternated, best of --repeat: the run, its "
+               "a posteriori check at 10× the tolerance and any retry at 1/100 of it (final tol / rtol)."), "",
+              "| scene | kept | knots (estimated) | rotation steps | est. knots / rotation steps | Taylor tol | "
+              "Taylor steps | Taylor (ms) | Taylor error (rad) | DOP853 rtol | DOP853 steps | DOP853 (ms) "
+              "| DOP853 error (rad) | Taylor / DOP853 | scene run: Taylor / DOP853 (ms) | final tol / rtol | plan |",
+              "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|"]
+    for r in results["knots"]:
+        lines.append(f"| {r['skip']} | {r['kept']} | {r['knots']} ({r['estimate']:.0f}) | {r['rotation']:.0f} | "
+                     f"{r['estimate'] / r['rotation']:.3g} | {r['tol']:.1e} | {r['taylor_steps']} | "
+                     f"{r['taylor'] * 1e3:.3f} | {r['taylor_error']:.1e} | {r['rtol']:.1e} | {r['dop_steps']} | "
+                     f"{r['dop'] * 1e3:.3f} | {r['dop_error']:.1e} | {r['taylor'] / r['dop']:.2f} | "
+                     f"{r['scene_taylor'] / r['scene_dop']:.2f} ({r['scene_taylor'] * 1e3:.1f} / {r['scene_dop'] * 1e3:.1f}) | "
+                     f"{r['final_tol']:.0e} / {r['final_rtol']:.0e} | {r['choice']} |")
     return "\n".join(lines)
 
 

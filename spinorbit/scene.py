@@ -24,9 +24,12 @@ Decisions, cheapest first:
    figure's back-reaction (:class:`spinorbit.coupling.rigid_body.CoupledRigidBody`, ``coupled=True``).
    The Moon on DE421's orbits needs neither: DE421 integrated its orbit with the lunar figure.
 5. **Outputs only at the end → one output time**: the dense interpolant is formed for the last step alone, quantities computed once.
-6. **Integrator**: the quaternion DOP853 (non-singular everywhere), the fastest in every measured
-   work-precision scene (``docs/performance.md``). The canonical-element integrator is used only when
-   asked for and the state is away from its singular sets; otherwise the plan says why not.
+6. **Integrator**: the Taylor method (:mod:`spinorbit.core.integrate_taylor`, the fastest in the
+   work-precision scenes of ``docs/performance.md``) while the sampled perturbers' knots, each of
+   which ends a Taylor step, are at most as many as the steps the rotation needs; otherwise the
+   quaternion DOP853, which steps across them (:meth:`Scene._integrator_choice`). The
+   canonical-element integrator is used only when asked for and the state is away from its singular
+   sets; otherwise the plan says why not.
 
 Frames and units as in :mod:`spinorbit.coupling.one_way`: the state's attitude is relative to ICRF,
 times are astropy Times (TDB inside), distances au, GM au³/day².
@@ -48,6 +51,7 @@ from .core.errors import SpinorbitError
 from .planner import (
     ARCSEC_PER_RAD,
     DROP_SHARE,
+    RTOL_RANGE,
     SURVEY_TOLERANCE,
     Decision,
     PerturberEstimate,
@@ -81,6 +85,33 @@ COUPLED_EPS_RANGE = (1e-13, 1e-10)
 #: Largest relative difference allowed between the body's mass (RigidBody.mass) and its mass in the
 #: orbit model (G is known to 2e-5 and DE421's GMs come with their own rounding).
 MASS_MISMATCH = 1e-2
+#: Integrators a Scene accepts ("auto": the planner chooses between "taylor" and "quaternion").
+INTEGRATORS = ("auto", "quaternion", "elements", "taylor")
+#: First Taylor tol per unit of the integration share: the Taylor method's global error was 2-60 × tol
+#: in work-precision scene (a) (docs/performance.md), so share × 0.3 / 60 puts it where DOP853's first
+#: rtol (share / 1000, global ≈ 300 × rtol: planner.RTOL_PER_ERROR) puts DOP853's: at ≤ 0.3 × share.
+TAYLOR_TOL_PER_ERROR = 0.3 / 60.0
+#: The Taylor route is taken while the sampled perturbers' knots inside the span (each one ends a
+#: Taylor step: the Hermite interpolant is not smooth there) are at most this many times the steps the
+#: rotation itself needs. Measured (bench_scene_skips run of 2026-12-01, "Taylor against DOP853 by
+#: knots" in docs/performance.md; knots/rotation steps as the planner estimates them): the integrators
+#: alone at their first tolerances, Taylor/DOP853 CPU 0.75-0.97 up to 0.4, 1.15 at 0.96, 1.7-2.1 at
+#: 2.5-3.2, 5.1-12.9 at 7.5-90, the Taylor error ≥ 37× smaller throughout; whole Scene.run 0.53-0.60
+#: up to 0.96 (DOP853's a posteriori check asked for its retry at rtol/100 there, the Taylor run's did
+#: not), 0.71 at 2.5, 1.07-1.18 at 3.2-7.5, 3.2 at 90 (and 0.88 at 44, the DE421 Moon, whose sampling
+#: dominates the run: noise, the row 'DOP853 instead of Taylor' of the same run gave 1.54 the other way).
+#: 1.0 is where the integrators alone break even: conservative where DOP853 would retry, ≤ 1.15× lost
+#: where it would not.
+TAYLOR_KNOT_SHARE = 1.0
+#: The rotation steps are counted by a Taylor run of the free motion over at most this many rotations
+#: (2π/|ω|), scaled to the span: a few hundred steps, ~0.1 ms.
+TAYLOR_PROBE_ROTATIONS = 20.0
+#: Sample times of the run against the a priori grid (coupling.one_way._a_priori_grid) of the survey:
+#: the refinement passes added 1.41× for DE421's Earth and Sun seen from the Moon (224/159 samples in
+#: bench_scene_skips), 1.0-1.1× for a circular relative orbit, 1.9× on the Apophis flyby (1169/625).
+SAMPLE_REFINEMENT = 1.4
+#: Numbers of docs/performance.md (work_precision run of 2026-11-22), CPU at 1e-10 rad in scene (a).
+WORK_PRECISION_MS = {"Taylor": 2.86, "heyoka": 3.68, "DOP853": 11.45, "elements": 74.36}
 
 
 def _sharing_samples(method):
@@ -345,8 +376,10 @@ class Scene:
         Attitude tolerance (angle) of the whole run.
     quantities : sequence of str
         Among :data:`QUANTITIES`.
-    integrator : {"auto", "quaternion", "elements"}
-        "auto" lets the planner choose.
+    integrator : {"auto", "quaternion", "elements", "taylor"}
+        "auto" lets the planner choose between the Taylor method and the quaternion DOP853
+        (:meth:`_integrator_choice`: Taylor while the sampled perturbers' knots are few against the
+        rotation's own steps).
     sample_tolerance : float
         Relative interpolation error of the sampled perturbers in the run.
 
@@ -391,8 +424,8 @@ class Scene:
         if unknown or not quantities:
             raise SceneError(f"quantities expects some of {QUANTITIES}; got {tuple(quantities)!r}.")
         self.quantities = tuple(quantities)
-        if integrator not in ("auto", "quaternion", "elements"):
-            raise SceneError(f"integrator expects 'auto', 'quaternion' or 'elements'; got {integrator!r}.")
+        if integrator not in INTEGRATORS:
+            raise SceneError(f"integrator expects one of {INTEGRATORS}; got {integrator!r}.")
         self.integrator = integrator
         if not (isinstance(sample_tolerance, float) and 1e-14 <= sample_tolerance < 1e-2):
             raise SceneError(f"sample_tolerance expects a float in [1e-14, 1e-2); got {sample_tolerance!r}.")
@@ -646,12 +679,14 @@ class Scene:
                                       f"{COUPLED_EPS_RANGE[0]:g}…{COUPLED_EPS_RANGE[1]:g} since it controls the orbits too"))
             return Plan("coupled", "rebound", tuple(names), (), estimates, "rebound-bs", eps, self.end_only,
                         tolerance, kappa, 0.0, not skip, decisions, None, 0.0, bound)
-        integrator, reason = self._integrator_choice(skip)
         share = tolerance - used - back_reaction
-        rtol = initial_rtol(share)
-        decisions.append(Decision("integrator", f"{integrator} DOP853, rtol {rtol:.1e} (checked a posteriori "
-                                  f"against a run at {CHECK_RTOL_FACTOR:g}× rtol)", reason))
         kept = tuple(n for n in names if n not in dropped)
+        integrator, reason = self._integrator_choice(skip, source, kept, share)
+        rtol = _first_tolerance(integrator, share)
+        what, knob = ("Taylor (core.integrate_taylor)", "tol") if integrator == "taylor" else (
+            f"{integrator} DOP853", "rtol")
+        decisions.append(Decision("integrator", f"{what}, {knob} {rtol:.1e} (checked a posteriori "
+                                  f"against a run at {CHECK_RTOL_FACTOR:g}× {knob})", reason))
         return Plan("one-way", source, kept, tuple(dropped), estimates, integrator, rtol, self.end_only,
                     tolerance, kappa, used, not skip, decisions, samples, back_reaction, bound)
 
@@ -817,12 +852,86 @@ class Scene:
             f"'{self.orbit.name}') with the body and its perturbers as particles (e.g. from simulation_from_de421), "
             "or loosen the tolerance.")
 
-    def _integrator_choice(self, skip):
-        measured = ("quaternion DOP853 was the fastest spinorbit method at every measured precision "
-                    "(docs/performance.md, at 1e-10 rad: 13.7 ms vs elements 77.9 ms and SABA4 32.6 ms in scene (a)) "
-                    "and is non-singular everywhere")
-        if self.integrator != "elements":
-            return "quaternion", measured if skip else "skip=False (reference run): " + measured
+    def _integrator_choice(self, skip, source, kept, share):
+        """The one-way route's integrator and why: (name, reason).
+
+        "auto" takes the Taylor method (:func:`spinorbit.core.integrate_taylor.integrate_taylor`) when
+        the sampled perturbers' knots inside the span are at most :data:`TAYLOR_KNOT_SHARE` × the steps
+        the rotation needs, else the quaternion DOP853. The one-way model's figure is the principal
+        moments alone (degree-2 torques, ``propagate_one_way``), for which the Taylor recurrences exist
+        (they have no degree-3/4 terms). Why knots: a Taylor step ends at every sample time (the
+        Hermite interpolant is not smooth across it), so the Taylor run takes about rotation steps +
+        knots steps, while DOP853 steps across them (:meth:`_taylor_steps`: both counts, estimated).
+        The reference plan (``skip=False``) runs the quaternion DOP853, the integrator the other
+        routes are checked against, unless another one is asked for.
+        """
+        measured = ("at 1e-10 rad in work-precision scene (a) (docs/performance.md) the Taylor method took "
+                    f"{WORK_PRECISION_MS['Taylor']:g} ms, DOP853 {WORK_PRECISION_MS['DOP853']:g} ms, heyoka "
+                    f"{WORK_PRECISION_MS['heyoka']:g} ms and the elements {WORK_PRECISION_MS['elements']:g} ms, "
+                    "but a Taylor step ends at every sample time of a sampled perturber")
+        if self.integrator == "elements":
+            return self._elements_choice()
+        if self.integrator == "quaternion":
+            return "quaternion", "asked for (non-singular everywhere)"
+        if self.integrator == "auto" and not skip:
+            return "quaternion", ("skip=False (reference run): the quaternion DOP853, non-singular everywhere and the "
+                                  "integrator the planned routes are checked against")
+        tol = _first_tolerance("taylor", share)
+        steps, knots, probed = self._taylor_steps(source, kept, skip, tol)
+        counts = (f"the rotation needs ≈ {steps:.0f} Taylor steps (the free motion at tol {tol:.1e} over "
+                  f"{probed:.3g} d of the span's {self.span_days:.4g} d, scaled) and the sampled perturbers add "
+                  f"≈ {knots:.0f} knots")
+        if self.integrator == "taylor":
+            return "taylor", f"asked for; {counts}"
+        limit = TAYLOR_KNOT_SHARE * steps
+        rule = (f"(Taylor while knots ≤ {TAYLOR_KNOT_SHARE:g} × the rotation steps = {limit:.0f}: at their first "
+                "tolerances Taylor/DOP853 CPU was 0.75-1.15 up to 1 ×, 1.7-13 at 2.5-90 ×, bench_scene_skips in "
+                "docs/performance.md)")
+        if knots <= limit:
+            return "taylor", f"{counts} {rule}; {measured}, and here there are few"
+        return "quaternion", f"{counts} {rule}; {measured}, and here they dominate: the quaternion DOP853 steps across them"
+
+    def _taylor_steps(self, source, kept, skip, tol):
+        """(rotation steps, knots inside the span, probed days) for the Taylor rule.
+
+        Rotation steps: :func:`~spinorbit.core.integrate_taylor.integrate_taylor` on the free motion
+        over at most :data:`TAYLOR_PROBE_ROTATIONS` × 2π/|ω|, scaled to the span (the torques are weak
+        against the rotation, so they hardly change the steps: 268 free against 275 torqued in
+        bench_scene_skips' 'drop perturbers' scene at tol 1e-10). Knots: the sample times the run will
+        have strictly inside (epoch, last output): counted for samples the plan keeps for the run,
+        otherwise the a priori grid (:func:`spinorbit.coupling.one_way._a_priori_grid`) of the survey's
+        states at the run's sample tolerance × :data:`SAMPLE_REFINEMENT`. Perturbers sampled on
+        separate grids (DE421/REBOUND bodies and user ephemerides) add their counts.
+        """
+        from .core.dynamics import make_model
+        from .core.integrate_taylor import integrate_taylor
+        from .coupling.one_way import _a_priori_grid, _to_core
+
+        free = make_model(self.state.body.principal_moments)  # the figure the one-way run uses
+        y0 = _to_core(self.state)
+        spin = float(np.linalg.norm(y0[4:]))
+        probed = self.span_days if spin == 0.0 else min(self.span_days, TAYLOR_PROBE_ROTATIONS * 2 * math.pi / spin)
+        _, stats = integrate_taylor(y0, self.epoch_day, [self.epoch_day + probed], free, tol=tol, return_stats=True)
+        steps = stats["steps"] * self.span_days / probed
+        named = [n for n in kept if n in self.named]
+        moving = [p.name for p in self.moving if p.name in kept]
+        groups = []
+        if named:
+            exact = self._keeps_survey(source, skip)  # then the run samples are the survey's (plan.samples)
+            groups.append((self._sampler(source, named, self._survey_tolerance(exact)), exact))
+        if moving:
+            groups.append((self._sampler("user", moving, SURVEY_TOLERANCE), False))
+        knots = 0.0
+        t0, t1 = self.epoch_day, self.output_days[-1]
+        for samples, exact in groups:
+            days = samples.days if exact else _a_priori_grid(samples.days, samples.states, samples.days[0],
+                                                             samples.days[-1], self.sample_tolerance)
+            inside = float(np.count_nonzero((days > t0) & (days < t1)))
+            knots += inside if exact else SAMPLE_REFINEMENT * inside
+        return steps, knots, probed
+
+    def _elements_choice(self):
+        """The canonical elements when asked for and the state is away from their singular sets."""
         from .core import canonical as _canonical
         from .core.integrate_elements import MIN_SEPARATRIX_DISTANCE, MIN_SIN_J
 
@@ -929,8 +1038,10 @@ class Scene:
         if "omega" not in self.quantities:
             run.remove_column("omega")
         run.meta["rtol"] = rtol
-        stats = {k: run.meta[k] for k in ("accepted", "rejected", "rhs_calls")}
-        stats.update(rtol=rtol, samples=int(samples.days.size), passes=int(getattr(samples, "passes", 0)))
+        # DOP853 reports accepted/rejected/rhs_calls; Taylor steps (= accepted, 0 rejected), order, no RHS calls.
+        stats = {k: run.meta[k] for k in ("accepted", "rejected", "rhs_calls", "steps", "order") if k in run.meta}
+        stats.update(integrator=plan.integrator, rtol=rtol, samples=int(samples.days.size),
+                     passes=int(getattr(samples, "passes", 0)))
         return run, {"dropped": plan.dropped_bound_rad, "integration": integration, "sampling": sampling}, stats
 
     def _coupled(self, plan, report):
@@ -961,6 +1072,15 @@ class Scene:
 def _worst_attitude(estimate):
     """The worst-attitude bound of a PerturberEstimate (``bound_rad`` for one made without it)."""
     return estimate.bound_rad if estimate.worst_attitude_rad is None else estimate.worst_attitude_rad
+
+
+def _first_tolerance(integrator, share):
+    """First local tolerance for an integration error share (rad): DOP853's rtol from
+    :func:`spinorbit.planner.initial_rtol`, the Taylor tol from :data:`TAYLOR_TOL_PER_ERROR`, both
+    clipped to the planner's range (the retry loop of ``Scene._one_way`` goes down to 1e-13)."""
+    if integrator == "taylor":
+        return float(np.clip(share * TAYLOR_TOL_PER_ERROR, *RTOL_RANGE))
+    return initial_rtol(share)
 
 
 def _subset(samples, names):

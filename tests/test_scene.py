@@ -343,7 +343,8 @@ def test_error_estimate_covers_the_difference_to_a_tight_reference():
 
 
 def test_a_tolerance_out_of_reach_is_reported_not_hidden():
-    # 200 d at 1e-12 rad: even at rtol 1e-13 the integration estimate is ~1e-9 rad (measured 9.8e-10).
+    # 200 d at 1e-12 rad: even at tol 1e-13 the integration estimate is ~1e-10 rad (measured 9.6e-11 with
+    # the Taylor method the planner takes here; 7.6e-10 with the quaternion DOP853).
     result = Scene(sam_state(), EPOCH, EPOCH + 200 * u.day, perturbers=("sun",), orbit=Orbit.circular(2.5 * u.au),
                    tolerance=1e-12 * u.rad).run()
     assert result.stats["rtol"] == 1e-13
@@ -376,6 +377,7 @@ def test_plan_reads_like_explain():
     ({"tolerance": 1 * u.rad}, "between 1e-12 rad and 0.1 rad"),
     ({"quantities": ("attitude", "spin")}, "quantities"),
     ({"integrator": "rk4"}, "integrator"),
+    ({"integrator": "Taylor"}, "integrator expects one of"),
     ({"orbit": None}, "need the body's orbit"),
     ({"orbit": "de421"}, "Orbit.de421"),
     ({"perturbers": (3,)}, "body names"),
@@ -626,13 +628,14 @@ def test_bodies_on_their_own_orbits_and_bad_collections():
 MOONLET_RADIUS, MOONLET_RATE = 1e-3, 3.0
 
 
-def moonlet(gm, relative=True, centre=None):
-    """The moonlet as an EphemerisPerturber; barycentric (relative=False) about the ``centre`` orbit."""
+def moonlet(gm, relative=True, centre=None, rate=MOONLET_RATE):
+    """The moonlet as an EphemerisPerturber; barycentric (relative=False) about the ``centre`` orbit;
+    ``rate`` in rad/day."""
     def states(days):
         days = np.atleast_1d(np.asarray(days, dtype=float))
-        c, s, zero = np.cos(MOONLET_RATE * days), np.sin(MOONLET_RATE * days), np.zeros(days.shape)
+        c, s, zero = np.cos(rate * days), np.sin(rate * days), np.zeros(days.shape)
         r = MOONLET_RADIUS * np.stack([c, s, zero], axis=1)
-        v = MOONLET_RADIUS * MOONLET_RATE * np.stack([-s, c, zero], axis=1)
+        v = MOONLET_RADIUS * rate * np.stack([-s, c, zero], axis=1)
         if centre is not None:
             body_r, body_v = centre(days)
             r, v = r + body_r, v + body_v
@@ -694,3 +697,93 @@ def test_moving_perturber_bad_input():
     wrong = EphemerisPerturber("p", 1e-12 * u.au**3 / u.day**2, lambda d: (np.ones((3,)), np.ones((3,))), relative=True)
     with pytest.raises(SceneError, match=r"of shape \(\d+, 3\) each"):
         Scene(sam_state(), EPOCH, EPOCH + 1 * u.day, perturbers=(wrong,)).plan()
+
+
+# ------------------------------------------------------------------------------------------------
+# The Taylor route: chosen while the sampled perturbers' knots are few against the rotation's steps.
+
+
+def moonlet_scene(period_days, span=20.0, **kwargs):
+    """The SAM body at 2.5 au, the Sun and a kept moonlet (G·M 1e-16: bound ≈ 8 arcsec) of the given period."""
+    perturbers = ("sun", moonlet(1e-16, rate=2 * math.pi / period_days))
+    return Scene(sam_state(), EPOCH, EPOCH + np.linspace(2.0, span, 5) * u.day, perturbers=perturbers,
+                 orbit=Orbit.circular(2.5 * u.au), tolerance=1 * u.arcsec, **kwargs)
+
+
+def run_samples(scene):
+    """The kept perturbers' samples at the run's tolerance, as the one-way run builds them."""
+    return [scene._sampler("ephemeris", ["sun"], scene.sample_tolerance),
+            scene._sampler("user", ["moonlet"], scene.sample_tolerance)]
+
+
+@pytest.mark.parametrize("period, chosen", [(300.0, "taylor"), (2 * math.pi / MOONLET_RATE, "quaternion")])
+def test_auto_takes_taylor_while_the_knots_are_few_against_the_rotation_steps(period, chosen):
+    # Measured: rotation steps 334 estimated, 330 free over the whole span; knots estimated / true:
+    # 48 / 40 (300 d moonlet: Taylor, 344 steps torqued) and 6006 / 8582 (2.1 d: DOP853; Taylor would take
+    # 8583 steps). The bounds below leave a factor 2 for the estimate, 20 % for the probe's scaling.
+    from spinorbit.core.dynamics import make_model
+    from spinorbit.core.integrate_taylor import integrate_taylor
+    from spinorbit.coupling.one_way import _to_core
+    from spinorbit.scene import TAYLOR_KNOT_SHARE, _first_tolerance
+
+    scene = moonlet_scene(period)
+    plan = scene.plan()
+    assert "moonlet" in plan.kept and plan.integrator == chosen, str(plan)
+    reason = next(d.reason for d in plan.decisions if d.topic == "integrator")
+    assert "docs/performance.md" in reason and "2.86 ms" in reason and "11.45 ms" in reason
+    # The rule's two counts against the truth: the knots the run really has, the steps a Taylor run
+    # of the free motion over the whole span really takes.
+    tol = _first_tolerance("taylor", plan.integration_share_rad)
+    steps, knots, _ = scene._taylor_steps(plan.orbit_source, plan.kept, True, tol)
+    assert (knots <= TAYLOR_KNOT_SHARE * steps) == (chosen == "taylor")
+    samples = run_samples(scene)
+    t0, t1 = scene.epoch_day, scene.output_days[-1]
+    days = np.unique(np.concatenate([s.days for s in samples]))
+    true_knots = np.count_nonzero((days > t0) & (days < t1))
+    assert 0.5 * true_knots <= knots <= 2.0 * true_knots + 2
+    y0 = _to_core(scene.state)
+    _, free = integrate_taylor(y0, t0, [t1], make_model(scene.state.body.principal_moments), tol=tol, return_stats=True)
+    assert free["steps"] == pytest.approx(steps, rel=0.2)
+    # The premise: every knot ends a Taylor step.
+    model = make_model(scene.state.body.principal_moments, [src for s in samples for src in s.sources()])
+    _, torqued = integrate_taylor(y0, t0, scene.output_days, model, tol=tol, return_stats=True)
+    assert torqued["steps"] >= true_knots
+
+
+def test_taylor_route_stays_within_tolerance_of_the_reference_run():
+    scene = moonlet_scene(300.0)
+    plan = scene.plan()
+    assert plan.integrator == "taylor" and "tol" in str(plan)
+    result = scene.run(plan)
+    assert result.stats["integrator"] == "taylor" and result.table.meta["integrator"] == "taylor"
+    # Taylor steps are its accepted steps; it never rejects one and calls no right-hand side.
+    assert result.stats["accepted"] == result.stats["steps"] > 0 and result.stats["rejected"] == 0
+    assert "rhs_calls" not in result.stats
+    reference = scene.run(scene.plan(skip=False))  # quaternion DOP853, nothing skipped
+    assert reference.plan.integrator == "quaternion"
+    measured = worst_difference(result, reference)
+    assert measured <= scene.tolerance_rad
+    assert measured <= result.error_estimate.to_value(u.rad) + reference.error_estimate.to_value(u.rad)
+    assert result.tolerance_met
+
+
+def test_taylor_asked_for_runs_where_auto_would_not_and_agrees():
+    asked = moonlet_scene(2 * math.pi / MOONLET_RATE, span=6.0, integrator="taylor")
+    plan = asked.plan()
+    assert plan.integrator == "taylor" and "asked for" in str(plan)
+    auto = moonlet_scene(2 * math.pi / MOONLET_RATE, span=6.0)
+    assert auto.plan().integrator == "quaternion"
+    a, b = asked.run(plan), auto.run()
+    assert worst_difference(a, b) <= asked.tolerance_rad
+    assert worst_difference(a, b) <= a.error_estimate.to_value(u.rad) + b.error_estimate.to_value(u.rad)
+    quaternion = moonlet_scene(2 * math.pi / MOONLET_RATE, span=6.0, integrator="quaternion").plan()
+    assert quaternion.integrator == "quaternion" and "asked for" in str(quaternion)
+
+
+def test_one_way_taylor_bad_input_raises_in_words():
+    start = Time("2020-01-01", scale="tdb")
+    samples = _NoSamples(float(sum(tdb_days(start))), float(sum(tdb_days(start + 2 * u.day))))
+    with pytest.raises(ValueError, match="integrator: expected one of"):
+        propagate_one_way(sam_state(), start, start + 1 * u.day, samples, integrator="taylor4")
+    with pytest.raises(ValueError, match="tol: expected a tolerance > 0"):
+        propagate_one_way(sam_state(), start, start + 1 * u.day, samples, rtol=-1.0, integrator="taylor")

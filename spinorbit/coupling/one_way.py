@@ -4,7 +4,8 @@ The rotating body's translational motion and its perturbers' positions come from
 the planets, a user ephemeris or a REBOUND run for the body). They are sampled once, onto an
 adaptive time grid, into cubic-Hermite :func:`spinorbit.core.perturbers.sampled_source` s; the
 rotation is then integrated entirely in numba by
-:func:`spinorbit.core.integrate_quaternion.integrate_quaternion`. Neglecting the back-reaction is
+:func:`spinorbit.core.integrate_quaternion.integrate_quaternion` (or the Taylor method,
+:func:`spinorbit.core.integrate_taylor.integrate_taylor`, or the canonical elements). Neglecting the back-reaction is
 exact to the ratio of the rotational to the orbital angular momentum of the body (≈ 1e-13 for a
 300 m asteroid at 1 au), far below everything else here.
 
@@ -529,6 +530,8 @@ def sample_from_rebound(sim, body, start, end, perturbers=DEFAULT_PERTURBERS,
 
 #: Default relative tolerance of the rotation integrator (local error per DOP853 step).
 DEFAULT_RTOL = 1e-10
+#: Rotation integrators :func:`propagate_one_way` can run.
+INTEGRATORS = ("quaternion", "elements", "taylor")
 
 
 def _to_core(state):
@@ -555,14 +558,18 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
     samples : SampledPerturbers
         From :func:`sample_from_ephemeris` or :func:`sample_from_rebound`.
     rtol : float
-        Local relative tolerance of the DOP853 integrator.
+        Local tolerance of the integrator: DOP853's rtol ("quaternion", "elements") or the Taylor
+        method's ``tol`` ("taylor"; both are local errors per step, relative per component group).
     periods : bool
         Also compute the instantaneous (osculating, torque-free) P_ψ, P_φ, mode and E/E0 of every
         output state.
-    integrator : {"quaternion", "elements"}
-        :func:`~spinorbit.core.integrate_quaternion.integrate_quaternion` (default; non-singular) or
+    integrator : {"quaternion", "elements", "taylor"}
+        :func:`~spinorbit.core.integrate_quaternion.integrate_quaternion` (default; non-singular),
         :func:`~spinorbit.core.integrate_elements.integrate_elements` (canonical elements, paper
-        eq. 11; raises near the separatrix, spin about C and the reference pole).
+        eq. 11; raises near the separatrix, spin about C and the reference pole) or
+        :func:`~spinorbit.core.integrate_taylor.integrate_taylor` (adaptive Taylor method on the same
+        equations; it ends a step at every sample time, where the Hermite interpolant is not smooth,
+        so it pays at least one step per sample inside the span).
     extra_sources : sequence
         More :mod:`spinorbit.core.perturbers` sources (e.g. ``fixed_source``) added to the sampled ones.
 
@@ -572,7 +579,11 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
         Columns ``time`` (Time), ``quaternion`` (n, 4; scalar first, user body axes → ICRF),
         ``omega`` (n, 3; rad/day, user body axes), ``momentum_direction`` (n, 3; unit, ICRF); with
         ``periods``: ``mode``, ``energy_ratio`` (E/E0), ``P_psi``, ``P_phi`` (day).
-        ``table.meta`` holds the integrator statistics and the sampling error estimate.
+        ``table.meta`` holds the integrator statistics and the sampling error estimate: DOP853's
+        ``accepted``, ``rejected``, ``rhs_calls``; the Taylor method's ``steps``, ``order`` and
+        ``mean_orbit_order``, with ``accepted`` = ``steps`` and ``rejected`` = 0 (it chooses each step
+        after computing the series and never rejects one) and no ``rhs_calls`` (it evaluates no
+        right-hand side: the series come from the recurrences).
     """
     if not isinstance(state, RotationState):
         raise TypeError(f"state must be a spinorbit.RotationState, got {type(state).__name__}.")
@@ -586,8 +597,8 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
             f"the run spans TDB days [{min(t0, t_out.min()):.4f}, {max(t0, t_out.max()):.4f}] since J2000 but the "
             f"perturbers are sampled on [{lo:.4f}, {hi:.4f}]; sample a longer span."
         )
-    if integrator not in ("quaternion", "elements"):
-        raise ValueError(f"integrator: expected 'quaternion' or 'elements', got {integrator!r}.")
+    if integrator not in INTEGRATORS:
+        raise ValueError(f"integrator: expected one of {INTEGRATORS}, got {integrator!r}.")
     body = state.body
     model = make_model(body.principal_moments, [*samples.sources(), *extra_sources])
     if integrator == "elements":
@@ -595,6 +606,12 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
 
         ys, stats = integrate_elements(_to_core(state), t0, t_out, model, rtol=rtol, return_stats=True)
         stats.pop("frame")
+    elif integrator == "taylor":
+        from ..core.integrate_taylor import integrate_taylor
+
+        # The figure here is degree 2 (principal moments only), so integrate_taylor never falls back.
+        ys, stats = integrate_taylor(_to_core(state), t0, t_out, model, tol=rtol, return_stats=True)
+        stats.update(accepted=stats["steps"], rejected=0)
     else:
         ys, stats = integrate_quaternion(_to_core(state), t0, t_out, model, rtol=rtol, return_stats=True)
     table = QTable()

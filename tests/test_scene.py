@@ -704,8 +704,8 @@ def test_moving_perturber_bad_input():
 
 
 def moonlet_scene(period_days, span=20.0, **kwargs):
-    """The SAM body at 2.5 au, the Sun and a kept moonlet (G·M 1e-16: bound ≈ 8 arcsec) of the given period."""
-    perturbers = ("sun", moonlet(1e-16, rate=2 * math.pi / period_days))
+    """The SAM body at 2.5 au, the Sun and a kept moonlet (G·M 1e-14: its free-motion bound is ≈ 7 arcsec, above the drop share) of the given period."""
+    perturbers = ("sun", moonlet(1e-14, rate=2 * math.pi / period_days))
     return Scene(sam_state(), EPOCH, EPOCH + np.linspace(2.0, span, 5) * u.day, perturbers=perturbers,
                  orbit=Orbit.circular(2.5 * u.au), tolerance=1 * u.arcsec, **kwargs)
 

@@ -139,7 +139,7 @@ SWEEP_FACTOR = 10.0
 EXPECTED_FIRST_REASON = {"separatrix": "separatrix", "from +C": "spin about C", "from -C": "spin about C",
                          "from -A": "spin about A", "from +A": "spin about A", "spherical": "nearly spherical body",
                          # sin P = 5e-4 ... 2e-6 < RESUME_MARGIN × MIN_SIN_P: before the guard the elements
-                         # took these, 5.8e-9 rad off (1e-3) or stuck at steps of ~1e-13 (1e-6)
+                         # took these, 5.8e-9 rad off (1e-3) or stuck at steps of ~5e-12 (1e-6)
                          "from the B-C plane": "symmetric permanent rotation",
                          "from the A-B plane": "symmetric permanent rotation"}
 
@@ -208,9 +208,10 @@ def test_momentum_passing_the_reference_pole_is_handed_over_and_back():
 @pytest.mark.parametrize("body, momentum", [((0.5, 1.0, 1.0), [5e-7, 1.0, 0.0]), ((1.0, 1.0, 2.0), [0.6, -0.8, 2e-6])],
                          ids=["B = C", "A = B"])
 def test_symmetric_body_next_to_its_permanent_rotation_stops_the_elements(body, momentum):
-    """M 5e-7 (2e-6) rad from the equal-moment plane: before the guard (MIN_SIN_P) the run took steps
-    of ~1e-13 time units (75731 accepted, t = 3.8e-7 after 1e5 steps), i.e. ~1e8 steps (about an
-    hour) before the step cap; now it stops at t0 and names the set."""
+    """M 5e-7 (2e-6) rad from the equal-moment plane: before the guard (MIN_SIN_P) the sweep's state
+    took steps of 5e-12 time units on average (1e5 steps reached t = 3.8e-7 of 126; A = B: 9.6e-3 of
+    126), so the hand-over sat ~1 h in the elements until the step cap of 1e8; now they stop at t0 and
+    name the set."""
     y0 = np.r_[Q_GENERIC, np.array(momentum) / np.array(body)]
     with pytest.raises(ElementsSingularityError, match="MIN_SIN_P") as info:
         integrate_elements(y0, 0.0, [1.0], make_model(body, [fixed_source(1e-3, np.array([1.0, 0.3, 0.5]))]), rtol=RTOL)

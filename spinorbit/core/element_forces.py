@@ -143,19 +143,29 @@ def andoyer_gradient_from_torque(attitude, momentum, nx, ny, nz):
 
 @jit
 def singularity_distances(elements, attitude, momentum, ic):
-    """(1 − m or 1 − μ, sin J, sin I, sin J_A) of a state: how far it is from the elements' singular sets.
+    """(1 − m or 1 − μ, sin J, sin I, sin J_A, sin P) of a state: how far it is from the elements' singular sets.
 
     1 − m → 0 at the separatrix (and the mode changes across it); sin J → 0 at spin about ±C (the
     centre of the SAM elements); sin I → 0 when the angular momentum is along the reference z axis;
     sin J_A = |M × A axis| / G → 0 at spin about ±A (the centre of the LAM elements, S → Z, where
-    the Jacobian's 1/√(a − d) terms overflow). A permanent rotation returns a separatrix distance of 0.
+    the Jacobian's 1/√(a − d) terms overflow); sin P → 0 at the permanent rotations of an exactly
+    symmetric body (:func:`_distances`). A permanent rotation returns a separatrix distance of 0.
     """
     work, _ = working_elements(elements)
-    return _distances(motion_from_elements(work[0], work[1], ic), attitude, momentum)
+    return _distances(motion_from_elements(work[0], work[1], ic), attitude, momentum, ic)
 
 
 @jit
-def _distances(mo, attitude, momentum):
+def _distances(mo, attitude, momentum, ic):
+    """(1 − m or 1 − μ, sin J, sin I, sin J_A, sin P) of a motion, its body attitude and body momentum.
+
+    sin P is the sine of the angle of M from the equal-moment plane of an exactly symmetric body
+    (|M_x|/G for B = C, |M_z|/G for A = B; 1 for a triaxial body, which has no such set): there the
+    motion is next to a permanent rotation, its gap d − c = (a − c) sin² P (resp. a − d) is a
+    difference of nearly equal numbers, resolved by (S, Z) only to ≈ ε d, so the phase the elements
+    carry is wrong by ≈ ε / sin² P (``canonical.symmetric_gap_resolved`` refuses only below ≈ 4ε).
+    """
+    a_b, b_c = ic[3], ic[4]
     sep = 0.0 if mo[MO_MODE] == MODE_UNIFORM else mo[MO_PARAM_C]
     big_g = math.sqrt(momentum[0] ** 2 + momentum[1] ** 2 + momentum[2] ** 2)
     sin_j = math.hypot(momentum[0], momentum[1]) / big_g
@@ -163,7 +173,12 @@ def _distances(mo, attitude, momentum):
     m0 = attitude[0, 0] * momentum[0] + attitude[1, 0] * momentum[1] + attitude[2, 0] * momentum[2]
     m1 = attitude[0, 1] * momentum[0] + attitude[1, 1] * momentum[1] + attitude[2, 1] * momentum[2]
     sin_i = math.hypot(m0, m1) / big_g
-    return sep, sin_j, sin_i, sin_j_a
+    sin_p = 1.0
+    if b_c <= 0.0 < a_b:
+        sin_p = abs(momentum[0]) / big_g
+    elif a_b <= 0.0 < b_c:
+        sin_p = abs(momentum[2]) / big_g
+    return sep, sin_j, sin_i, sin_j_a, sin_p
 
 
 @jit
@@ -190,7 +205,7 @@ def elements_rhs_into(t, elements, model, frame, ic, dy):
 
     Returns
     -------
-    sep, sin_j, sin_i, sin_j_a : float
+    sep, sin_j, sin_i, sin_j_a, sin_p : float
         :func:`singularity_distances` of the state (computed from quantities the RHS has anyway).
     """
     # The motion and elliptic constants of (S, Z) once, for both the backward map and the Jacobian.
@@ -215,7 +230,7 @@ def elements_rhs_into(t, elements, model, frame, ic, dy):
     dy[3] = a * elements[0] - du[0]
     dy[4] = -du[1]
     dy[5] = -du[2]
-    return _distances(mo, attitude, momentum)
+    return _distances(mo, attitude, momentum, ic)
 
 
 @jit

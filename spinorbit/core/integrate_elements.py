@@ -33,7 +33,8 @@ Design choices
   hence the RHS of s and z, carry terms proportional to s and the steps shrink as the run goes on
   (2× more steps on 10³ turns of scene (c)). Element outputs are in the shifted representation.
 * **Singular sets are detected, not crossed**: at the end of each accepted step the RHS reports
-  1 − m (or 1 − μ), sin J, sin I and the sine of the angle of M from the A axis; below the
+  1 − m (or 1 − μ), sin J, sin I, the sine of the angle of M from the A axis and, for an exactly
+  symmetric body, the sine of its angle from the equal-moment plane (permanent rotations); below the
   ``MIN_*`` constants the run stops with :class:`ElementsSingularityError` naming the set and the
   time. Bodies too nearly spherical for the tolerance are refused up front
   (``MIN_ASPHERICITY_PER_RTOL``). The automatic hand-over to the
@@ -92,6 +93,15 @@ MIN_SIN_J = 1e-3
 MIN_SIN_J_A = 1e-3
 #: Stop near the reference z axis: dh/dt grows like 1/sin I (the node is undefined at I = 0).
 MIN_SIN_I = 1e-3
+#: Stop near a permanent rotation of an exactly symmetric body (M within angle P of the equal-moment
+#: plane: B = C, or A = B): the gap of the motion to it, (a − c) sin² P, is resolved by (S, Z) only to
+#: ≈ ε d, so the phase the elements carry is wrong by ≈ ε / sin² P, whatever rtol. Measured over 20
+#: turns under a weak torque (benchmarks/accuracy_symmetric_permanent.py, table in
+#: docs/elements_integrator.md): 5–30 ε / sin² P, i.e. 4.5e-11 (B = C) and 1.2e-11 rad (A = B) at
+#: sin P = 1e-2, no more than quaternion DOP853's own error at rtol 1e-12 (4.1e-11, 4.3e-10), but
+#: 4.2× it at 3e-3 and 108× at 1e-3 (B = C). A fixed value like the other thresholds (the kernel
+#: sees atol, not rtol); at rtol < 1e-12 the elements near it are less accurate than rtol asks.
+MIN_SIN_P = 1e-2
 #: Refuse bodies closer to a sphere than (C − A)/C < MIN_ASPHERICITY_PER_RTOL × rtol: S lies in
 #: [√(A/C) Z, Z], an interval of relative width ≈ (C − A)/(2C), and the step error test allows
 #: rtol·G in S; below this ratio S (hence the energy, the mode parameter and the period) is not
@@ -112,6 +122,7 @@ STATUS_SEPARATRIX = 10
 STATUS_SPIN_ABOUT_C = 11
 STATUS_REFERENCE_POLE = 12
 STATUS_SPIN_ABOUT_A = 13
+STATUS_SYMMETRIC_PERMANENT = 14
 
 
 @jit
@@ -158,9 +169,11 @@ def _dense_coefficients(t, y, y_new, f_new, h, model, frame, ic, k, coeffs):
 
 @jit
 def _singular_status(distances):
-    sep, sin_j, sin_i, sin_j_a = distances
+    sep, sin_j, sin_i, sin_j_a, sin_p = distances
     if not (sep >= MIN_SEPARATRIX_DISTANCE):
         return STATUS_SEPARATRIX
+    if not (sin_p >= MIN_SIN_P):
+        return STATUS_SYMMETRIC_PERMANENT
     if not (sin_j >= MIN_SIN_J):
         return STATUS_SPIN_ABOUT_C
     if not (sin_j_a >= MIN_SIN_J_A):
@@ -369,7 +382,7 @@ class ElementsSingularityError(SingularElementsError):
     """The run approached a singular set of the canonical elements and stopped there.
 
     Attributes ``t_stop`` (time of the last accepted step), ``kind`` ("separatrix", "spin about C",
-    "spin about A", "reference pole") and ``y_stop`` (the state (q, ω) at ``t_stop``, from the backward map of the elements
+    "spin about A", "symmetric permanent rotation", "reference pole") and ``y_stop`` (the state (q, ω) at ``t_stop``, from the backward map of the elements
     there); continue from there with :func:`integrate_quaternion`, or let
     :func:`spinorbit.core.integrate_handover.integrate_with_handover` do it.
     """
@@ -386,6 +399,9 @@ _SINGULAR = {
     STATUS_SPIN_ABOUT_C: ("spin about C", f"sin J fell below MIN_SIN_J = {MIN_SIN_J:g} (spin about ±C)"),
     STATUS_SPIN_ABOUT_A: ("spin about A", f"the angle of M from the A axis fell below MIN_SIN_J_A = {MIN_SIN_J_A:g} "
                           "(spin about ±A)"),
+    STATUS_SYMMETRIC_PERMANENT: ("symmetric permanent rotation", f"the angle of M from the equal-moment plane of "
+                                 f"the symmetric body fell below MIN_SIN_P = {MIN_SIN_P:g} (next to a permanent "
+                                 "rotation, whose gap the elements resolve only to ε)"),
     STATUS_REFERENCE_POLE: ("reference pole", f"sin I fell below MIN_SIN_I = {MIN_SIN_I:g} (angular momentum "
                             "along the reference z axis)"),
 }
@@ -505,7 +521,8 @@ def integrate_elements(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=DE
         y0 is a permanent rotation or on the separatrix, or the body is too nearly spherical for rtol
         (:func:`check_resolvable_body`).
     ElementsSingularityError
-        The run approached the separatrix, spin about C or A, or the reference pole (``t_stop``, ``kind``).
+        The run approached the separatrix, spin about C or A, a permanent rotation of a symmetric body, or the
+        reference pole (``t_stop``, ``kind``).
     IntegrationError
         Step cap, step underflow, non-finite state.
     """

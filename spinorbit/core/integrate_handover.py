@@ -2,7 +2,9 @@
 
 The elements (S, Z, H; s, z, h) are singular at the separatrix (1 − m → 0: the period and ∂m/∂d
 diverge, and the mode changes across it), at spin about ±C (sin J → 0) or ±A (the centres of the
-SAM and LAM elements) and with the angular momentum along the reference z axis (sin I → 0), and they
+SAM and LAM elements), next to the permanent rotations of an exactly symmetric body (M in its
+equal-moment plane, sin P → 0: the gap to them is resolved only to ε) and with the angular momentum
+along the reference z axis (sin I → 0), and they
 cannot resolve a body spherical to better than ~200 rtol; :func:`spinorbit.core.integrate_elements.integrate_elements`
 detects these and stops (its ``MIN_*`` constants). The non-singular quaternion equations
 (:mod:`spinorbit.core.dynamics`) have none of them. This driver runs the elements while they are
@@ -11,7 +13,7 @@ well defined and the quaternion DOP853 through the passage:
 1. elements until the kernel reports a singular set at the end of an accepted step (time t_s);
 2. the state (q, ω) at t_s from the backward map (eqs. 7–8) of the elements there; DOP853 on the
    quaternion equations from it, in probes of ``check_interval``;
-3. after each probe the distances (1 − m, sin J, sin I) of the state are measured, with the reference
+3. after each probe the distances (1 − m, sin J, sin I, sin J_A, sin P) of the state are measured, with the reference
    frame the elements would use (the "auto" rule of ``reference_frame_for``, so the reference pole is
    left by turning the frame, not by waiting); when every distance is ``RESUME_MARGIN`` times its stop
    threshold, the forward map (eq. 4) gives new elements and step 1 resumes.
@@ -41,6 +43,7 @@ from .integrate_elements import (
     MIN_SIN_I,
     MIN_SIN_J,
     MIN_SIN_J_A,
+    MIN_SIN_P,
     STATUS_SUCCESS,
     reference_frame_for,
     run_elements,
@@ -55,7 +58,7 @@ from .integrate_quaternion import (
 from .rotations import quat_to_attitude
 
 #: Resume the elements only when every singularity distance is this many times its stop threshold
-#: (hysteresis: 1 − m ≥ 1e-3, sin J ≥ 1e-2, sin I ≥ 1e-2 with the default thresholds).
+#: (hysteresis: 1 − m ≥ 1e-3, sin J ≥ 1e-2, sin I ≥ 1e-2, sin P ≥ 0.1 with the default thresholds).
 RESUME_MARGIN = 10.0
 #: Default probe length of a quaternion stretch, in turns of the body (2π/|ω| at the switch): short
 #: enough to hand back soon after the passage, long enough that the DOP853 restarts cost little.
@@ -69,7 +72,8 @@ class Switch(NamedTuple):
     """One hand-over: at time ``t`` the integrator ``to`` took over, because of ``reason``.
 
     ``reason`` is a singular set for a switch to the quaternion integrator ("separatrix", "spin
-    about C", "spin about A", "reference pole", "permanent rotation", or "nearly spherical body":
+    about C", "spin about A", "symmetric permanent rotation" (M next to the equal-moment plane of a
+    symmetric body), "reference pole", "permanent rotation", or "nearly spherical body":
     then for the whole run), "safely away" for a switch back.
     """
 
@@ -79,10 +83,11 @@ class Switch(NamedTuple):
 
 
 def singularity_distances_of_state(y, moments):
-    """(1 − m or 1 − μ, sin J, sin I, sin J_A) of a state (q, ω), sin I in the frame the elements would use.
+    """(1 − m or 1 − μ, sin J, sin I, sin J_A, sin P) of a state (q, ω), sin I in the frame the elements would use.
 
     As :func:`spinorbit.core.element_forces.singularity_distances`; sin J_A is the sine of the angle of
-    M from the A axis (spin about ±A, the centre of the LAM elements).
+    M from the A axis (spin about ±A, the centre of the LAM elements), sin P that of M from the
+    equal-moment plane of an exactly symmetric body (1 for a triaxial one).
 
     Parameters
     ----------
@@ -93,21 +98,23 @@ def singularity_distances_of_state(y, moments):
 
     Returns
     -------
-    tuple of 4 floats
+    tuple of 5 floats
         0 for the separatrix distance of a permanent rotation (no elements), as in the kernel.
     """
     ic = inertia_constants(*moments)
     momentum = np.asarray(moments) * y[4:]
     attitude = quat_to_attitude(np.ascontiguousarray(y[:4])) @ reference_frame_for(y, moments).T
     mo, _ = motion_from_momentum(momentum[0], momentum[1], momentum[2], ic)
-    return _distances(mo, np.ascontiguousarray(attitude), momentum)
+    return _distances(mo, np.ascontiguousarray(attitude), momentum, ic)
 
 
 def _singular_reason(distances, margin):
     """The first singular set closer than ``margin`` × its threshold, or None."""
-    sep, sin_j, sin_i, sin_j_a = distances
+    sep, sin_j, sin_i, sin_j_a, sin_p = distances
     if not sep >= margin * MIN_SEPARATRIX_DISTANCE:
         return "separatrix" if sep > 0.0 else "permanent rotation"
+    if not sin_p >= margin * MIN_SIN_P:
+        return "symmetric permanent rotation"
     if not sin_j >= margin * MIN_SIN_J:
         return "spin about C"
     if not sin_j_a >= margin * MIN_SIN_J_A:

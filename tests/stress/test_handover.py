@@ -137,7 +137,11 @@ def test_bad_driver_parameters_say_what_was_expected(kwargs, pattern):
 #: rtol on the separatrix cases below (and better than DOP853 elsewhere). 10× is the bound.
 SWEEP_FACTOR = 10.0
 EXPECTED_FIRST_REASON = {"separatrix": "separatrix", "from +C": "spin about C", "from -C": "spin about C",
-                         "from -A": "spin about A", "from +A": "spin about A", "spherical": "nearly spherical body"}
+                         "from -A": "spin about A", "from +A": "spin about A", "spherical": "nearly spherical body",
+                         # sin P = 5e-4 ... 2e-6 < RESUME_MARGIN × MIN_SIN_P: before the guard the elements
+                         # took these, 5.8e-9 rad off (1e-3) or stuck at steps of ~5e-12 (1e-6)
+                         "from the B-C plane": "symmetric permanent rotation",
+                         "from the A-B plane": "symmetric permanent rotation"}
 
 
 @pytest.mark.parametrize("label, body, momentum", SWEEP, ids=[c[0] for c in SWEEP])
@@ -199,3 +203,16 @@ def test_momentum_passing_the_reference_pole_is_handed_over_and_back():
     ref = integrate_quaternion(y0, 0.0, times, pole_model, rtol=1e-15)
     plain = integrate_quaternion(y0, 0.0, times, pole_model, rtol=RTOL)
     assert angle(ys, ref) <= angle(plain, ref)
+
+
+@pytest.mark.parametrize("body, momentum", [((0.5, 1.0, 1.0), [5e-7, 1.0, 0.0]), ((1.0, 1.0, 2.0), [0.6, -0.8, 2e-6])],
+                         ids=["B = C", "A = B"])
+def test_symmetric_body_next_to_its_permanent_rotation_stops_the_elements(body, momentum):
+    """M 5e-7 (2e-6) rad from the equal-moment plane: before the guard (MIN_SIN_P) the sweep's state
+    took steps of 5e-12 time units on average (1e5 steps reached t = 3.8e-7 of 126; A = B: 9.6e-3 of
+    126), so the hand-over sat ~1 h in the elements until the step cap of 1e8; now they stop at t0 and
+    name the set."""
+    y0 = np.r_[Q_GENERIC, np.array(momentum) / np.array(body)]
+    with pytest.raises(ElementsSingularityError, match="MIN_SIN_P") as info:
+        integrate_elements(y0, 0.0, [1.0], make_model(body, [fixed_source(1e-3, np.array([1.0, 0.3, 0.5]))]), rtol=RTOL)
+    assert info.value.kind == "symmetric permanent rotation" and info.value.t_stop == 0.0

@@ -931,20 +931,29 @@ class Scene:
         return steps, knots, probed
 
     def _elements_choice(self):
-        """The canonical elements when asked for and the state is away from their singular sets."""
-        from .core import canonical as _canonical
-        from .core.integrate_elements import MIN_SEPARATRIX_DISTANCE, MIN_SIN_J
+        """The canonical elements when asked for and the state is away from their singular sets.
 
-        mo, _, momentum, _ = self.state._motion()
-        separatrix = float(mo[_canonical.MO_PARAM_C]) if mo[_canonical.MO_MODE] != _canonical.MODE_UNIFORM else 0.0
-        sin_j = float(np.hypot(momentum[0], momentum[1]) / np.linalg.norm(momentum))
-        if abs(separatrix) < SINGULAR_MARGIN * MIN_SEPARATRIX_DISTANCE or sin_j < SINGULAR_MARGIN * MIN_SIN_J:
-            return "quaternion", (f"elements were asked but the state is near their singular sets (1 - m = "
-                                  f"{separatrix:.2g}, sin J = {sin_j:.2g}; limits {SINGULAR_MARGIN:g} × "
-                                  f"{MIN_SEPARATRIX_DISTANCE:g} and {SINGULAR_MARGIN:g} × {MIN_SIN_J:g}): "
-                                  "the non-singular quaternion integrator is used")
-        return "elements", (f"asked for; the state is away from the singular sets (1 - m = {separatrix:.2g}, "
-                            f"sin J = {sin_j:.2g})")
+        The distances are the integrator's own (:func:`~spinorbit.core.integrate_handover.singularity_distances_of_state`),
+        each against :data:`SINGULAR_MARGIN` × its stop threshold, except the equal-moment plane of a
+        symmetric body (sin P), held to the hand-over's resume margin: its threshold is 1e-2, so the
+        100× margin would refuse every symmetric body.
+        """
+        from .core.integrate_elements import MIN_SEPARATRIX_DISTANCE, MIN_SIN_J, MIN_SIN_J_A, MIN_SIN_P
+        from .core.integrate_handover import RESUME_MARGIN, singularity_distances_of_state
+        from .coupling.one_way import _to_core
+
+        moments = np.array(self.state.body.principal_moments)
+        separatrix, sin_j, _, sin_j_a, sin_p = singularity_distances_of_state(_to_core(self.state), moments)
+        limits = {"1 - m": (abs(separatrix), SINGULAR_MARGIN * MIN_SEPARATRIX_DISTANCE),
+                  "sin J": (sin_j, SINGULAR_MARGIN * MIN_SIN_J),
+                  "sin J_A": (sin_j_a, SINGULAR_MARGIN * MIN_SIN_J_A),
+                  "sin P": (sin_p, RESUME_MARGIN * MIN_SIN_P)}
+        numbers = ", ".join(f"{name} = {value:.2g}" for name, (value, _) in limits.items())
+        near = [f"{name} < {limit:g}" for name, (value, limit) in limits.items() if not value >= limit]
+        if near:
+            return "quaternion", (f"elements were asked but the state is near their singular sets ({numbers}; "
+                                  f"{', '.join(near)}): the non-singular quaternion integrator is used")
+        return "elements", f"asked for; the state is away from the singular sets ({numbers})"
 
     # ------------------------------------------------------------------------------------------
     # Running

@@ -331,6 +331,23 @@ def test_elements_asked_near_the_separatrix_fall_back_to_quaternions():
     assert plan.integrator == "quaternion" and "singular sets" in str(plan)
 
 
+@pytest.mark.parametrize("moments, omega, expect", [
+    ((1.0, 1.0, 2.0), [0.6, -0.8, 1e-4], "quaternion"),  # A = B, M 2e-4 rad from the A-B plane
+    ((1.0, 1.0, 2.0), [0.3, 0.2, 0.5], "elements"),  # A = B, M far from the plane (sin P ≈ 0.88)
+])
+def test_elements_asked_next_to_a_symmetric_permanent_rotation_fall_back_to_quaternions(moments, omega, expect):
+    # The hand-over's sin P set (integrate_elements.MIN_SIN_P): a symmetric body spinning next to its
+    # equal-moment plane, where the elements' error grows like ε/sin²P; asking for them there used to
+    # end in ElementsSingularityError from the run instead of a plan that says why not.
+    state = RotationState(RigidBody(list(moments)), [1, 0, 0, 0], omega)
+    scene = Scene(state, EPOCH, EPOCH + 2 * u.day, perturbers=("sun",), orbit=Orbit.circular(2.5 * u.au),
+                  tolerance=1e-2 * u.arcsec, integrator="elements")
+    plan = scene.plan()
+    reason = next(d.reason for d in plan.decisions if d.topic == "integrator")
+    assert plan.integrator == expect and "sin P" in reason, reason
+    assert scene.run(plan).tolerance_met
+
+
 def test_error_estimate_covers_the_difference_to_a_tight_reference():
     times = EPOCH + np.linspace(2.0, 20.0, 5) * u.day
     kwargs = {"perturbers": ("sun", "jupiter"), "orbit": Orbit.circular(2.5 * u.au)}

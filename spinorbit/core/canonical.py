@@ -208,7 +208,12 @@ def motion_from_elements(big_s, big_z, ic):
     a_d = max(a * (big_z - big_s) * (big_z + big_s) / z2, 0.0)
     d = a * big_s * big_s / z2
     d_c = max(d - c, 0.0)
-    b_d = b - d
+    # b − d from the same side as the smaller gap, = (a − d) − (a − b) or (b − c) − (d − c), so that
+    # 1 − m (1 − μ) is formed from the very differences m (μ) is: for A = B, m = 0 needs b − d = a − d
+    # exactly, for B = C, μ = 0 needs d − b = d − c. b − d of the rounded d differs from the accurate
+    # a − d above by ε d, which made 1 − m = 0.9987 at a − d = 7e-14 d, hence sn² + cn² = 1 + 4e-9 and
+    # |M| = G (1 + 2e-9) (tests/stress/test_fuzz.py). Either form rounds no worse than b − d (≈ ε d).
+    b_d = a_d - a_b if a_d < d_c else b_c - d_c
     if b_d > 0.0:
         mode = MODE_SAM
     elif b_d < 0.0:
@@ -330,9 +335,16 @@ def multiply3(a, b):
 
 
 @jit
-def attitude_from_parts(mx, my, mz, big_g, sin_l, cos_l, g, cos_i, sin_i, h):
-    """R = R3(l) R1(J) R3(g) R1(I) R3(h), with J from the momentum (sin J = |M⊥|/G, cos J = M_z/G)."""
-    w = node_to_body(sin_l, cos_l, math.hypot(mx, my) / big_g, mz / big_g)
+def attitude_from_parts(mx, my, mz, sin_l, cos_l, g, cos_i, sin_i, h):
+    """R = R3(l) R1(J) R3(g) R1(I) R3(h), with J from the momentum's direction (sin J = |M⊥|/|M|, cos J = M_z/|M|).
+
+    J is normalised by the computed |M|, not by the element G = Z: the elliptic amplitudes meet
+    |M| = G only to rounding of the energy differences (≈ ε d/(a − c), large for nearly symmetric
+    bodies), and dividing by G would make R1(J), hence R, non-orthonormal by that much. Each factor
+    is then a rotation to rounding, so R is one whatever the conditioning of the elements.
+    """
+    norm = math.sqrt(mx * mx + my * my + mz * mz)
+    w = node_to_body(sin_l, cos_l, math.hypot(mx, my) / norm, mz / norm)
     cg, sg = math.cos(g), math.sin(g)
     r3g = np.zeros((3, 3))
     r3g[0, 0], r3g[0, 1], r3g[1, 0], r3g[1, 1], r3g[2, 2] = cg, sg, -sg, cg, 1.0
@@ -440,7 +452,7 @@ def state_from_elements_motion(elements, flip, mo, mk, pk):
     mx, my, mz, sin_l, cos_l = body_from_argument(arg, mo, mk)
     g = z + mo[MO_G_PER_S] * s + mo[MO_PN_COEFF] * pn_k(arg, mk, pk)
     sin_i = math.sqrt(max((big_z - big_h) * (big_z + big_h), 0.0)) / big_z
-    working = attitude_from_parts(mx, my, mz, big_z, sin_l, cos_l, g, big_h / big_z, sin_i, h)
+    working = attitude_from_parts(mx, my, mz, sin_l, cos_l, g, big_h / big_z, sin_i, h)
     fx, fy, fz = flip_signs(flip)
     return flip_attitude(working, flip), np.array([fx * mx, fy * my, fz * mz])
 

@@ -201,19 +201,27 @@ def motion_from_elements(big_s, big_z, ic):
     """Motion constants from S (≥ 0, the flip already removed) and Z = G.
 
     d = a S²/Z², and its differences are formed from S and Z directly (a − d = a (Z − S)(Z + S)/Z²
-    is exact to rounding where d → a).
+    is exact to rounding where d → a), the smaller gap first and the others from it.
     """
     a, b, c, a_b, b_c, a_c = ic
     z2 = big_z * big_z
     a_d = max(a * (big_z - big_s) * (big_z + big_s) / z2, 0.0)
     d = a * big_s * big_s / z2
     d_c = max(d - c, 0.0)
-    # b − d from the same side as the smaller gap, = (a − d) − (a − b) or (b − c) − (d − c), so that
-    # 1 − m (1 − μ) is formed from the very differences m (μ) is: for A = B, m = 0 needs b − d = a − d
-    # exactly, for B = C, μ = 0 needs d − b = d − c. b − d of the rounded d differs from the accurate
-    # a − d above by ε d, which made 1 − m = 0.9987 at a − d = 7e-14 d, hence sn² + cn² = 1 + 4e-9 and
-    # |M| = G (1 + 2e-9) (tests/stress/test_fuzz.py). Either form rounds no worse than b − d (≈ ε d).
-    b_d = a_d - a_b if a_d < d_c else b_c - d_c
+    # One d for all three differences: the smaller gap is kept as formed above and the other two are
+    # taken from it, (d − c, b − d) = ((a − c) − (a − d), (a − d) − (a − b)) or (a − d, b − d) =
+    # ((a − c) − (d − c), (b − c) − (d − c)), so that d − c + a − d = a − c and m, 1 − m (μ, 1 − μ)
+    # are built from the same numbers (each rounds no worse than the one-ulp sensitivity 2ε d of S).
+    # Formed independently they belong to d's an ulp apart: for A = B (m = 0) b − fl(d) against the
+    # accurate a − d gave 1 − m = 0.9987 at a − d = 7e-14 d, hence sn² + cn² = 1 + 4e-9, an attitude
+    # 4e-9 from orthonormal and |M| = G (1 + 2e-9); for a body of A = 614, B = C = 615, |M|² missed G²
+    # by ε d/(a − c) = 1.7e-13 (both found by tests/stress/test_fuzz.py).
+    if a_d < d_c:
+        d_c = max(a_c - a_d, 0.0)
+        b_d = a_d - a_b
+    else:
+        a_d = max(a_c - d_c, 0.0)
+        b_d = b_c - d_c
     if b_d > 0.0:
         mode = MODE_SAM
     elif b_d < 0.0:

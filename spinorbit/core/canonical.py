@@ -201,14 +201,27 @@ def motion_from_elements(big_s, big_z, ic):
     """Motion constants from S (≥ 0, the flip already removed) and Z = G.
 
     d = a S²/Z², and its differences are formed from S and Z directly (a − d = a (Z − S)(Z + S)/Z²
-    is exact to rounding where d → a).
+    is exact to rounding where d → a), the smaller gap first and the others from it.
     """
     a, b, c, a_b, b_c, a_c = ic
     z2 = big_z * big_z
     a_d = max(a * (big_z - big_s) * (big_z + big_s) / z2, 0.0)
     d = a * big_s * big_s / z2
     d_c = max(d - c, 0.0)
-    b_d = b - d
+    # One d for all three differences: the smaller gap is kept as formed above and the other two are
+    # taken from it, (d − c, b − d) = ((a − c) − (a − d), (a − d) − (a − b)) or (a − d, b − d) =
+    # ((a − c) − (d − c), (b − c) − (d − c)), so that d − c + a − d = a − c and m, 1 − m (μ, 1 − μ)
+    # are built from the same numbers (each rounds no worse than the one-ulp sensitivity 2ε d of S).
+    # Formed independently they belong to d's an ulp apart: for A = B (m = 0) b − fl(d) against the
+    # accurate a − d gave 1 − m = 0.9987 at a − d = 7e-14 d, hence sn² + cn² = 1 + 4e-9, an attitude
+    # 4e-9 from orthonormal and |M| = G (1 + 2e-9); for a body of A = 614, B = C = 615, |M|² missed G²
+    # by ε d/(a − c) = 1.7e-13 (both found by tests/stress/test_fuzz.py).
+    if a_d < d_c:
+        d_c = max(a_c - a_d, 0.0)
+        b_d = a_d - a_b
+    else:
+        a_d = max(a_c - d_c, 0.0)
+        b_d = b_c - d_c
     if b_d > 0.0:
         mode = MODE_SAM
     elif b_d < 0.0:
@@ -330,9 +343,16 @@ def multiply3(a, b):
 
 
 @jit
-def attitude_from_parts(mx, my, mz, big_g, sin_l, cos_l, g, cos_i, sin_i, h):
-    """R = R3(l) R1(J) R3(g) R1(I) R3(h), with J from the momentum (sin J = |M⊥|/G, cos J = M_z/G)."""
-    w = node_to_body(sin_l, cos_l, math.hypot(mx, my) / big_g, mz / big_g)
+def attitude_from_parts(mx, my, mz, sin_l, cos_l, g, cos_i, sin_i, h):
+    """R = R3(l) R1(J) R3(g) R1(I) R3(h), with J from the momentum's direction (sin J = |M⊥|/|M|, cos J = M_z/|M|).
+
+    J is normalised by the computed |M|, not by the element G = Z: the elliptic amplitudes meet
+    |M| = G only to rounding of the energy differences (≈ ε d/(a − c), large for nearly symmetric
+    bodies), and dividing by G would make R1(J), hence R, non-orthonormal by that much. Each factor
+    is then a rotation to rounding, so R is one whatever the conditioning of the elements.
+    """
+    norm = math.sqrt(mx * mx + my * my + mz * mz)
+    w = node_to_body(sin_l, cos_l, math.hypot(mx, my) / norm, mz / norm)
     cg, sg = math.cos(g), math.sin(g)
     r3g = np.zeros((3, 3))
     r3g[0, 0], r3g[0, 1], r3g[1, 0], r3g[1, 1], r3g[2, 2] = cg, sg, -sg, cg, 1.0
@@ -440,7 +460,7 @@ def state_from_elements_motion(elements, flip, mo, mk, pk):
     mx, my, mz, sin_l, cos_l = body_from_argument(arg, mo, mk)
     g = z + mo[MO_G_PER_S] * s + mo[MO_PN_COEFF] * pn_k(arg, mk, pk)
     sin_i = math.sqrt(max((big_z - big_h) * (big_z + big_h), 0.0)) / big_z
-    working = attitude_from_parts(mx, my, mz, big_z, sin_l, cos_l, g, big_h / big_z, sin_i, h)
+    working = attitude_from_parts(mx, my, mz, sin_l, cos_l, g, big_h / big_z, sin_i, h)
     fx, fy, fz = flip_signs(flip)
     return flip_attitude(working, flip), np.array([fx * mx, fy * my, fz * mz])
 

@@ -18,7 +18,8 @@ from hypothesis import strategies as st
 from spinorbit import RigidBody, RotationState
 from spinorbit.body import InvalidBodyError
 from spinorbit.core import SingularElementsError, canonical_to_andoyer
-from spinorbit.core.canonical import inertia_constants, symmetric_gap_resolved
+from spinorbit.core.canonical import (MO_MODE, MO_PARAM, MO_PARAM_C, MODE_LAM, MODE_SAM, inertia_constants, motion_from_elements,
+                                      symmetric_gap_resolved)
 from spinorbit.core.rotations import euler313_to_attitude
 from spinorbit.state import ANDOYER_G_RANGE, InvalidStateError
 
@@ -148,3 +149,91 @@ def test_backward_map_refuses_elements_at_a_symmetric_permanent_rotation():
         canonical_to_andoyer(at_rotation.S, at_rotation.Z, at_rotation.H, at_rotation.s, at_rotation.z,
                              at_rotation.h, *body.principal_moments)
     assert not symmetric_gap_resolved(at_rotation.S, at_rotation.Z, ic)
+
+
+# Symmetric bodies next to (but resolvably above) the permanent rotation in the equal-moment plane.
+# Found by the fuzzing above: (712, 942, 712), ω = (0, 2.96e-4, 708) (a − d = 7.5e-14 d, 340 ulp)
+# mapped back to an attitude with |R Rᵀ − 1| = 4e-9 and |M| = G (1 + 2e-9): the backward map formed
+# b − d from the rounded d while a − d came from (Z − S)(Z + S), so for A = B it had m = 0 but
+# 1 − m = 0.9987, and sn² + cn² = 1 + 4e-9. The round trip may be poorly conditioned there (ε d/gap,
+# measured against the floor in tests/stress/test_phase_space_floor.py); a non-rotation is a defect.
+# The search below then found (614, 615, 615): |M| = G (1 + 8.7e-14), d − c + a − d ≠ a − c by ε d.
+RESOLVED_NEAR_SYMMETRIC = [
+    ((712.0, 942.0, 712.0), [0.0, 0.0, 0.0, 1.0], [0.0, 0.00029591220828559115, 708.0]),
+    ((614.0, 615.0, 615.0), [0.0, 0.0, 0.0, 1.0], [-0.001, 1.0, 0.0]),
+    ((1.0, 1.0, 2.0), [0.3, 0.5, -0.2, 0.787], [0.6, -0.8, 2e-7]),  # A = B, ω 2e-7 from the A-B plane
+    ((0.5, 1.0, 1.0), [0.3, 0.5, -0.2, 0.787], [1e-7, 1.0, 0.0]),  # B = C, ω 1e-7 from the B-C plane
+]
+#: |M| = G and T = ½ a S² hold to rounding once the differences belong to one d: a few ulp of G², T
+#: (measured ≤ 1.1e-15 over 20000 draws of the search below, seeds 1–4).
+ENERGY_TOLERANCE = 1e-13
+
+
+def assert_round_trip_is_a_state(body, state):
+    back = RotationState.from_canonical_elements(body, state.canonical_elements())
+    r = back.attitude_matrix
+    assert np.all(np.isfinite(r)) and np.all(np.isfinite(back.angular_velocity.value))
+    assert np.abs(r @ r.T - np.eye(3)).max() < ORTHONORMAL_TOLERANCE
+    kinetic, momentum = [], []
+    for s in (state, back):
+        w = s.angular_velocity.value
+        kinetic.append(float(np.dot(w * np.array(body.moments), w)))
+        momentum.append(float(np.linalg.norm(w * np.array(body.moments))))
+    assert abs(kinetic[1] - kinetic[0]) <= ENERGY_TOLERANCE * kinetic[0]
+    assert abs(momentum[1] - momentum[0]) <= ENERGY_TOLERANCE * momentum[0]
+
+
+@pytest.mark.parametrize("moments, q, omega", RESOLVED_NEAR_SYMMETRIC)
+def test_round_trip_next_to_a_symmetric_permanent_rotation_is_a_rotation(moments, q, omega):
+    body = RigidBody(moments)
+    state = RotationState(body, np.array(q) / np.linalg.norm(q), omega)
+    elements = state.canonical_elements()  # resolved: these must not be refused
+    ic = inertia_constants(*body.principal_moments)
+    assert symmetric_gap_resolved(abs(elements.S), elements.Z, ic)
+    assert_round_trip_is_a_state(body, state)
+
+
+@pytest.mark.parametrize("principal, big_s, big_z, mode", [
+    # A = B, a − d ≈ 7.4e-14 d: resolved, but b − d of the rounded d is not (the fuzz example's S, Z;
+    # 1 − m was 0.9987 before the fix)
+    ((712.0, 712.0, 942.0), 504096.0000000582, 504096.00000007707, MODE_SAM),
+    # B = C, d − c ≈ 1.4e-7 d (ω 1e-3 rad from the B-C plane of (5, 6, 6), found by the test below):
+    # b − d = −(d − c) must come from the same d − c (forming it as (a − d) − (a − b) gave 1 − 1.8e-9)
+    ((5.0, 6.0, 6.0), 5.477227857228509, 6.000002083332972, MODE_LAM),
+])
+def test_backward_map_keeps_the_parameter_complement_of_a_symmetric_body(principal, big_s, big_z, mode):
+    """m = 0 exactly (a − b = 0 or b − c = 0), so 1 − m must be 1 to rounding, else sn² + cn² ≠ 1."""
+    mo = motion_from_elements(big_s, big_z, inertia_constants(*principal))
+    assert mo[MO_MODE] == mode and mo[MO_PARAM] == 0.0
+    assert abs(mo[MO_PARAM_C] - 1.0) <= 2 * np.finfo(float).eps
+
+
+@st.composite
+def near_symmetric_plane(draw):
+    """(moments, q, ω): two equal moments, ω within 1e-3 rad (down to 1e-16) of their plane."""
+    equal, other = draw(positive), draw(positive)
+    assume(2 * equal >= other * (1 + 1e-9))  # physical: the sum of two moments ≥ the third
+    k = draw(st.integers(0, 2))  # body axis of the distinct moment
+    moments = [equal] * 3
+    moments[k] = other
+    i, j = [n for n in range(3) if n != k]
+    theta = draw(st.floats(-math.pi, math.pi))
+    offset = draw(st.sampled_from([-1.0, 1.0])) * 10.0 ** draw(st.floats(-16, -3))
+    rate = draw(st.floats(1e-2, 1e3))
+    omega = [0.0, 0.0, 0.0]
+    omega[i], omega[j], omega[k] = rate * math.cos(theta), rate * math.sin(theta), rate * offset
+    q = draw(st.lists(st.floats(-1, 1), min_size=4, max_size=4))
+    assume(np.linalg.norm(q) > 0.1)
+    return tuple(moments), np.array(q) / np.linalg.norm(q), omega
+
+
+@given(near_symmetric_plane())
+def test_elements_next_to_a_symmetric_permanent_rotation_are_refused_or_a_rotation(case):
+    moments, q, omega = case
+    body = RigidBody(moments)
+    state = RotationState(body, q, omega)
+    try:
+        state.canonical_elements()
+    except SingularElementsError:
+        return
+    assert_round_trip_is_a_state(body, state)

@@ -25,7 +25,9 @@ A method's sweep over tolerances stops once one point costs more than SLOW_POINT
 accurate points would cost more still), so that the whole run takes a few minutes.
 
 Writes ``docs/img/work_precision_<scene>.png`` and the ``work_precision`` section of
-``docs/performance.md``. ``--quick`` runs shortened scenes and fewer tolerances and only prints (a
+``docs/performance.md``. ``--averaged`` then runs the long-span comparison of the averaged
+propagator against heyoka (``benchmarks/bench_averaged.py``, its own section). ``--quick`` runs
+shortened scenes and fewer tolerances and only prints (a
 smoke test, not the published numbers).
 """
 
@@ -272,6 +274,9 @@ def main(argv=None):
     parser.add_argument("--quick", action="store_true", help="short scenes, few tolerances (smoke test)")
     parser.add_argument("--scenes", default="abc", help="which scenes to run, e.g. 'a' or 'ac'")
     parser.add_argument("--no-write", action="store_true", help="print only; do not touch docs/")
+    parser.add_argument("--averaged", action="store_true",
+                        help="then the averaged propagator against heyoka over 1000 orbits (benchmarks/bench_averaged.py, "
+                             "its own section of docs/performance.md; with --quick: 30 orbits, print only)")
     args = parser.parse_args(argv)
     if args.quick:
         # A smoke run must never overwrite the published plots and tables.
@@ -449,6 +454,12 @@ def main(argv=None):
     print(text)
     if not args.no_write:
         write_section("work_precision", text)
+    if args.averaged:
+        # Long spans are a regime of their own (span × accuracy map): one script measures it, reached
+        # from here so that the work-precision run can cover the full and the averaged methods at once.
+        from benchmarks.bench_averaged import main as averaged_main
+
+        averaged_main(["--quick"] if args.quick else [])
 
 
 if __name__ == "__main__":

@@ -11,7 +11,7 @@ import platform
 from datetime import datetime, timezone
 from pathlib import Path
 
-from spinorbit.atomic import write_bytes_atomically
+from spinorbit.runs.atomic import write_bytes_atomically
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 

@@ -25,11 +25,11 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from _report import machine_line, write_section  # noqa: E402
 
-import spinorbit.core.integrate_elements as integrate_elements_module  # noqa: E402
-from spinorbit.core.dynamics import make_model  # noqa: E402
-from spinorbit.core.integrate_quaternion import integrate_quaternion  # noqa: E402
-from spinorbit.core.perturbers import fixed_source  # noqa: E402
-from spinorbit.core.rotations import rotation_angle_between_many  # noqa: E402
+import spinorbit.core.integrators.elements as integrate_elements_module  # noqa: E402
+from spinorbit.core.dynamics.equations import make_model  # noqa: E402
+from spinorbit.core.integrators.quaternion import integrate_quaternion  # noqa: E402
+from spinorbit.core.model.perturbers import fixed_source  # noqa: E402
+from spinorbit.core.math.rotations import rotation_angle_between_many  # noqa: E402
 from tests.stress.test_phase_space_floor import Q_GENERIC  # noqa: E402
 
 EPS = float(np.finfo(float).eps)

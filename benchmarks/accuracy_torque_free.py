@@ -33,7 +33,7 @@ from test_torque_free import (  # noqa: E402
     rotation_period,
 )
 
-from spinorbit.core.torque_free import torque_free_states  # noqa: E402
+from spinorbit.core.free_motion.flow import torque_free_states  # noqa: E402
 
 CASES = [
     ("HLW (LAM)", HLW_MOMENTS, HLW_MOMENTUM, IDENTITY),

@@ -6,9 +6,9 @@ P_φ = 2π/ω_g of the mean (S, Z) — at outputs spread logarithmically over th
 
 - Reference: heyoka's Taylor integrator in double precision at tol 1e-15 on the quaternion equations
   (``benchmarks/peers.py``), its osculating states converted to mean elements by the first-order
-  short-period map (:func:`spinorbit.core.short_period.osculating_to_mean`). For the Apophis-like
+  short-period map (:func:`spinorbit.core.averaging.short_period.osculating_to_mean`). For the Apophis-like
   scene the reference is checked against spinorbit's DOP853 at rtol 1e-13 over 100 orbits.
-- Averaged: :func:`spinorbit.core.propagate_averaged.propagate_averaged`, singly averaged (over the
+- Averaged: :func:`spinorbit.core.averaging.propagate.propagate_averaged`, singly averaged (over the
   free rotation; the orbit resolved) and doubly averaged (over the Keplerian orbit too). Its CPU
   includes the osculating → mean conversion of the initial state.
 - heyoka swept over tolerances; its mean quantities come from the same conversion, which is *not*
@@ -49,17 +49,17 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from benchmarks._report import DOCS, machine_line, write_section
 from benchmarks.peers import make_heyoka_integrator
 from benchmarks.scenes import scene_apophis, scene_toutatis
-from spinorbit.core.averaged import element_differences, fast_frequencies, moments_of
-from spinorbit.core.canonical import inertia_constants
-from spinorbit.core.integrate_elements import elements_of_state
-from spinorbit.core.integrate_quaternion import integrate_quaternion
-from spinorbit.core.propagate_averaged import (
+from spinorbit.core.averaging.mean_equations import element_differences, fast_frequencies, moments_of
+from spinorbit.core.elements.canonical import inertia_constants
+from spinorbit.core.integrators.elements import elements_of_state
+from spinorbit.core.integrators.quaternion import integrate_quaternion
+from spinorbit.core.averaging.propagate import (
     averaging_frame,
     free_motion_numbers,
     propagate_averaged,
     validity_numbers,
 )
-from spinorbit.core.short_period import osculating_to_mean
+from spinorbit.core.averaging.short_period import osculating_to_mean
 
 HEYOKA_TOLERANCES = (1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12)
 REFERENCE_TOL = 1e-15
@@ -188,7 +188,7 @@ def equal_accuracy_ratio(study, name):
 
 def reference_check(scene, orbits, log):
     """heyoka tol 1e-15 vs spinorbit DOP853 rtol 1e-13 over `orbits` orbits: largest attitude angle."""
-    from spinorbit.core.rotations import rotation_angle_between_many
+    from spinorbit.core.math.rotations import rotation_angle_between_many
 
     t_out = output_times(scene, orbits, count=5)
     _, ys_h = heyoka_run(scene, REFERENCE_TOL, t_out)

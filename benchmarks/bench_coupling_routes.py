@@ -12,10 +12,10 @@ import numpy as np
 import rebound
 from astropy.time import Time
 
-from spinorbit.core.gravity_field import make_body
-from spinorbit.core.dynamics import inertial_angular_momentum
+from spinorbit.core.model.gravity_field import make_body
+from spinorbit.core.dynamics.equations import inertial_angular_momentum
 from spinorbit.coupling.moon import ARCSEC_PER_RAD, moon_at_de421, moon_figure
-from spinorbit.coupling.rebound_adapter import attach_rotation_ias15, simulation_from_de421
+from spinorbit.coupling.rebound.adapter import attach_rotation_ias15, simulation_from_de421
 from spinorbit.ephemeris import moon_orientation_raw
 
 YEAR = 365.25
@@ -70,8 +70,8 @@ def main():
         y = hooks.state
         y[:4] /= np.linalg.norm(y[:4])
         from spinorbit.coupling.rigid_body import CoupledRigidBody  # noqa: F401  (same formulas)
-        from spinorbit.core.dynamics import body_frame_position, kinetic_energy
-        from spinorbit.core.gravity_field import figure_force_function_and_gradient
+        from spinorbit.core.dynamics.equations import body_frame_position, kinetic_energy
+        from spinorbit.core.model.gravity_field import figure_force_function_and_gradient
         p, b = sim.particles["Planet"], sim.particles["Body"]
         r = body_frame_position(y[:4], np.array(p.xyz) - np.array(b.xyz))
         u, _ = figure_force_function_and_gradient(r, sim.G * p.m, figure)

@@ -24,7 +24,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _report import machine_line, write_section  # noqa: E402
 
 from spinorbit import special  # noqa: E402
-from spinorbit.core import elliptic as E  # noqa: E402
+from spinorbit.core.math import elliptic as E  # noqa: E402
 
 N = 200_000
 REPEATS = 7

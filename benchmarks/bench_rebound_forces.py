@@ -17,7 +17,7 @@ import numpy as np
 from astropy.time import Time
 
 from _report import machine_line, write_section
-from spinorbit.coupling import rebound_adapter as adapter
+from spinorbit.coupling.rebound import adapter as adapter
 
 J2000 = Time(2451545.0, format="jd", scale="tdb")
 YEAR = 365.25

@@ -38,10 +38,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from _report import machine_line, repeat_main
 
-from spinorbit import RigidBody, RotationState, asteroids
-from spinorbit.coupling.rebound_adapter import body_index, simulation_from_de421
+from spinorbit.data import asteroids
+from spinorbit import RigidBody, RotationState
+from spinorbit.coupling.rebound.adapter import body_index, simulation_from_de421
 from spinorbit.ephemeris import de421_constants, moon_orientation
-from spinorbit.scene import EphemerisPerturber, Orbit, Scene, _angles
+from spinorbit.scene.scene import EphemerisPerturber, Orbit, Scene, _angles
 from spinorbit.time import tdb_days
 
 EPOCH = Time("2020-01-01", scale="tdb")
@@ -197,11 +198,10 @@ INTEGRATOR_ROWS = ("Taylor instead of DOP853", "DOP853 instead of Taylor")
 def knot_rows(scene_rows, repeat):
     """Taylor against DOP853 on each one-way scene's model, each at the first tolerance the planner would
     give it, with the rule's counts (``Scene._taylor_steps``) and the true ones."""
-    from spinorbit.core.dynamics import make_model
-    from spinorbit.core.integrate_quaternion import integrate_quaternion
-    from spinorbit.core.integrate_taylor import integrate_taylor
-    from spinorbit.coupling.one_way import _to_core
-    from spinorbit.scene import _first_tolerance
+    from spinorbit.core.dynamics.equations import make_model
+    from spinorbit.core.integrators.quaternion import integrate_quaternion
+    from spinorbit.core.integrators.taylor import integrate_taylor
+    from spinorbit.scene.scene import _first_tolerance
 
     rows, seen = [], set()
     sweep = [(f"moonlet, period {period:g} d", None, moonlet_scene(period), None) for period in MOONLET_PERIODS]
@@ -217,7 +217,7 @@ def knot_rows(scene_rows, repeat):
         groups = ([scene._sampler(plan.orbit_source, named, scene.sample_tolerance)] if named else []) + (
             [scene._sampler("user", moving, scene.sample_tolerance)] if moving else [])
         model = make_model(scene.state.body.principal_moments, [s for g in groups for s in g.sources()])
-        y0, t0, t_out = _to_core(scene.state), scene.epoch_day, scene.output_days
+        y0, t0, t_out = scene.state.core_state(), scene.epoch_day, scene.output_days
         share = plan.integration_share_rad
         tol, rtol = _first_tolerance("taylor", share), _first_tolerance("quaternion", share)
         steps, estimate, _ = scene._taylor_steps(plan.orbit_source, plan.kept, True, tol)
@@ -312,7 +312,7 @@ def markdown(results, repeat):
                "Rotation steps and estimated knots: the planner's counts (`Scene._taylor_steps`: the Taylor method "
                "on the free motion over ≤ 20 rotations, scaled; knots from the survey's a priori grid); knots: the "
                "true sample times strictly inside the span (each ends a Taylor step). The planner takes Taylor while "
-               "estimated knots ≤ `spinorbit.scene.TAYLOR_KNOT_SHARE` × rotation steps. The moonlet rows: the SAM "
+               "estimated knots ≤ `spinorbit.scene.scene.TAYLOR_KNOT_SHARE` × rotation steps. The moonlet rows: the SAM "
                "body at 2.5 au with the Sun and a relative circle of 0.01 au (G·M 1e-12 au³/day²) of the given "
                "period, 20 d, 200 outputs, 1 arcsec. Scene run: the whole `Scene.run` of the scene planned (skip=True) "
                "with `integrator` forced to 'taylor' and to 'quaternion', alternated, best of --repeat: the run, its "

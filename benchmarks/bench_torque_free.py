@@ -35,7 +35,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 from _heyoka_reference import propagate as reference_propagate, rotation_angle  # noqa: E402
 from _report import machine_line, write_section  # noqa: E402
 
-from spinorbit.core.torque_free import (  # noqa: E402
+from spinorbit.core.free_motion.flow import (  # noqa: E402
     FL_PERIOD_HI,
     FL_RATE_HI,
     flow_constants,
@@ -128,7 +128,7 @@ def closed_form_section():
         "",
         machine_line() + " One core (`NUMBA_NUM_THREADS=1`).",
         "",
-        "Regular precession in closed form (`spinorbit.core.regular_precession`: two sin/cos and two quaternion "
+        "Regular precession in closed form (`spinorbit.core.free_motion.regular_precession`: two sin/cos and two quaternion "
         "products per output, double-double phases) against the elliptic flow at parameter 0 "
         "(`closed_forms=False`) for the same states: random attitudes and body momenta (seeded), times over "
         "100 turns. The two are timed alternately in one process, best of "

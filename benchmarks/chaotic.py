@@ -25,12 +25,12 @@ import math
 
 import numpy as np
 
-from spinorbit.core.dynamics import make_model
-from spinorbit.core.integrate_handover import integrate_with_handover
-from spinorbit.core.integrate_quaternion import integrate_quaternion
-from spinorbit.core.integrate_splitting import integrate_splitting
-from spinorbit.core.perturbers import kepler_source
-from spinorbit.core.rotations import rotation_angle_between_many
+from spinorbit.core.dynamics.equations import make_model
+from spinorbit.core.integrators.handover import integrate_with_handover
+from spinorbit.core.integrators.quaternion import integrate_quaternion
+from spinorbit.core.integrators.splitting import integrate_splitting
+from spinorbit.core.model.perturbers import kepler_source
+from spinorbit.core.math.rotations import rotation_angle_between_many
 
 MOMENTS = (0.60, 0.86, 1.00)
 ECCENTRICITY = 0.1

@@ -6,25 +6,25 @@ integrates the scene once and returns the states at ``scene.t_out``. The benchma
 callable. Adding a method (e.g. the canonical-element equations or a splitting scheme) is adding one
 entry to :data:`METHODS`.
 
-- ``spinorbit-dop853``: :func:`spinorbit.core.integrate_quaternion.integrate_quaternion`.
+- ``spinorbit-dop853``: :func:`spinorbit.core.integrators.quaternion.integrate_quaternion`.
 - ``spinorbit DOP853, tabulated perturbers``: the same integrator with each Keplerian perturber
   replaced by cubic Hermite samples of its orbit, dense enough for 1e-15 relative position error
   (:func:`tabulated_model`): how an ephemeris-driven run looks, and it takes the Kepler solve (80 % of
   the cost in scene (a)) out of the loop. Tabulation time counts as preparation.
-- ``spinorbit splitting <scheme>``: :func:`spinorbit.core.integrate_splitting.integrate_splitting`, a
+- ``spinorbit splitting <scheme>``: :func:`spinorbit.core.integrators.splitting.integrate_splitting`, a
   fixed-step symplectic splitting (exact torque-free drift + torque kicks). It has no tolerance: its
   sweep parameter is the number of steps per rotation of the scene (step = span / (rotations × n),
   ``prepare_splitting``), reported in the "tol" column of the tables.
 - ``spinorbit canonical elements (DOP853)``:
-  :func:`spinorbit.core.integrate_elements.integrate_elements`, the canonical-element equations
+  :func:`spinorbit.core.integrators.elements.integrate_elements`, the canonical-element equations
   (paper eq. 11) with the same DOP853 tableau; same state layout in and out.
-- ``spinorbit Taylor (numba)``: :func:`spinorbit.core.integrate_taylor.integrate_taylor`, the adaptive
+- ``spinorbit Taylor (numba)``: :func:`spinorbit.core.integrators.taylor.integrate_taylor`, the adaptive
   Taylor method on the same equations (tolerance = its tol, heyoka's order and step rule).
 - ``scipy DOP853, pure-Python RHS``: ``solve_ivp(method="DOP853")`` with a right-hand side written in
   plain Python/numpy (:func:`python_rhs`: Kepler solve by Newton, MacCullagh torque), the baseline the
   issue's ≥100× goal names; scene (a) only and two tolerances (≈1–3 s per run).
 - ``scipy-DOP853``: ``scipy.integrate.solve_ivp(method="DOP853")`` with the Python RHS
-  :func:`spinorbit.core.dynamics.scipy_rhs` (which calls the same compiled RHS).
+  :func:`spinorbit.core.dynamics.equations.scipy_rhs` (which calls the same compiled RHS).
 - ``heyoka``: heyoka's Taylor integrator on the same equations, rebuilt as heyoka expressions:
   degree-2 (MacCullagh) torque N = 3μ/R⁵ r × (I r) of point masses; an elliptic perturber's position
   from ``hy.kepE`` of the time; a hyperbolic one (no hyperbolic Kepler solver in heyoka) from the
@@ -41,9 +41,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from spinorbit.core.dynamics import scipy_rhs
-from spinorbit.core.integrate_quaternion import default_atol, integrate_quaternion
-from spinorbit.core.perturbers import kepler_state
+from spinorbit.core.dynamics.equations import scipy_rhs
+from spinorbit.core.integrators.quaternion import default_atol, integrate_quaternion
+from spinorbit.core.model.perturbers import kepler_state
 
 
 @dataclass
@@ -84,8 +84,8 @@ def tabulated_model(scene, rtol=TABULATION_RTOL):
     angular rate on the orbit, at pericentre; the bound is rough, so a factor 2 of margin is kept):
     h = 0.5 (384 rtol)^(1/4) / ω_max.
     """
-    from spinorbit.core.dynamics import make_model
-    from spinorbit.core.perturbers import sampled_source
+    from spinorbit.core.dynamics.equations import make_model
+    from spinorbit.core.model.perturbers import sampled_source
 
     t_lo = min(scene.t0, float(np.min(scene.t_out)))
     t_hi = max(scene.t0, float(np.max(scene.t_out)))
@@ -120,7 +120,7 @@ def prepare_spinorbit_tabulated(scene, tol):
 
 def prepare_splitting(scene, steps_per_rotation, scheme):
     """Fixed-step splitting with ``steps_per_rotation`` steps per rotation of the scene."""
-    from spinorbit.core.integrate_splitting import integrate_splitting
+    from spinorbit.core.integrators.splitting import integrate_splitting
 
     span = abs(float(scene.t_out[-1]) - scene.t0)
     step = span / (scene.rotations * steps_per_rotation)
@@ -156,7 +156,7 @@ def _prepare_call(integrate, scene, **kwargs):
 
 
 def prepare_spinorbit_elements(scene, tol):
-    from spinorbit.core.integrate_elements import integrate_elements
+    from spinorbit.core.integrators.elements import integrate_elements
 
     return _prepare_call(integrate_elements, scene, rtol=tol)
 
@@ -164,7 +164,7 @@ def prepare_spinorbit_elements(scene, tol):
 # --------------------------------------------------------------------------- Taylor
 
 def prepare_spinorbit_taylor(scene, tol):
-    from spinorbit.core.integrate_taylor import integrate_taylor
+    from spinorbit.core.integrators.taylor import integrate_taylor
 
     return _prepare_call(integrate_taylor, scene, tol=tol)
 

@@ -20,10 +20,10 @@ from scipy.integrate import quad, solve_ivp
 from scipy.optimize import brentq
 from scipy.special import ellipk
 
-from spinorbit.asteroids import aligning_quaternion as _quat_aligning  # one implementation, in the library
-from spinorbit.core.dynamics import make_model
-from spinorbit.core.perturbers import kepler_source
-from spinorbit.core.rotations import matrix_to_quat
+from spinorbit.data.asteroids import aligning_quaternion as _quat_aligning  # one implementation, in the library
+from spinorbit.core.dynamics.equations import make_model
+from spinorbit.core.model.perturbers import kepler_source
+from spinorbit.core.math.rotations import matrix_to_quat
 
 GM_SUN = 2.9591220828559115e-4  # AU³/day² (IAU nominal, k²)
 GM_EARTH = GM_SUN / 332946.0487  # AU³/day²

@@ -36,13 +36,13 @@ import chaotic
 from _mp_reference import exact_states
 from _report import DOCS, machine_line, write_section
 
-from spinorbit.core.dynamics import make_model, total_energy
-from spinorbit.core.integrate_elements import integrate_elements
-from spinorbit.core.integrate_quaternion import integrate_quaternion
-from spinorbit.core.integrate_splitting import integrate_splitting
-from spinorbit.core.perturbers import fixed_source
-from spinorbit.core.rotations import rotation_angle_between_many
-from spinorbit.core.torque_free import torque_free_states
+from spinorbit.core.dynamics.equations import make_model, total_energy
+from spinorbit.core.integrators.elements import integrate_elements
+from spinorbit.core.integrators.quaternion import integrate_quaternion
+from spinorbit.core.integrators.splitting import integrate_splitting
+from spinorbit.core.model.perturbers import fixed_source
+from spinorbit.core.math.rotations import rotation_angle_between_many
+from spinorbit.core.free_motion.flow import torque_free_states
 
 EPS = np.finfo(float).eps
 IMG = DOCS / "img"
@@ -194,7 +194,7 @@ def sweep():
 def handover_table():
     from stress import test_handover as scene
 
-    from spinorbit.core.integrate_handover import integrate_with_handover
+    from spinorbit.core.integrators.handover import integrate_with_handover
 
     lines = ["| initial state | rtol | switches | hand-over error (rad) | DOP853 alone (rad) |", "|---|---:|---:|---:|---:|"]
     for gap, label in [(0.02, "1 − m = 0.23, passages"), (0.06, "1 − m = 0.64, none")]:

@@ -49,15 +49,15 @@ import itertools
 from benchmarks._report import DOCS, machine_line, write_section
 from benchmarks.peers import METHODS, prepare_spinorbit, reference_solution
 from benchmarks.scenes import all_scenes
-from spinorbit.atomic import atomic_path
-from spinorbit.core.integrate_elements import integrate_elements_fixed_step
-from spinorbit.core.integrate_quaternion import integrate_fixed_step
-from spinorbit.core.integrate_splitting import integrate_splitting
-from spinorbit.core.integrate_taylor import (
+from spinorbit.runs.atomic import atomic_path
+from spinorbit.core.integrators.elements import integrate_elements_fixed_step
+from spinorbit.core.integrators.quaternion import integrate_fixed_step
+from spinorbit.core.integrators.splitting import integrate_splitting
+from spinorbit.core.integrators.taylor import (
     integrate_taylor,
     integrate_taylor_fixed_step,
 )
-from spinorbit.core.rotations import rotation_angle_between_many
+from spinorbit.core.math.rotations import rotation_angle_between_many
 
 #: Accuracy at which methods are compared (rad).
 TARGET_ERROR = 1e-10
@@ -122,7 +122,7 @@ def rhs_cost_ns(model, y, t0, calls=200_000):
     """CPU per call (ns) of the compiled RHS alone, in a numba loop (no integrator around it)."""
     import numba
 
-    from spinorbit.core.dynamics import rhs_into
+    from spinorbit.core.dynamics.equations import rhs_into
 
     @numba.njit
     def loop(y, model, t0, n):
@@ -141,8 +141,8 @@ def rhs_cost_ns(model, y, t0, calls=200_000):
 
 def cost_breakdown(scene, tol=1e-12):
     """Where spinorbit's time goes at one tolerance: steps, RHS calls, RHS cost with/without torque."""
-    from spinorbit.core.dynamics import make_model
-    from spinorbit.core.integrate_quaternion import default_atol, integrate_quaternion
+    from spinorbit.core.dynamics.equations import make_model
+    from spinorbit.core.integrators.quaternion import default_atol, integrate_quaternion
 
     y0 = np.asarray(scene.y0, float)
     atol = default_atol(y0, tol)

@@ -2,12 +2,12 @@
 
 Initial spin: Pravec et al. 2014 (Icarus 233, 48) — SAM, retrograde, P_ψ = 263 h, P_φ = 27.38 h,
 moments 0.61 : 0.965 : 1, angular momentum towards ecliptic (λ, β) = (250°, −75°)
-(:func:`spinorbit.asteroids.apophis_rotation_state`). Orbit (default ``--orbit published``): the JPL
-Horizons solution JPL#218 state at 2021-01-01 TDB (:data:`spinorbit.asteroids.APOPHIS_HORIZONS`),
+(:func:`spinorbit.data.asteroids.apophis_rotation_state`). Orbit (default ``--orbit published``): the JPL
+Horizons solution JPL#218 state at 2021-01-01 TDB (:data:`spinorbit.data.asteroids.APOPHIS_HORIZONS`),
 integrated to 2029 with the Sun, planets, Moon and Pluto from DE421 in REBOUND (IAS15, Earth J2 + EIH);
 the encounter is then an outcome (printed). ``--orbit geometry`` uses the documented fallback encounter
 geometry instead (perigee imposed: 38 000 km from Earth's centre at 7.4 km/s at 2029-04-13 21:46 UTC,
-directions from rounded elements; :mod:`spinorbit.asteroids`). Torques: Sun, Earth, Moon (degree 2,
+directions from rounded elements; :mod:`spinorbit.data.asteroids`). Torques: Sun, Earth, Moon (degree 2,
 point masses), one way.
 
 The rotation *phase* at perigee is not known from the published state, and the outcome depends on it
@@ -35,7 +35,7 @@ from astropy import units as u
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from spinorbit import RotationState
-from spinorbit.asteroids import (
+from spinorbit.data.asteroids import (
     APOPHIS_2029,
     APOPHIS_HORIZONS,
     apophis_encounter_simulation,

@@ -20,8 +20,8 @@ import time
 import numpy as np
 
 from spinorbit.commands.moon import plot_comparison
-from spinorbit.core.integrate_quaternion import integrate_quaternion
-from spinorbit.core.lunar_interior import (
+from spinorbit.core.integrators.quaternion import integrate_quaternion
+from spinorbit.core.model.lunar_interior import (
     IN_CORE_A,
     IN_CORE_C,
     IN_EARTH_J2R2,

@@ -1,9 +1,9 @@
 """(4179) Toutatis 1992–2012: the tumbling spin under solar and Earth torques, through the 2004 flyby.
 
 Initial state: Takahashi, Busch & Scheeres 2013 (AJ 146, 95, Table 2) at 1992-11-09T17:49:47 UTC
-(:func:`spinorbit.asteroids.toutatis_rotation_state`; the Euler-angle reading is documented there).
+(:func:`spinorbit.data.asteroids.toutatis_rotation_state`; the Euler-angle reading is documented there).
 Orbit: the documented encounter geometry of the 2004-09-29 flyby (0.01036 au; directions and
-semi-major axis from rounded elements, :mod:`spinorbit.asteroids`), integrated backwards to 1992 and
+semi-major axis from rounded elements, :mod:`spinorbit.data.asteroids`), integrated backwards to 1992 and
 forwards to 2012 with the Sun, planets, Moon and Pluto from DE421 in REBOUND (IAS15). Torques: Sun
 and Earth (degree 2), one way. The other Earth approaches (1992, 1996, 2000, 2008, 2012) come out
 wherever this approximate orbit puts them — they are printed next to the real ones.
@@ -34,7 +34,7 @@ from astropy.time import Time
 # Run from a checkout without installing (the project does not use editable installs).
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from spinorbit.asteroids import TOUTATIS_2004, TOUTATIS_EPOCH, encounter_simulation, toutatis_rotation_state
+from spinorbit.data.asteroids import TOUTATIS_2004, TOUTATIS_EPOCH, encounter_simulation, toutatis_rotation_state
 from spinorbit.coupling.one_way import propagate_one_way, sample_from_rebound
 from spinorbit.time import tdb_days
 

@@ -1,5 +1,5 @@
 """``python -m spinorbit``: the same as the ``spinorbit`` command."""
 
-from .cli import main
+from spinorbit.cli import main
 
 raise SystemExit(main())

@@ -122,9 +122,12 @@ class RigidBody:
             not isinstance(self.radius, u.Quantity) or self.radius.unit.physical_type != "length"
         ):
             raise u.UnitTypeError(f"radius must be a Quantity in a length unit (e.g. 0.2 * u.km); got {self.radius!r}.")
+        to_principal = _principal_permutation(values)
+        values.flags.writeable = False  # shared with the states built on this body: never changed
+        to_principal.flags.writeable = False
         object.__setattr__(self, "_values", values)
         object.__setattr__(self, "_unit", unit)
-        object.__setattr__(self, "_to_principal", _principal_permutation(values))
+        object.__setattr__(self, "_to_principal", to_principal)
 
     @property
     def principal_moments(self) -> tuple[float, float, float]:
@@ -133,14 +136,19 @@ class RigidBody:
         return float(big_a), float(big_b), float(big_c)
 
     @property
+    def moment_values(self) -> np.ndarray:
+        """The moments about the user's body x, y, z, as plain floats in :attr:`moment_unit` (read-only)."""
+        return self._values
+
+    @property
     def moment_unit(self) -> u.Unit:
         """Unit of the moments (dimensionless when given as ratios)."""
         return self._unit
 
     @property
     def to_principal(self) -> np.ndarray:
-        """Proper rotation P: principal-axis components = P @ user-axis components."""
-        return self._to_principal.copy()
+        """Proper rotation P: principal-axis components = P @ user-axis components (read-only)."""
+        return self._to_principal
 
     @property
     def f(self) -> float:

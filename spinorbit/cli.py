@@ -65,7 +65,7 @@ class _Parser(argparse.ArgumentParser):
 
 def _command_modules():
     """The subcommand modules in :mod:`spinorbit.commands`, in name order (private ``_*`` skipped)."""
-    from . import commands
+    from spinorbit import commands
 
     names = sorted(info.name for info in pkgutil.iter_modules(commands.__path__) if not info.name.startswith("_"))
     return [importlib.import_module(f"{commands.__name__}.{name}") for name in names]
@@ -73,7 +73,7 @@ def _command_modules():
 
 def build_parser() -> argparse.ArgumentParser:
     """The ``spinorbit`` parser with one subparser per command module."""
-    from . import __version__
+    from spinorbit import __version__
 
     parser = _Parser(
         prog="spinorbit",
@@ -103,7 +103,7 @@ def _input_errors():
     """Exception types that mean "the input was wrong", imported lazily (they pull in astropy)."""
     from astropy.units import UnitTypeError
 
-    from . import InvalidBodyError, InvalidStateError, SpinorbitError
+    from spinorbit import InvalidBodyError, InvalidStateError, SpinorbitError
 
     return (CommandError, InvalidBodyError, InvalidStateError, SpinorbitError, UnitTypeError)
 

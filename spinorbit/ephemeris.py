@@ -34,8 +34,8 @@ import types
 import astropy.units as u
 import numpy as np
 
-from .core.rotations import attitude_to_quat_many, euler313_rates_to_omega, euler313_to_attitude
-from .time import J2000_JD_TDB, tdb_day_and_fraction
+from spinorbit.core.math.rotations import attitude_to_quat_many, euler313_rates_to_omega, euler313_to_attitude
+from spinorbit.time import J2000_JD_TDB, tdb_day_and_fraction
 
 __all__ = [
     "KNOWN_BODIES",
@@ -115,7 +115,7 @@ def _span():
 DE421_SPAN_JD_TDB = (2414992.5, 2524624.5)
 
 
-def _resolve_body(body) -> str:
+def resolve_body(body) -> str:
     if not isinstance(body, str):
         raise TypeError(f"body must be a name (str); got {type(body).__name__} ({body!r}).")
     name = body.strip().lower()
@@ -177,7 +177,7 @@ def barycentric_state_km(body: str, day, fraction=0.0):
     ------
     UnknownBodyError, EphemerisRangeError
     """
-    name = _resolve_body(body)
+    name = resolve_body(body)
     _check_span(day, fraction)
     if name in _SERIES:
         return _evaluate(_SERIES[name], day, fraction)
@@ -238,7 +238,7 @@ def barycentric_state(body: str, time):
     TypeError
         If ``time`` is not an astropy ``Time``.
     """
-    name = _resolve_body(body)  # before the time conversion, so a bad name fails first
+    name = resolve_body(body)  # before the time conversion, so a bad name fails first
     day, fraction = tdb_day_and_fraction(time)
     position, velocity = barycentric_state_km(name, day, fraction)
     return (position * u.km).to(u.AU), (velocity * (u.km / u.day)).to(u.AU / u.day)

@@ -32,7 +32,7 @@ from astropy.coordinates import (
     UnitSphericalRepresentation,
 )
 
-from .core.rotations import quat_to_matrix, rot1
+from spinorbit.core.math.rotations import quat_to_matrix, rot1
 
 __all__ = [
     "OBLIQUITY_J2000",

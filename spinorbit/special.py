@@ -1,7 +1,7 @@
 """Jacobian elliptic functions and elliptic integrals for every parameter m ≥ 0.
 
 Vectorized front ends (numpy broadcasting) of the numba kernels in
-:mod:`spinorbit.core.elliptic`. Names and argument order follow scipy and mpmath: the parameter
+:mod:`spinorbit.core.math.elliptic`. Names and argument order follow scipy and mpmath: the parameter
 m (not the modulus k), and Π(n; φ | m) with the sign convention 1 − n sin²θ (mpmath, Boost,
 the paper). Unlike :mod:`scipy.special`, m > 1 and m = 1 are supported, |u| is reduced without
 losing ε·|u| of phase, and the complementary parameter may be given exactly with ``mc=``.
@@ -16,8 +16,8 @@ Scalar input gives a Python float; array input gives an ndarray of the broadcast
 
 import numpy as np
 
-from spinorbit.core import elliptic as _kernels
-from spinorbit.core._jit import jit
+from spinorbit.core.math import elliptic as _kernels
+from spinorbit.core.jit import jit
 
 __all__ = ["ellipj", "am", "ellipk", "ellipf", "ellippi", "pn"]
 

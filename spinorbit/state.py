@@ -13,13 +13,13 @@ from dataclasses import dataclass
 import numpy as np
 from astropy import units as u
 
-from .body import RigidBody
-from .core import andoyer as _andoyer
-from .core import canonical as _canonical
-from .core import motion_summary as _summary
-from .core import rotations as _rotations
-from .core import torque_free as _torque_free
-from .core.errors import SingularElementsError
+from spinorbit.body import RigidBody
+from spinorbit.core.elements import andoyer as _andoyer
+from spinorbit.core.elements import canonical as _canonical
+from spinorbit.core.free_motion import summary as _summary
+from spinorbit.core.math import rotations as _rotations
+from spinorbit.core.free_motion import flow as _torque_free
+from spinorbit.core.errors import SingularElementsError
 
 __all__ = ["RotationState", "CanonicalElements", "InvalidStateError"]
 
@@ -60,7 +60,7 @@ def _unresolved_gap_message(big_s, big_z, moments, what):
         f"{what}: the body is axisymmetric ({equal}) and the spin is within rounding of its permanent rotation "
         f"perpendicular to the symmetry axis (S = {big_s!r}, Z = {big_z!r}): S and Z "
         "cannot resolve the gap d − c (B = C) or a − d (A = B) that sets the rate of the elliptic argument, so the "
-        "canonical elements carry no phase there (spinorbit.core.canonical.symmetric_gap_resolved). "
+        "canonical elements carry no phase there (spinorbit.core.elements.canonical.symmetric_gap_resolved). "
         "propagate_torque_free still works (regular precession in closed form); use the attitude and spin directly."
     )
 
@@ -125,7 +125,7 @@ class CanonicalElements:
 
     S, Z, H are in the body's moment unit × rad/day; s is in day × (moment unit × rad/day)⁻¹… i.e.
     ds/dt = a S with a = 1/A; z, h in radians. ``flip`` is the body-frame turn that puts the state on
-    the paper's branch (``spinorbit.core.canonical.FLIP_*``); ``reference`` the passive rotation from
+    the paper's branch (``spinorbit.core.elements.canonical.FLIP_*``); ``reference`` the passive rotation from
     the inertial frame to the frame of H and h.
     """
 
@@ -183,7 +183,7 @@ class RotationState:
             values = angular_momentum.to_value(body.moment_unit * RAD_PER_DAY, equivalencies=u.dimensionless_angles())
         else:
             values = np.asarray(angular_momentum, dtype=float)
-        return cls(body, quaternion, np.asarray(values, dtype=float) / body._values)
+        return cls(body, quaternion, np.asarray(values, dtype=float) / body.moment_values)
 
     # -- what users read -----------------------------------------------------------------------
     @property
@@ -208,25 +208,38 @@ class RotationState:
     @property
     def angular_momentum(self) -> u.Quantity:
         """Body angular momentum I ω in the user's body axes (moment unit × rad/day)."""
-        return self._body._values * self._omega * (self._body.moment_unit * RAD_PER_DAY)
+        return self._body.moment_values * self._omega * (self._body.moment_unit * RAD_PER_DAY)
 
     @property
     def angular_momentum_direction(self) -> np.ndarray:
         """Unit vector of the angular momentum in the inertial frame (fixed in free rotation)."""
-        inertial = self.attitude_matrix.T @ (self._body._values * self._omega)
+        inertial = self.attitude_matrix.T @ (self._body.moment_values * self._omega)
         return inertial / np.linalg.norm(inertial)
 
     # -- principal-axis view used by the core ---------------------------------------------------
-    def _principal(self):
-        p = self._body._to_principal
+    def principal_attitude_and_momentum(self) -> tuple[np.ndarray, np.ndarray]:
+        """(R_p, M_p): inertial → principal-axis attitude matrix and body angular momentum on the
+        principal axes (A ≤ B ≤ C), in :attr:`RigidBody.moment_unit` · rad/day, as plain floats."""
+        p = self._body.to_principal
         attitude = p @ self.attitude_matrix
-        momentum = p @ (self._body._values * self._omega)
+        momentum = p @ (self._body.moment_values * self._omega)
         return attitude, momentum
+
+    def core_state(self) -> np.ndarray:
+        """The state vector the core integrates: y = (q, ω), shape (7,), plain floats.
+
+        q is the scalar-first quaternion principal axes → inertial frame, ω the angular velocity on
+        the principal axes in rad/day (``docs/conventions.md``). This is the one way from a
+        :class:`RotationState` to the arrays of :mod:`spinorbit.core`.
+        """
+        p = self._body.to_principal
+        attitude = p @ self.attitude_matrix
+        return np.concatenate([_rotations.attitude_to_quat(np.ascontiguousarray(attitude)), p @ self._omega])
 
     def _motion(self):
         big_a, big_b, big_c = self._body.principal_moments
         ic = _canonical.inertia_constants(big_a, big_b, big_c)
-        _, momentum = self._principal()
+        _, momentum = self.principal_attitude_and_momentum()
         if not np.any(momentum):
             raise InvalidStateError("the body is not rotating (zero spin): it has no rotation mode or elements.")
         mo, flip = _canonical.motion_from_momentum(momentum[0], momentum[1], momentum[2], ic)
@@ -252,7 +265,7 @@ class RotationState:
 
         1 for principal-axis rotation about C; C/A for rotation about A; C/B on the separatrix.
         """
-        _, momentum = self._principal()
+        _, momentum = self.principal_attitude_and_momentum()
         return float(_summary.energy_ratio(*momentum, *self._body.principal_moments))
 
     @property
@@ -287,10 +300,10 @@ class RotationState:
 
         Momenta in the body's moment unit × rad/day, angles in radians. ``reference`` as in
         :meth:`canonical_elements`. At J = 0 (spin exactly about C) only l + g is defined; the split
-        follows ``spinorbit.core.andoyer.andoyer_from_attitude``.
+        follows ``spinorbit.core.elements.andoyer.andoyer_from_attitude``.
         """
         frame = self._reference_frame(reference)
-        attitude, momentum = self._principal()
+        attitude, momentum = self.principal_attitude_and_momentum()
         return tuple(float(x) for x in _andoyer.andoyer_from_attitude(attitude @ frame.T, momentum))
 
     @classmethod
@@ -312,8 +325,8 @@ class RotationState:
             )
         frame = np.eye(3) if reference is None else _as_rotation_matrix(reference)
         attitude_ref, momentum = _andoyer.attitude_from_andoyer(*values)
-        p = body._to_principal
-        return cls.from_matrix(body, p.T @ attitude_ref @ frame, (p.T @ momentum) / body._values)
+        p = body.to_principal
+        return cls.from_matrix(body, p.T @ attitude_ref @ frame, (p.T @ momentum) / body.moment_values)
 
     def canonical_elements(self, reference="auto") -> CanonicalElements:
         """Fukushima's canonical elements (paper eq. 4) of this state.
@@ -337,7 +350,7 @@ class RotationState:
                 "this state is a permanent rotation (spin about a principal axis that makes s infinite): it has no "
                 "finite canonical elements. propagate_torque_free still works (uniform rotation)."
             )
-        attitude, momentum = self._principal()
+        attitude, momentum = self.principal_attitude_and_momentum()
         frame = self._reference_frame(reference)
         ic = _canonical.inertia_constants(*moments)
         if not _canonical.symmetric_gap_resolved(mo[_canonical.MO_S], mo[_canonical.MO_G], ic):
@@ -357,9 +370,9 @@ class RotationState:
                 elements.S, elements.Z, body.principal_moments, "these elements"))
         values = np.array([elements.S, elements.Z, elements.H, elements.s, elements.z, elements.h])
         attitude_ref, momentum = _canonical.state_from_elements(values, elements.flip, ic)
-        p = body._to_principal
+        p = body.to_principal
         attitude_user = p.T @ attitude_ref @ elements.reference
-        return cls.from_matrix(body, attitude_user, (p.T @ momentum) / body._values)
+        return cls.from_matrix(body, attitude_user, (p.T @ momentum) / body.moment_values)
 
     def propagate_torque_free(self, dt, closed_forms=True) -> tuple[np.ndarray, u.Quantity]:
         """Exact torque-free motion (paper eq. 12) at times ``dt`` after this state.
@@ -370,7 +383,7 @@ class RotationState:
             Time offsets (days if plain floats), scalar or 1-D.
         closed_forms : bool
             True (default): a body with two exactly equal moments takes the regular precession in
-            closed form (``spinorbit.core.regular_precession``, trig only); False: the elliptic flow
+            closed form (``spinorbit.core.free_motion.regular_precession``, trig only); False: the elliptic flow
             at parameter 0 (same result to ~1e-15 rad, for comparisons).
 
         Returns
@@ -384,8 +397,8 @@ class RotationState:
         times = np.atleast_1d(np.asarray(times, dtype=float))
         if times.ndim != 1 or not np.all(np.isfinite(times)):
             raise ValueError("dt must be a finite scalar or 1-D array of time offsets.")
-        attitude, momentum = self._principal()
-        p = self._body._to_principal
+        attitude, momentum = self.principal_attitude_and_momentum()
+        p = self._body.to_principal
         principal_q, principal_m = _torque_free.torque_free_states(
             _rotations.attitude_to_quat(attitude), momentum, *self._body.principal_moments, times,
             closed_forms=closed_forms,
@@ -395,7 +408,7 @@ class RotationState:
         right_product = np.array([[p0, -p1, -p2, -p3], [p1, p0, p3, -p2], [p2, -p3, p0, p1], [p3, p2, -p1, p0]])
         quaternions = principal_q @ right_product.T  # row-wise q ⊗ q(P), no Python loop over times
         body_momentum = principal_m @ p  # Pᵀ M_p for every row
-        return quaternions, (body_momentum / self._body._values) * RAD_PER_DAY
+        return quaternions, (body_momentum / self._body.moment_values) * RAD_PER_DAY
 
     def __repr__(self):
         omega = ", ".join(f"{w:.6g}" for w in self._omega)

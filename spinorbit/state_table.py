@@ -1,11 +1,11 @@
 """The output-table columns of many rotation states at once, with :class:`~spinorbit.RotationState`'s definitions.
 
-A run's table (:class:`spinorbit.scene.SceneResult`, :func:`spinorbit.coupling.one_way.propagate_one_way`)
+A run's table (:class:`spinorbit.scene.scene.SceneResult`, :func:`spinorbit.coupling.one_way.propagate_one_way`)
 reports for every row what the row's RotationState would: its unit quaternion, angular velocity,
 inertial momentum direction and, with "periods", the mode, E/E0, P_ψ and P_φ of its torque-free motion.
 Building one RotationState per row cost ~0.1 ms a row (validation, Quantities, one compiled call per
 property), far more than the exact flow behind it; here the columns come from array operations and
-one compiled loop (:func:`spinorbit.core.motion_summary.motion_summary_many`, the kernels the
+one compiled loop (:func:`spinorbit.core.free_motion.summary.motion_summary_many`, the kernels the
 properties themselves call).
 
 On a torque-free run mode, E/E0 and the periods are constants of the motion: ``motion=state`` takes
@@ -19,9 +19,9 @@ from __future__ import annotations
 import numpy as np
 from astropy import units as u
 
-from .core import motion_summary as _summary
-from .core.rotations import attitude_to_quat_many, quat_to_attitude_many
-from .state import MODE_NAMES, QUATERNION_NORM_TOLERANCE, InvalidStateError, RotationState
+from spinorbit.core.free_motion import summary as _summary
+from spinorbit.core.math.rotations import attitude_to_quat_many, quat_to_attitude_many
+from spinorbit.state import MODE_NAMES, QUATERNION_NORM_TOLERANCE, InvalidStateError, RotationState
 
 __all__ = ["from_principal", "table_columns"]
 
@@ -32,7 +32,7 @@ def from_principal(body, rows):
     What ``RotationState.from_matrix(body, Pᵀ R(q), Pᵀ ω)`` holds for each row (same quaternion
     representative: the largest component positive), for all rows at once.
     """
-    p = body._to_principal
+    p = body.to_principal
     rows = np.atleast_2d(np.asarray(rows, dtype=float))
     attitudes = np.matmul(p.T, quat_to_attitude_many(np.ascontiguousarray(rows[:, :4])))
     return attitude_to_quat_many(np.ascontiguousarray(attitudes)), rows[:, 4:] @ p
@@ -51,7 +51,7 @@ def _unit_quaternions(quaternions):
 
 def _motion_columns(body, omegas):
     """mode, E/E0, P_ψ, P_φ of every row's torque-free motion (the kernels of RotationState's properties)."""
-    momenta = np.ascontiguousarray((body._values * omegas) @ body._to_principal.T)  # P (I ω), row by row
+    momenta = np.ascontiguousarray((body.moment_values * omegas) @ body.to_principal.T)  # P (I ω), row by row
     if not np.all(np.any(momenta != 0.0, axis=1)):
         raise InvalidStateError("the body is not rotating (zero spin): it has no rotation mode or elements.")
     n = momenta.shape[0]
@@ -104,7 +104,7 @@ def table_columns(body, quaternions, omegas, omega=True, motion=None):
     columns = {"quaternion": quaternions}
     if omega:
         columns["omega"] = omegas * (u.rad / u.day)
-    inertial = np.einsum("nji,nj->ni", quat_to_attitude_many(np.ascontiguousarray(quaternions)), body._values * omegas)
+    inertial = np.einsum("nji,nj->ni", quat_to_attitude_many(np.ascontiguousarray(quaternions)), body.moment_values * omegas)
     columns["momentum_direction"] = inertial / np.linalg.norm(inertial, axis=1, keepdims=True)  # Rᵀ I ω / |…|
     if motion is None:
         return columns

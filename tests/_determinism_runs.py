@@ -12,13 +12,13 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from spinorbit.checkpoint import fingerprint
-from spinorbit.core.dynamics import make_model
-from spinorbit.core.integrate_elements import integrate_elements
-from spinorbit.core.integrate_quaternion import integrate_quaternion
-from spinorbit.core.integrate_splitting import integrate_splitting
-from spinorbit.core.perturbers import kepler_source
-from spinorbit.core.torque_free import torque_free_states_many
+from spinorbit.runs.checkpoint import fingerprint
+from spinorbit.core.dynamics.equations import make_model
+from spinorbit.core.integrators.elements import integrate_elements
+from spinorbit.core.integrators.quaternion import integrate_quaternion
+from spinorbit.core.integrators.splitting import integrate_splitting
+from spinorbit.core.model.perturbers import kepler_source
+from spinorbit.core.free_motion.flow import torque_free_states_many
 
 MOMENTS = (2.0 / 3.0, 1.0, 2.0)
 Y0 = np.array([0.9, 0.1, -0.3, 0.2, 0.6, 0.05, 0.5])

@@ -14,8 +14,8 @@ from __future__ import annotations
 import mpmath as mp
 import numpy as np
 
-from spinorbit.core import torque_free as tf
-from spinorbit.core.canonical import (
+from spinorbit.core.free_motion import flow as tf
+from spinorbit.core.elements.canonical import (
     FLIP_A,
     FLIP_B,
     FLIP_C,
@@ -24,7 +24,7 @@ from spinorbit.core.canonical import (
     flip_attitude,
     node_angles,
 )
-from spinorbit.core.rotations import quat_to_attitude
+from spinorbit.core.math.rotations import quat_to_attitude
 
 
 def secular_am(u, m):

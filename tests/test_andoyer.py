@@ -6,8 +6,8 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from spinorbit.core import andoyer
-from spinorbit.core import rotations as rot
+from spinorbit.core.elements import andoyer
+from spinorbit.core.math import rotations as rot
 
 ROUNDING = 1e-14  # a few ulp of quantities of order 1
 EPS = np.finfo(float).eps

@@ -1,9 +1,124 @@
-"""The fast core must never import the units layer or the integrations."""
+"""The layout rules of docs/architecture.md, checked on the source.
 
+Every rule reads the package's own import statements (module level and inside functions alike), so a
+new module is checked the day it is added:
+
+- the fast core never imports the units layer or the integrations (checked on a fresh interpreter);
+- each folder of the core imports only the folders below it, and the layer above the core keeps its
+  order (units bridge, long-run infrastructure, coupling, scene planning, data, command line);
+- no import circles between modules;
+- no module imports another module's private name (``from x import _y``);
+- old import paths answer with a DeprecationWarning and the very object of the new path.
+"""
+
+import ast
 import subprocess
 import sys
+from pathlib import Path
 
+import pytest
+
+PACKAGE = Path(__file__).resolve().parent.parent / "spinorbit"
 FORBIDDEN_IN_CORE = ("astropy", "skyfield", "rebound", "reboundx", "heyoka", "jplephem")
+
+#: The core's folders, lowest first: each may import only itself and those before it.
+CORE_LAYERS = ("math", "model", "dynamics", "elements", "free_motion", "integrators", "averaging")
+#: Core modules every core folder may use (numba settings, error types).
+CORE_BASE = ("spinorbit.core.jit", "spinorbit.core.errors")
+
+#: The layer above the core, lowest first (the core below them all).
+UPPER_LAYERS = (
+    ("bridge", ("spinorbit.body", "spinorbit.state", "spinorbit.state_table", "spinorbit.time",
+                "spinorbit.frames", "spinorbit.ephemeris", "spinorbit.special")),
+    ("runs", ("spinorbit.runs",)),
+    ("coupling", ("spinorbit.coupling",)),
+    ("scene", ("spinorbit.scene",)),
+    ("data", ("spinorbit.data",)),
+    ("command line", ("spinorbit.cli", "spinorbit.commands", "spinorbit.__main__")),
+)
+#: Modules every layer may import: the front door's lazy table and the old-path shims.
+ANYWHERE = ("spinorbit", "spinorbit.old_paths")
+
+# Still to mend in the reorganisation (issue 13); each entry is removed by the change that fixes it,
+# and the lists are deleted once empty.
+KNOWN_CIRCLES = [
+    ["spinorbit.coupling.long_run", "spinorbit.coupling.rigid_body"],
+    ["spinorbit.scene.many", "spinorbit.scene.scene"],
+]
+KNOWN_PRIVATE_CROSSINGS = [
+    "spinorbit.core.integrators.elements: from spinorbit.core.integrators.quaternion import _A",
+    "spinorbit.core.integrators.elements: from spinorbit.core.integrators.quaternion import _B",
+    "spinorbit.core.integrators.elements: from spinorbit.core.integrators.quaternion import _C",
+    "spinorbit.core.integrators.elements: from spinorbit.core.integrators.quaternion import _dense_polynomial",
+    "spinorbit.core.integrators.elements: from spinorbit.core.integrators.quaternion import _dense_rows",
+    "spinorbit.core.integrators.elements: from spinorbit.core.integrators.quaternion import _error_norm",
+    "spinorbit.core.integrators.elements: from spinorbit.core.integrators.quaternion import _extra_stage_input",
+    "spinorbit.core.integrators.handover: from spinorbit.core.integrators.elements import _SINGULAR",
+    "spinorbit.core.integrators.handover: from spinorbit.core.integrators.elements import _STATUS_MESSAGES",
+]
+KNOWN_LONG = [
+    "spinorbit.core.free_motion.flow",
+    "spinorbit.core.math.elliptic",
+    "spinorbit.coupling.rebound.adapter",
+    "spinorbit.scene.scene",
+]
+
+
+def _module_name(path):
+    parts = list(path.relative_to(PACKAGE.parent).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts = parts[:-1]
+    return ".".join(parts)
+
+
+def _imports(path):
+    """(imported module, imported names) of every import statement in ``path``, relative ones resolved."""
+    me = _module_name(path)
+    package = me if path.name == "__init__.py" else me.rsplit(".", 1)[0]
+    found = []
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.Import):
+            found += [(alias.name, ()) for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            module = node.module or ""
+            if node.level:
+                base = package.split(".")[: len(package.split(".")) - (node.level - 1)]
+                module = ".".join(base + ([module] if module else []))
+            found.append((module, tuple(alias.name for alias in node.names)))
+    return found
+
+
+MODULES = {_module_name(path): path for path in sorted(PACKAGE.rglob("*.py"))}
+
+
+def _internal_targets(module, names):
+    """The spinorbit modules an import statement loads: the module, or its submodules named in ``names``."""
+    if not (module == "spinorbit" or module.startswith("spinorbit.")):
+        return []
+    submodules = [f"{module}.{name}" for name in names if f"{module}.{name}" in MODULES]
+    return submodules or [module]
+
+
+def _edges():
+    return {
+        name: sorted({target for module, names in _imports(path) for target in _internal_targets(module, names)}
+                     - {name})
+        for name, path in MODULES.items()
+    }
+
+
+def _upper_layer(module):
+    for rank, (_, prefixes) in enumerate(UPPER_LAYERS):
+        if any(module == p or module.startswith(p + ".") for p in prefixes):
+            return rank
+    return None
+
+
+def _core_layer(module):
+    parts = module.split(".")
+    if len(parts) >= 3 and parts[2] in CORE_LAYERS:
+        return CORE_LAYERS.index(parts[2])
+    return None
 
 
 def test_core_imports_no_astropy_skyfield_or_rebound():
@@ -17,3 +132,151 @@ def test_core_imports_no_astropy_skyfield_or_rebound():
     )
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert result.stdout.strip() == "", f"spinorbit.core imported {result.stdout.strip()}"
+
+
+def test_every_core_module_is_in_a_layer():
+    loose = [m for m in MODULES if m.startswith("spinorbit.core.") and _core_layer(m) is None
+             and m not in CORE_BASE]
+    assert loose == [], f"core modules outside the layers {CORE_LAYERS}: {loose} (docs/architecture.md)"
+
+
+def test_core_folders_import_only_the_folders_below():
+    wrong = []
+    for module, targets in _edges().items():
+        layer = _core_layer(module)
+        if layer is None and module not in CORE_BASE:
+            continue
+        for target in targets:
+            if target in ANYWHERE or target in CORE_BASE or target == "spinorbit.core":
+                if target == "spinorbit.core":
+                    wrong.append(f"{module} -> {target} (import the owning module, not the lazy front door)")
+                continue
+            target_layer = _core_layer(target)
+            if target_layer is None or (layer is not None and target_layer > layer) or layer is None:
+                wrong.append(f"{module} -> {target}")
+    assert wrong == [], "core layer order violated (docs/architecture.md):\n" + "\n".join(wrong)
+
+
+def test_upper_layers_keep_their_order():
+    wrong = []
+    for module, targets in _edges().items():
+        if module.startswith("spinorbit.core") or module in ANYWHERE:
+            continue
+        layer = _upper_layer(module)
+        assert layer is not None, f"{module} is in no layer of UPPER_LAYERS: add it to docs/architecture.md and here"
+        for target in targets:
+            if target.startswith("spinorbit.core") or target in ANYWHERE:
+                continue
+            if _upper_layer(target) > layer:
+                wrong.append(f"{module} ({UPPER_LAYERS[layer][0]}) -> {target} ({UPPER_LAYERS[_upper_layer(target)][0]})")
+    assert wrong == [], "a lower layer imports a higher one (docs/architecture.md):\n" + "\n".join(wrong)
+
+
+def test_no_import_circles():
+    edges = _edges()
+    index, low, stack, on_stack, circles = {}, {}, [], set(), []
+
+    def visit(node):  # Tarjan's strongly connected components
+        index[node] = low[node] = len(index)
+        stack.append(node)
+        on_stack.add(node)
+        for target in edges.get(node, ()):
+            if target not in index:
+                visit(target)
+                low[node] = min(low[node], low[target])
+            elif target in on_stack:
+                low[node] = min(low[node], index[target])
+        if low[node] == index[node]:
+            component = []
+            while True:
+                member = stack.pop()
+                on_stack.discard(member)
+                component.append(member)
+                if member == node:
+                    break
+            if len(component) > 1:
+                circles.append(sorted(component))
+
+    for node in edges:
+        if node not in index:
+            visit(node)
+    circles = [c for c in circles if c not in KNOWN_CIRCLES]
+    assert circles == [], f"import circles: {circles}"
+
+
+def test_no_private_names_cross_modules():
+    crossings = []
+    for module, path in MODULES.items():
+        for target, names in _imports(path):
+            if not target.startswith("spinorbit"):
+                continue
+            for name in names:
+                if name.startswith("_") and not name.startswith("__") and f"{target}.{name}" not in MODULES:
+                    crossings.append(f"{module}: from {target} import {name}")
+    crossings = [c for c in crossings if c not in KNOWN_PRIVATE_CROSSINGS]
+    assert crossings == [], "private names imported across modules (make them public where they belong):\n" + \
+        "\n".join(crossings)
+
+
+def test_no_module_is_too_long():
+    # docs/architecture.md: ~600 lines at most, unless the module's docstring says why one concept needs more.
+    long = []
+    for module, path in MODULES.items():
+        lines = path.read_text().count("\n")
+        docstring = ast.get_docstring(ast.parse(path.read_text())) or ""
+        if lines > 650 and "one concept" not in docstring and module not in KNOWN_LONG:
+            long.append(f"{module}: {lines} lines")
+    assert long == [], "modules over the size rule without a reason in their docstring:\n" + "\n".join(long)
+
+
+def test_old_paths_warn_and_give_the_new_objects():
+    code = (
+        "import importlib, warnings\n"
+        "from spinorbit.old_paths import MOVED_MODULES, MOVED_NAMES\n"
+        "bad = []\n"
+        "for old, new in MOVED_MODULES.items():\n"
+        "    with warnings.catch_warnings(record=True) as caught:\n"
+        "        warnings.simplefilter('always')\n"
+        "        module = importlib.import_module(old)\n"
+        "    if not any(issubclass(w.category, DeprecationWarning) and old in str(w.message) for w in caught):\n"
+        "        bad.append(old + ': no DeprecationWarning')\n"
+        "    if len(new) == 1 and module is not importlib.import_module(new[0]):\n"
+        "        bad.append(old + ': not the new module')\n"
+        "print(len(MOVED_MODULES)); print('\\n'.join(bad))\n"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    count, *bad = result.stdout.strip().split("\n")
+    assert int(count) > 0
+    assert [b for b in bad if b] == []
+
+
+@pytest.mark.parametrize(
+    ("old", "name", "new"),
+    [
+        ("spinorbit.core.dynamics", "make_model", "spinorbit.core.dynamics.equations"),
+        ("spinorbit.core.integrate_quaternion", "integrate_quaternion", "spinorbit.core.integrators.quaternion"),
+        ("spinorbit.checkpoint", "Checkpoint", "spinorbit.runs.checkpoint"),
+    ],
+)
+def test_an_old_name_is_the_new_object(old, name, new):
+    code = (
+        "import importlib, warnings\n"
+        "warnings.simplefilter('error')\n"
+        f"new = getattr(importlib.import_module({new!r}), {name!r})\n"
+        "try:\n"
+        f"    exec('from {old} import {name} as old')\n"
+        "except DeprecationWarning as warning:\n"
+        "    print('warned:', warning)\n"
+        "warnings.simplefilter('ignore')\n"
+        f"exec('from {old} import {name} as old')\n"
+        "print(old is new)\n"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert "warned:" in result.stdout and result.stdout.strip().endswith("True"), result.stdout + result.stderr
+
+
+def test_core_entry_points_resolve():
+    import spinorbit.core as core
+
+    for name in core.__all__:
+        assert callable(getattr(core, name)), name

@@ -1,4 +1,4 @@
-"""One-way coupling and the asteroid examples' physics (``spinorbit.coupling.one_way``, ``spinorbit.asteroids``).
+"""One-way coupling and the asteroid examples' physics (``spinorbit.coupling.one_way``, ``spinorbit.data.asteroids``).
 
 Numbers quoted in comments were measured on this 2-core machine when the tests were written.
 """
@@ -11,7 +11,7 @@ from _offline import no_network  # noqa: F401
 from astropy import units as u
 from astropy.time import Time
 
-from spinorbit.asteroids import (
+from spinorbit.data.asteroids import (
     APOPHIS_2029,
     TOUTATIS_2004,
     TOUTATIS_EPOCH,
@@ -22,21 +22,20 @@ from spinorbit.asteroids import (
     encounter_state,
     toutatis_rotation_state,
 )
-from spinorbit.core.dynamics import make_model
-from spinorbit.core.integrate_quaternion import integrate_quaternion
-from spinorbit.core.perturbers import kepler_source, kepler_state
-from spinorbit.core.rotations import rotation_angle_between_many
+from spinorbit.core.dynamics.equations import make_model
+from spinorbit.core.integrators.quaternion import integrate_quaternion
+from spinorbit.core.model.perturbers import kepler_source, kepler_state
+from spinorbit.core.math.rotations import rotation_angle_between_many
 from spinorbit.coupling.one_way import (
     SampledPerturbers,
     _de421_state,
-    _to_core,
     de421_orbit,
     propagate_one_way,
     rebound_orbit,
     sample_from_ephemeris,
     sample_from_rebound,
 )
-from spinorbit.coupling.rebound_adapter import MissingBodyError, install_extra_forces
+from spinorbit.coupling.rebound.adapter import MissingBodyError, install_extra_forces
 from spinorbit.ephemeris import EphemerisRangeError, UnknownBodyError, de421_constants
 
 GM_SUN = de421_constants().gm["sun"]
@@ -93,7 +92,7 @@ def test_de421_sampled_sun_matches_kepler_sun(kepler_samples):
     """
     samples = kepler_samples
     state = apophis_rotation_state()
-    y0 = _to_core(state)
+    y0 = state.core_state()
     moments = state.body.principal_moments
     kepler_sun = kepler_source(GM_SUN, ORBIT["a"], ORBIT["e"], ORBIT["inc"], ORBIT["node"], ORBIT["argp"],
                                ORBIT["mean_anomaly"], sign=-1.0)

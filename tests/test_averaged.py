@@ -15,7 +15,7 @@ import pytest
 from scipy.special import ellipe, ellipk
 
 from benchmarks.scenes import scene_apophis, scene_toutatis
-from spinorbit.core.averaged import (
+from spinorbit.core.averaging.mean_equations import (
     POLHODE_POINTS,
     anomaly_position_xyz,
     degree2_mean_rhs,
@@ -25,12 +25,12 @@ from spinorbit.core.averaged import (
     polhode_mean_inertia,
     torus_mean_rhs,
 )
-from spinorbit.core.canonical import inertia_constants
-from spinorbit.core.dynamics import MODEL_PERTURBERS, make_model
-from spinorbit.core.perturbers import perturber_state
-from spinorbit.core.integrate_elements import elements_of_state
-from spinorbit.core.integrate_quaternion import integrate_quaternion
-from spinorbit.core.propagate_averaged import (
+from spinorbit.core.elements.canonical import inertia_constants
+from spinorbit.core.dynamics.equations import MODEL_PERTURBERS, make_model
+from spinorbit.core.model.perturbers import perturber_state
+from spinorbit.core.integrators.elements import elements_of_state
+from spinorbit.core.integrators.quaternion import integrate_quaternion
+from spinorbit.core.averaging.propagate import (
     INVALID_PERTURBATION,
     INVALID_RESONANCE,
     MAX_PERTURBATION,
@@ -44,7 +44,7 @@ from spinorbit.core.propagate_averaged import (
     true_anomaly_of_time,
     validity_code,
 )
-from spinorbit.core.short_period import mean_to_osculating, osculating_to_mean
+from spinorbit.core.averaging.short_period import mean_to_osculating, osculating_to_mean
 
 THRESHOLDS = np.array([MIN_FREQUENCY_RATIO, MAX_PERTURBATION, 1e-3])
 
@@ -119,8 +119,8 @@ def test_quadrature_average_of_ds_and_dz_momenta_rates_vanish():
     """⟨∂U/∂s⟩ and ⟨∂U/∂z⟩ over the torus (eq. 11's dS/dt, dZ/dt averaged) are zero: S and Z are
     constant in the mean. Checked on the raw grid average of eq. (11), not on the mean RHS (which
     sets them to zero); scale: the instantaneous |dS/dt| at the same point."""
-    from spinorbit.core.averaged import torus_frequencies
-    from spinorbit.core.element_forces import elements_rhs_into
+    from spinorbit.core.averaging.mean_equations import torus_frequencies
+    from spinorbit.core.elements.equations import elements_rhs_into
 
     scene, model = scaled_apophis(100.0)
     ic, frame, el = setup(scene, model)
@@ -193,7 +193,7 @@ def test_short_period_corrections_track_the_full_integration_with_error_quadrati
 def test_osculating_states_from_the_propagator_match_the_full_integration():
     """The propagator's own osculating output (q, ω) vs the full integration, torque × 10: attitude
     within 1e-5 rad over 30 days (measured 3e-6 rad: the slow-phase error ε² · Ω t)."""
-    from spinorbit.core.rotations import rotation_angle_between_many
+    from spinorbit.core.math.rotations import rotation_angle_between_many
 
     scene, model = scaled_apophis(10.0)
     t_out = np.linspace(1.0, 30.0, 6)
@@ -264,7 +264,7 @@ def test_close_flyby_hands_over_and_back():
 @pytest.mark.parametrize("make_scene", [scene_apophis, scene_toutatis], ids=["e=0.19", "e=0.63"])
 def test_true_anomaly_map_against_the_kepler_solver(make_scene):
     """The anomaly stepping's closed forms against the model's own Kepler-equation solution
-    (:func:`spinorbit.core.perturbers.perturber_state`) over ±3 orbits: the position at f(t) is the
+    (:func:`spinorbit.core.model.perturbers.perturber_state`) over ±3 orbits: the position at f(t) is the
     perturber's position at t, dt/df = r²/|r × v|, and t(f(t)) = t; all to rounding (1e-12 relative,
     1e-9 d on times of ~1e3 d)."""
     scene = make_scene()

@@ -2,7 +2,7 @@
 
 The reference below evaluates eqs. (4), (5), (7), (8) as printed (angle forms, with mpmath's elliptic
 functions and the reciprocal-modulus transformation for m > 1), while the implementation uses the
-body-momentum forms of ``spinorbit.core.canonical``: two different routes to the same numbers.
+body-momentum forms of ``spinorbit.core.elements.canonical``: two different routes to the same numbers.
 """
 
 import math
@@ -14,8 +14,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from spinorbit.core import SingularElementsError, andoyer_to_canonical, canonical_to_andoyer
-from spinorbit.core import canonical as cn
-from spinorbit.core import rotations as rot
+from spinorbit.core.elements import canonical as cn
+from spinorbit.core.math import rotations as rot
 
 from _mp_reference import secular_am, secular_pi
 

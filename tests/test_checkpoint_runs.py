@@ -15,19 +15,19 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from spinorbit.atomic import atomic_path, write_bytes_atomically
-from spinorbit.checkpoint import (
+from spinorbit.runs.atomic import atomic_path, write_bytes_atomically
+from spinorbit.runs.checkpoint import (
     Checkpoint,
     CheckpointError,
     CheckpointSchedule,
     RunStopped,
 )
-from spinorbit.core.dynamics import make_model
-from spinorbit.core.gravity_field import make_body
-from spinorbit.core.perturbers import kepler_source
-from spinorbit.coupling.chunked_run import integrate_to_outputs
+from spinorbit.core.dynamics.equations import make_model
+from spinorbit.core.model.gravity_field import make_body
+from spinorbit.core.model.perturbers import kepler_source
+from spinorbit.coupling.long_run import integrate_to_outputs
 from spinorbit.coupling.rigid_body import CoupledRigidBody
-from spinorbit.resumable import METHODS, integrate_resumable
+from spinorbit.runs.resumable import METHODS, integrate_resumable
 
 ROOT = Path(__file__).resolve().parent.parent
 MOMENTS = (2.0 / 3.0, 1.0, 2.0)
@@ -188,7 +188,7 @@ def _system_with_earlier_forces():
     body's combined force, and a checkpoint must carry them back."""
     import rebound
 
-    from spinorbit.coupling.rebound_adapter import install_extra_forces, set_nongravitational
+    from spinorbit.coupling.rebound.adapter import install_extra_forces, set_nongravitational
 
     sim = rebound.Simulation()
     sim.units = ("AU", "day", "Msun")

@@ -13,8 +13,10 @@ import pytest
 from _offline import no_network  # noqa: F401
 from astropy.table import Table
 
-from spinorbit import RigidBody, RotationState, cli
-from spinorbit.commands import _common, torque_free
+from spinorbit import cli
+from spinorbit import RigidBody, RotationState
+from spinorbit.commands import _common
+from spinorbit.commands import torque_free
 
 ROOT = Path(__file__).resolve().parents[1]
 

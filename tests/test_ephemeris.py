@@ -8,7 +8,7 @@ import pytest
 from _offline import no_network  # noqa: F401  (autouse socket guard)
 from astropy.time import Time
 
-from spinorbit.core.rotations import euler313_to_attitude, quat_to_attitude
+from spinorbit.core.math.rotations import euler313_to_attitude, quat_to_attitude
 from spinorbit.ephemeris import (
     DE421_SPAN_JD_TDB,
     KNOWN_BODIES,

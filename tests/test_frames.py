@@ -8,7 +8,7 @@ from _offline import no_network  # noqa: F401  (autouse socket guard)
 from astropy.coordinates import BarycentricMeanEcliptic, CartesianRepresentation, SkyCoord
 from astropy.time import Time
 
-from spinorbit.core.rotations import quat_to_attitude
+from spinorbit.core.math.rotations import quat_to_attitude
 from spinorbit.ephemeris import moon_orientation
 from spinorbit.frames import (
     OBLIQUITY_J2000,

@@ -6,25 +6,25 @@ import numpy as np
 import pytest
 
 from benchmarks.scenes import scene_apophis, scene_hlw, scene_toutatis
-from spinorbit.core.andoyer import attitude_from_andoyer
-from spinorbit.core.canonical import inertia_constants
-from spinorbit.core.dynamics import force_function_and_torque_xyz, make_model
-from spinorbit.core.element_forces import (
+from spinorbit.core.elements.andoyer import attitude_from_andoyer
+from spinorbit.core.elements.canonical import inertia_constants
+from spinorbit.core.dynamics.equations import force_function_and_torque_xyz, make_model
+from spinorbit.core.elements.equations import (
     andoyer_gradient_from_torque,
     elements_rhs_into,
     force_function_of_elements,
     reduce_phase,
 )
 from spinorbit.core.errors import SingularElementsError
-from spinorbit.core.integrate_elements import (
+from spinorbit.core.integrators.elements import (
     ElementsSingularityError,
     elements_of_state,
     integrate_elements,
     reference_frame_for,
 )
-from spinorbit.core.integrate_quaternion import integrate_quaternion
-from spinorbit.core.perturbers import fixed_source
-from spinorbit.core.rotations import attitude_to_quat, rotation_angle_between_many
+from spinorbit.core.integrators.quaternion import integrate_quaternion
+from spinorbit.core.model.perturbers import fixed_source
+from spinorbit.core.math.rotations import attitude_to_quat, rotation_angle_between_many
 
 #: Central differences with step 1e-5 on O(1) quantities: truncation ~1e-10 · U''', rounding
 #: ~1e-16/1e-5 = 1e-11; 1e-8 relative to the largest component leaves a wide margin for both.
@@ -106,7 +106,7 @@ def test_phase_reduction_keeps_the_state():
     reduced = el.copy()
     assert reduce_phase(reduced, ic) != 0
     assert abs(reduced[3]) < abs(el[3])
-    from spinorbit.core.element_forces import attitude_and_momentum
+    from spinorbit.core.elements.equations import attitude_and_momentum
 
     r1, m1 = attitude_and_momentum(el, ic)
     r2, m2 = attitude_and_momentum(reduced, ic)

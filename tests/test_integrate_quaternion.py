@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from spinorbit.core.dynamics import (
+from spinorbit.core.dynamics.equations import (
     MODEL_PERTURBERS,
     inertial_angular_momentum,
     make_model,
@@ -14,8 +14,8 @@ from spinorbit.core.dynamics import (
     scipy_rhs,
     total_energy,
 )
-from spinorbit.core.integrate_quaternion import integrate_fixed_step, integrate_quaternion
-from spinorbit.core.perturbers import (
+from spinorbit.core.integrators.quaternion import integrate_fixed_step, integrate_quaternion
+from spinorbit.core.model.perturbers import (
     PERTURBER_ROW,
     kepler_source,
     kepler_state,
@@ -23,7 +23,7 @@ from spinorbit.core.perturbers import (
     perturber_state,
     sampled_source,
 )
-from spinorbit.core.rotations import quat_multiply, rotation_angle_between
+from spinorbit.core.math.rotations import quat_multiply, rotation_angle_between
 
 #: Invariant drift allowed after ~100 rotations at rtol = 1e-12: the local error per step is ~1e-12
 #: relative and accumulates over ~1e4 steps in a random-walk-to-linear way.
@@ -190,7 +190,7 @@ def test_matches_heyoka_on_a_short_torqued_run():
 
 def test_hot_path_positions_match_diagnostic_states_for_every_kind():
     """perturber_position_xyz (scalars, inlined in the RHS) and perturber_state (arrays) agree."""
-    from spinorbit.core.perturbers import fixed_source
+    from spinorbit.core.model.perturbers import fixed_source
 
     sources = [kepler_source(1.0, 2.0, 0.4, 0.1, 0.2, 0.3, 0.4), kepler_source(1.0, -0.3, 5.0, 0.5, 0.6, 0.7, -2.0),
                fixed_source(2.0, [1.0, -2.0, 0.5])]

@@ -5,16 +5,16 @@ import math
 import numpy as np
 import pytest
 
-from spinorbit.core.dynamics import inertial_angular_momentum, make_model, rhs, total_energy
-from spinorbit.core.integrate_quaternion import IntegrationError, integrate_quaternion
-from spinorbit.core.integrate_taylor import (
+from spinorbit.core.dynamics.equations import inertial_angular_momentum, make_model, rhs, total_energy
+from spinorbit.core.integrators.quaternion import IntegrationError, integrate_quaternion
+from spinorbit.core.integrators.taylor import (
     TaylorFallbackWarning,
     integrate_taylor,
     integrate_taylor_fixed_step,
     taylor_series,
 )
-from spinorbit.core.perturbers import fixed_source, kepler_source, kepler_state, sampled_source
-from spinorbit.core.rotations import rotation_angle_between
+from spinorbit.core.model.perturbers import fixed_source, kepler_source, kepler_state, sampled_source
+from spinorbit.core.math.rotations import rotation_angle_between
 
 TRIAXIAL = (0.61, 0.965, 1.0)
 Y0 = np.array([0.9, 0.1, -0.3, 0.2, 0.4, -1.1, 2.3])

@@ -24,8 +24,8 @@ import numpy as np
 import pytest
 from _mp_reference import secular_am, secular_pi
 
-from spinorbit.core.andoyer import andoyer_from_attitude
-from spinorbit.core.canonical import (
+from spinorbit.core.elements.andoyer import andoyer_from_attitude
+from spinorbit.core.elements.canonical import (
     FLIP_B,
     MO_ARG_PER_S,
     elliptic_constants,
@@ -33,8 +33,8 @@ from spinorbit.core.canonical import (
     motion_from_elements,
     state_from_elements,
 )
-from spinorbit.core.elliptic import parameter_constants
-from spinorbit.core.jacobian import (
+from spinorbit.core.math.elliptic import parameter_constants
+from spinorbit.core.elements.jacobian import (
     ZERO_COMPONENTS,
     andoyer_jacobian,
     andoyer_jacobian_many,
@@ -109,7 +109,7 @@ def reference_working(big_s, big_z, s, moments):
 
 def reference_andoyer(elements, moments, cache):
     """(L, G, H, l, g, h) of the elements (eqs. 7–8); S < 0 through the B-flip (module docstring of
-    spinorbit.core.jacobian). ``cache`` memoizes the elliptic part on (S, Z, s)."""
+    spinorbit.core.elements.jacobian). ``cache`` memoizes the elliptic part on (S, Z, s)."""
     big_s, big_z, big_h, s, z, h = elements
     sense = -1 if big_s < 0 else 1
     key = (big_s, big_z, s)

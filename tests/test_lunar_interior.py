@@ -1,13 +1,13 @@
-"""The mantle-and-core pieces of spinorbit.core.lunar_interior against independent formulas."""
+"""The mantle-and-core pieces of spinorbit.core.model.lunar_interior against independent formulas."""
 
 import numpy as np
 import pytest
 
-from spinorbit.core import lunar_interior as li
-from spinorbit.core.dynamics import MODEL_PERTURBERS, make_model, rhs
-from spinorbit.core.integrate_quaternion import integrate_quaternion
-from spinorbit.core.perturbers import sampled_source
-from spinorbit.core.rotations import quat_to_attitude
+from spinorbit.core.model import lunar_interior as li
+from spinorbit.core.dynamics.equations import MODEL_PERTURBERS, make_model, rhs
+from spinorbit.core.integrators.quaternion import integrate_quaternion
+from spinorbit.core.model.perturbers import sampled_source
+from spinorbit.core.math.rotations import quat_to_attitude
 
 PAIRS = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
 

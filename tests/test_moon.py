@@ -145,7 +145,7 @@ def test_long_span_attitude_against_de421(model, years):
 
 def test_checkpoints_are_refused_for_the_de421_model(tmp_path):
     """The one entry point dispatches checkpoints to the coupled models only; de421 says so at once."""
-    from spinorbit.checkpoint import CheckpointSchedule
+    from spinorbit.runs.checkpoint import CheckpointSchedule
     from spinorbit.coupling.moon import compare_model_with_de421
 
     with pytest.raises(ValueError, match="checkpoints apply to the REBOUND-coupled models"):

@@ -1,4 +1,4 @@
-"""spinorbit.coupling.rebound_adapter: offline DE421 simulations, raw-pointer forces, perturbers."""
+"""spinorbit.coupling.rebound.adapter: offline DE421 simulations, raw-pointer forces, perturbers."""
 
 import numpy as np
 import pytest
@@ -6,7 +6,7 @@ import rebound
 from _offline import no_network  # noqa: F401  (autouse socket guard)
 from astropy.time import Time
 
-from spinorbit.coupling.rebound_adapter import (
+from spinorbit.coupling.rebound.adapter import (
     DEFAULT_BODIES,
     ForceInstallError,
     MissingBodyError,
@@ -217,7 +217,7 @@ def test_nongravitational_needs_installed_forces_and_a_real_body():
 
 def test_reinstalled_forces_carry_every_parameter():
     """A rebuilt copy (the one-way sampler's route) integrates bit-for-bit like the original."""
-    from spinorbit.coupling.rebound_adapter import reinstall_extra_forces
+    from spinorbit.coupling.rebound.adapter import reinstall_extra_forces
 
     original = _sun_and_circular_body()
     set_nongravitational(original, "Body", 1e-6, -3e-7, 2e-7)
@@ -255,7 +255,7 @@ def _three_bodies(integrator, **settings):
     ("ias15", {"epsilon": 1e-5, "adaptive_mode": "global", "min_dt": 1e-4}, True),
 ])
 def test_a_rebuilt_copy_integrates_bit_for_bit_like_the_original(integrator, settings, warm):
-    """The one-way sampler's copies (``one_way._Snapshot``) keep every integrator setting (and state).
+    """The one-way sampler's copies (``one_way.SimulationSnapshot``) keep every integrator setting (and state).
 
     The old copy (particles, G, integrator name) ran BS at the default eps 1e-8 and IAS15 at epsilon
     1e-9. IAS15 is also copied mid-run (dt and its predictor are in REBOUND's binary). BS mid-run is
@@ -263,12 +263,12 @@ def test_a_rebuilt_copy_integrates_bit_for_bit_like_the_original(integrator, set
     copy's first step resets ``first_or_last_step`` (also with ``sim.copy()``); copied at day 10.3,
     measured 3.5e-14 au apart at day 40 (docs/coupling.md).
     """
-    from spinorbit.coupling.one_way import _Snapshot
+    from spinorbit.coupling.one_way import SimulationSnapshot
 
     original = _three_bodies(integrator, **settings)
     if warm:
         original.integrate(10.3)
-    copy = _Snapshot.of(original).build()
+    copy = SimulationSnapshot.of(original).build()
     for name, value in settings.items():
         assert getattr(copy.integrator, name) == getattr(original.integrator, name)
     for t in (11.0, 17.5, 40.0):
@@ -282,9 +282,9 @@ def test_a_rebuilt_copy_integrates_bit_for_bit_like_the_original(integrator, set
 def test_a_copy_keeps_the_forces_folded_into_a_rigid_body_and_refuses_foreign_ones():
     """A simulation with a body attached holds its earlier extra forces in the body's combined force:
     a copy must still carry them (the old copy saw no ExtraForces handle and dropped them)."""
-    from spinorbit.core.gravity_field import make_body
-    from spinorbit.coupling.one_way import _Snapshot
-    from spinorbit.coupling.rebound_adapter import _P_NG_BODY
+    from spinorbit.core.model.gravity_field import make_body
+    from spinorbit.coupling.one_way import SimulationSnapshot
+    from spinorbit.coupling.rebound.adapter import _P_NG_BODY
     from spinorbit.coupling.rigid_body import CoupledRigidBody
 
     plain, with_body = _three_bodies("bs"), _three_bodies("bs")
@@ -292,7 +292,7 @@ def test_a_copy_keeps_the_forces_folded_into_a_rigid_body_and_refuses_foreign_on
     plain.particles["Body"].m = 1e-18
     CoupledRigidBody(with_body, "Body", make_body((4e-35, 5e-35, 6e-35), mass=1e-18), [1, 0, 0, 0, 0, 0, 1.0],
                      coupled=False)
-    copies = [_Snapshot.of(sim).build() for sim in (plain, with_body)]
+    copies = [SimulationSnapshot.of(sim).build() for sim in (plain, with_body)]
     for copy in copies:
         copy.integrate(30.0)
     assert copies[0].particles["Body"].xyz == copies[1].particles["Body"].xyz
@@ -302,4 +302,4 @@ def test_a_copy_keeps_the_forces_folded_into_a_rigid_body_and_refuses_foreign_on
     foreign.add(m=1.0, name="Sun")
     foreign.additional_forces = lambda simulation: None
     with pytest.raises(ForceInstallError, match="did not install"):
-        _Snapshot.of(foreign)
+        SimulationSnapshot.of(foreign)

@@ -1,4 +1,4 @@
-"""The closed-form free flow of axisymmetric bodies (``spinorbit.core.regular_precession``).
+"""The closed-form free flow of axisymmetric bodies (``spinorbit.core.free_motion.regular_precession``).
 
 Two independent references:
 
@@ -18,9 +18,9 @@ import numpy as np
 import pytest
 
 from _heyoka_reference import rotation_angle
-from spinorbit.core.regular_precession import NO_SYMMETRY_AXIS, symmetry_axis
-from spinorbit.core.rotations import quat_to_attitude
-from spinorbit.core.torque_free import torque_free_attitudes, torque_free_states, torque_free_states_many
+from spinorbit.core.free_motion.regular_precession import NO_SYMMETRY_AXIS, symmetry_axis
+from spinorbit.core.math.rotations import quat_to_attitude
+from spinorbit.core.free_motion.flow import torque_free_attitudes, torque_free_states, torque_free_states_many
 
 # Against the 40-digit Euler-angle reference: what is left is the rounding of the quaternion products
 # q_L ⊗ q0 ⊗ q_R, of the inertial direction n and of the reduced half angles (bounded, a few ε); no

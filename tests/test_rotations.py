@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from spinorbit.core import rotations as rot
+from spinorbit.core.math import rotations as rot
 
 # Double-precision rotations of unit vectors: every check below is a few ulp of 1.
 ROUNDING = 1e-14

@@ -1,4 +1,4 @@
-"""Scenes and their planner (``spinorbit.scene``, ``spinorbit.planner``).
+"""Scenes and their planner (``spinorbit.scene.scene``, ``spinorbit.scene.planner``).
 
 Every skip is checked both ways — taken when it should be, not taken when it should not — and every
 skipped run is compared with the full run of the same scene (``Scene.plan(skip=False)``: all
@@ -17,20 +17,20 @@ from astropy import units as u
 from astropy.time import Time
 
 from spinorbit import RigidBody, RotationState
-from spinorbit.asteroids import (
+from spinorbit.data.asteroids import (
     APOPHIS_2029,
     apophis_encounter_simulation,
     apophis_rotation_state,
 )
-from spinorbit.core.gravity_field import make_body
-from spinorbit.core.rotations import attitude_to_quat, quat_to_attitude
-from spinorbit.coupling.rebound_adapter import MissingBodyError, simulation_from_de421
+from spinorbit.core.model.gravity_field import make_body
+from spinorbit.core.math.rotations import attitude_to_quat, quat_to_attitude
+from spinorbit.coupling.rebound.adapter import MissingBodyError, simulation_from_de421
 from spinorbit.coupling.rigid_body import CoupledRigidBody
 from spinorbit.ephemeris import UnknownBodyError, de421_constants, moon_orientation
-from spinorbit.planner import ARCSEC_PER_RAD, Plan, attitude_sensitivity
-from spinorbit.core.perturbers import kepler_source
+from spinorbit.scene.planner import ARCSEC_PER_RAD, Plan, attitude_sensitivity
+from spinorbit.core.model.perturbers import kepler_source
 from spinorbit.coupling.one_way import propagate_one_way
-from spinorbit.scene import EphemerisPerturber, FixedPerturber, Orbit, PlanError, Scene, SceneError, _angles, _NoSamples
+from spinorbit.scene.scene import EphemerisPerturber, FixedPerturber, Orbit, PlanError, Scene, SceneError, _angles, _NoSamples
 from spinorbit.time import tdb_days
 
 EPOCH = Time("2020-01-01", scale="tdb")
@@ -221,9 +221,9 @@ def test_worst_attitude_bound_kept_where_the_free_motion_bound_does_not_apply():
 
 def test_inertial_torques_along_is_the_rotated_body_torque():
     # The planner's torque along a history is M(q) times the one torque definition (total_torque).
-    from spinorbit.core.dynamics import inertial_torques_along, make_model, total_torque
-    from spinorbit.core.perturbers import fixed_source
-    from spinorbit.core.rotations import quat_to_matrix
+    from spinorbit.core.dynamics.equations import inertial_torques_along, make_model, total_torque
+    from spinorbit.core.model.perturbers import fixed_source
+    from spinorbit.core.math.rotations import quat_to_matrix
 
     model = make_model((0.61, 0.965, 1.0), [fixed_source(1e-7, np.array([0.3, 0.5, 0.8]))])
     rng = np.random.default_rng(7)
@@ -738,10 +738,9 @@ def test_auto_takes_taylor_while_the_knots_are_few_against_the_rotation_steps(pe
     # Measured: rotation steps 334 estimated, 330 free over the whole span; knots estimated / true:
     # 48 / 40 (300 d moonlet: Taylor, 344 steps torqued) and 6006 / 8582 (2.1 d: DOP853; Taylor would take
     # 8583 steps). The bounds below leave a factor 2 for the estimate, 20 % for the probe's scaling.
-    from spinorbit.core.dynamics import make_model
-    from spinorbit.core.integrate_taylor import integrate_taylor
-    from spinorbit.coupling.one_way import _to_core
-    from spinorbit.scene import TAYLOR_KNOT_SHARE, _first_tolerance
+    from spinorbit.core.dynamics.equations import make_model
+    from spinorbit.core.integrators.taylor import integrate_taylor
+    from spinorbit.scene.scene import TAYLOR_KNOT_SHARE, _first_tolerance
 
     scene = moonlet_scene(period)
     plan = scene.plan()
@@ -758,7 +757,7 @@ def test_auto_takes_taylor_while_the_knots_are_few_against_the_rotation_steps(pe
     days = np.unique(np.concatenate([s.days for s in samples]))
     true_knots = np.count_nonzero((days > t0) & (days < t1))
     assert 0.5 * true_knots <= knots <= 2.0 * true_knots + 2
-    y0 = _to_core(scene.state)
+    y0 = scene.state.core_state()
     _, free = integrate_taylor(y0, t0, [t1], make_model(scene.state.body.principal_moments), tol=tol, return_stats=True)
     assert free["steps"] == pytest.approx(steps, rel=0.2)
     # The premise: every knot ends a Taylor step.

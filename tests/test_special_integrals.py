@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 import _elliptic_reference as ref
 from _elliptic_reference import exact_parameter, relative_error
 from spinorbit import special
-from spinorbit.core import elliptic as kernels
+from spinorbit.core.math import elliptic as kernels
 
 pytestmark = pytest.mark.validation
 

@@ -12,7 +12,7 @@ import pytest
 from astropy import units as u
 
 from spinorbit import RigidBody, RotationState
-from spinorbit.core.rotations import quat_to_attitude
+from spinorbit.core.math.rotations import quat_to_attitude
 from spinorbit.state import InvalidStateError
 from spinorbit.state_table import from_principal, table_columns
 
@@ -122,9 +122,9 @@ def test_one_way_table_rows_are_their_rotation_states_and_osculate():
     """Under a torque the mode, E/E0 and periods of each row are that row's own (osculating) values."""
     from astropy.time import Time
 
-    from spinorbit.core.perturbers import fixed_source
+    from spinorbit.core.model.perturbers import fixed_source
     from spinorbit.coupling.one_way import propagate_one_way
-    from spinorbit.scene import _NoSamples
+    from spinorbit.scene.scene import _NoSamples
     from spinorbit.time import tdb_days
 
     state = STATES[0][1]

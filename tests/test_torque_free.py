@@ -14,8 +14,8 @@ import pytest
 
 from _heyoka_reference import propagate, rotation_angle
 from _mp_reference import exact_states
-from spinorbit.core.canonical import MODE_LAM, MODE_SAM, MODE_UNIFORM
-from spinorbit.core.torque_free import (
+from spinorbit.core.elements.canonical import MODE_LAM, MODE_SAM, MODE_UNIFORM
+from spinorbit.core.free_motion.flow import (
     FL_MODE,
     FL_PERIOD_HI,
     FL_RATE_HI,
@@ -25,7 +25,7 @@ from spinorbit.core.torque_free import (
     torque_free_states,
     torque_free_states_many,
 )
-from spinorbit.core.rotations import quat_to_attitude
+from spinorbit.core.math.rotations import quat_to_attitude
 
 # Goal of the long-span work: attitude error after 1e4 rotation periods (rad). Measured against
 # heyoka long double, the difference is heyoka's own drift (its energy random-walks at ~1e-18; the

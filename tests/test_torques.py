@@ -7,14 +7,14 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from spinorbit.core.dynamics import (
+from spinorbit.core.dynamics.equations import (
     force_function,
     make_model,
     rhs,
     total_energy,
     total_torque,
 )
-from spinorbit.core.gravity_field import (
+from spinorbit.core.model.gravity_field import (
     degree2_torque_closed_form,
     figure_force_function_and_gradient,
     figure_torque,
@@ -24,7 +24,7 @@ from spinorbit.core.gravity_field import (
     stokes_force_function_and_gradient,
     unnormalize_stokes,
 )
-from spinorbit.core.perturbers import (
+from spinorbit.core.model.perturbers import (
     fixed_source,
     hermite_state,
     kepler_source,
@@ -36,7 +36,7 @@ from spinorbit.core.perturbers import (
     solve_kepler_elliptic,
     solve_kepler_hyperbolic,
 )
-from spinorbit.core.rotations import quat_normalize
+from spinorbit.core.math.rotations import quat_normalize
 
 # Central differences with step h have truncation error ~h²·U''' and rounding ~ε·U/h; h = 1e-5 of
 # the length scale balances them at ~1e-10 relative.

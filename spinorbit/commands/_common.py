@@ -7,7 +7,7 @@ import os
 import sys
 import time
 
-from ..cli import CommandError
+from spinorbit.cli import CommandError
 
 #: Seconds a run must take before the progress bar shows itself.
 PROGRESS_DELAY_S = 2.0
@@ -80,11 +80,11 @@ def check_outputs(args) -> None:
 def atomic_output(option: str, path: str):
     """Yield a temporary path next to ``path``; on success move it into place, on failure delete it.
 
-    :func:`spinorbit.atomic.atomic_path` with the command line's error wording: readers never see a
+    :func:`spinorbit.runs.atomic.atomic_path` with the command line's error wording: readers never see a
     half-written file, a failed run leaves nothing behind, and an ``OSError`` becomes a
     :class:`~spinorbit.cli.CommandError` that names the option and the path.
     """
-    from ..atomic import atomic_path
+    from spinorbit.runs.atomic import atomic_path
 
     try:
         with atomic_path(path) as temporary:

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from ..cli import CommandError
-from ._common import Progress, atomic_output, quantity
+from spinorbit.cli import CommandError
+from spinorbit.commands._common import Progress, atomic_output, quantity
 
 #: Most output times a command accepts (each row builds a RotationState for the periods).
 MAX_TIMES = 100_000
@@ -85,7 +85,7 @@ def run_scene(scene, args):
 
 def run_and_report(args, state, start, times, orbit, name: str, title: str, period_unit: str) -> int:
     """Build the Scene from the shared options, run it (or print its plan), print the summary, write files."""
-    from ..scene import Scene
+    from spinorbit.scene.scene import Scene
 
     scene = Scene(state, start, times, perturbers=tuple(args.perturbers), orbit=orbit, tolerance=tolerance(args))
     result = run_scene(scene, args)
@@ -125,7 +125,7 @@ def ecsv_table(result, name: str, period_unit: str):
     import astropy.units as u
     from astropy.table import Table
 
-    from .. import __version__
+    from spinorbit import __version__
 
     qtable = result.table
     table = Table(meta={

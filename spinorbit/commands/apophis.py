@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from ._common import check_outputs
-from ._scene_command import (
+from spinorbit.commands._common import check_outputs
+from spinorbit.commands._scene_command import (
     add_scene_arguments,
     run_and_report,
     span_and_times,
@@ -48,12 +48,12 @@ def run(args) -> int:
     """Run ``spinorbit apophis``; return the exit status."""
     import astropy.units as u
 
-    from ..asteroids import (
+    from spinorbit.data.asteroids import (
         APOPHIS_2029,
         apophis_encounter_simulation,
         apophis_rotation_state,
     )
-    from ..scene import Orbit
+    from spinorbit.scene.scene import Orbit
 
     check_outputs(args)
     days = span_and_times(args, APOPHIS_2029.time_tdb, MAX_SPAN_DAYS)[0].to_value(u.day)

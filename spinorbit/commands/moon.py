@@ -7,8 +7,8 @@ import math
 import os
 import sys
 
-from ..cli import CommandError
-from ._common import Progress, atomic_output, check_output_path, check_outputs, quantity
+from spinorbit.cli import CommandError
+from spinorbit.commands._common import Progress, atomic_output, check_output_path, check_outputs, quantity
 
 #: The models (spinorbit.coupling.moon.MOON_MODELS, repeated so that --help does not import REBOUND).
 MOON_MODELS = ("de421", "rigid", "core-corrected")
@@ -76,7 +76,7 @@ def libration_table(comparison, model: str, coupled: bool):
     import numpy as np
     from astropy.table import Table
 
-    from .. import __version__
+    from spinorbit import __version__
 
     table = Table(meta={
         "software": f"spinorbit {__version__} moon",
@@ -103,7 +103,7 @@ def plot_comparison(comparison, path: str, title: str) -> None:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from ..coupling.moon import ARCSEC_PER_RAD
+    from spinorbit.coupling.moon import ARCSEC_PER_RAD
 
     years = (comparison.times - comparison.times[0]) / 365.25
     figure = Figure(figsize=(9, 7), layout="constrained")
@@ -129,7 +129,7 @@ def plot_comparison(comparison, path: str, title: str) -> None:
 
 def _checkpoint_schedule(args, span_days: float, step_days: float):
     """The checkpoint schedule of ``--checkpoint``/``--resume`` and the settings a resume must match."""
-    from ..checkpoint import CheckpointSchedule
+    from spinorbit.runs.checkpoint import CheckpointSchedule
 
     settings = {"command": NAME, "model": args.model, "coupled": not args.one_way, "span_days": span_days,
                 "step_days": step_days}
@@ -147,7 +147,7 @@ def _checkpoint_schedule(args, span_days: float, step_days: float):
 
 def run(args) -> int:
     """Run ``spinorbit moon``; return the exit status."""
-    from ..coupling.moon import compare_model_with_de421
+    from spinorbit.coupling.moon import compare_model_with_de421
 
     check_outputs(args)
     span = quantity("--span", args.span, "d", "time", "1 yr")

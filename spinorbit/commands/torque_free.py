@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 import math
 
-from ..cli import CommandError
-from ._common import Progress, atomic_output, check_output_path, quantity, unit
+from spinorbit.cli import CommandError
+from spinorbit.commands._common import Progress, atomic_output, check_output_path, quantity, unit
 
 NAME = "torque-free"
 SUMMARY = "exact torque-free rotation for given moments of inertia and spin"
@@ -114,7 +114,7 @@ def _offsets(args):
 def _state(args):
     import astropy.units as u
 
-    from .. import InvalidBodyError, RigidBody, RotationState
+    from spinorbit import InvalidBodyError, RigidBody, RotationState
 
     omega_unit = unit("--omega-unit", args.omega_unit, "angular velocity", "deg/day or rad/s")
     if not any(args.omega):
@@ -169,7 +169,7 @@ def _table(args, state, offsets, quaternions, omegas, omega_unit):
     import astropy.units as u
     from astropy.table import Table
 
-    from .. import __version__
+    from spinorbit import __version__
 
     p_psi, p_phi = state.periods
     table = Table(meta={

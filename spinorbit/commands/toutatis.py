@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from ._common import check_outputs
-from ._scene_command import (
+from spinorbit.commands._common import check_outputs
+from spinorbit.commands._scene_command import (
     add_scene_arguments,
     run_and_report,
     span_and_times,
@@ -43,13 +43,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args) -> int:
     """Run ``spinorbit toutatis``; return the exit status."""
-    from ..asteroids import (
+    from spinorbit.data.asteroids import (
         TOUTATIS_2004,
         TOUTATIS_EPOCH,
         encounter_simulation,
         toutatis_rotation_state,
     )
-    from ..scene import Orbit
+    from spinorbit.scene.scene import Orbit
 
     check_outputs(args)
     start = TOUTATIS_EPOCH.tdb

@@ -1,22 +1,58 @@
 """The fast core: plain floats, numpy and numba only.
 
-Nothing under ``spinorbit.core`` imports astropy, skyfield or rebound (a test enforces this), so the
-core can be called from numba-compiled loops and from REBOUND callbacks without Python overhead.
+Nothing under ``spinorbit.core`` imports astropy, skyfield or rebound (``tests/test_architecture.py``
+enforces it), so the core can be called from numba-compiled loops and from REBOUND callbacks without
+Python overhead. Its folders are layers, each importing only the ones before it
+(``docs/architecture.md``): ``math`` → ``model`` → ``dynamics`` → ``elements`` → ``free_motion`` →
+``integrators`` → ``averaging``.
 
-Paper-named entry points: :func:`andoyer_to_canonical` (Fukushima eq. 4) and
-:func:`canonical_to_andoyer` (eqs. 7–8); the exact torque-free flow (eq. 12) of one or many states:
-:func:`torque_free_states`, :func:`torque_free_states_many`.
+The stable entry points, importable from here (scripts written against them keep working):
+
+- the paper's maps :func:`andoyer_to_canonical` (Fukushima eq. 4) and :func:`canonical_to_andoyer`
+  (eqs. 7–8);
+- the exact torque-free flow (eq. 12) of one or many states: :func:`torque_free_states`,
+  :func:`torque_free_states_many`;
+- the model builder :func:`make_model` and the perturber sources :func:`fixed_source`,
+  :func:`kepler_source`, :func:`sampled_source`, :func:`sampled_source_from_callable`;
+- each integrator: :func:`integrate_quaternion`, :func:`integrate_elements`, :func:`integrate_taylor`,
+  :func:`integrate_splitting`, :func:`integrate_with_handover`, :func:`propagate_averaged`;
+- the errors :class:`SpinorbitError` and :class:`SingularElementsError`.
+
+They load on first use (PEP 562), so importing one integrator does not import the others.
 """
 
-from .elements import andoyer_to_canonical, canonical_to_andoyer
-from .errors import SingularElementsError, SpinorbitError
-from .torque_free import torque_free_states, torque_free_states_many
+import importlib
 
-__all__ = [
-    "andoyer_to_canonical",
-    "canonical_to_andoyer",
-    "torque_free_states",
-    "torque_free_states_many",
-    "SingularElementsError",
-    "SpinorbitError",
-]
+_ENTRY_POINTS = {
+    "andoyer_to_canonical": "spinorbit.core.elements.paper_maps",
+    "canonical_to_andoyer": "spinorbit.core.elements.paper_maps",
+    "torque_free_states": "spinorbit.core.free_motion.flow",
+    "torque_free_states_many": "spinorbit.core.free_motion.flow",
+    "make_model": "spinorbit.core.dynamics.equations",
+    "fixed_source": "spinorbit.core.model.perturbers",
+    "kepler_source": "spinorbit.core.model.perturbers",
+    "sampled_source": "spinorbit.core.model.perturbers",
+    "sampled_source_from_callable": "spinorbit.core.model.perturbers",
+    "integrate_quaternion": "spinorbit.core.integrators.quaternion",
+    "integrate_elements": "spinorbit.core.integrators.elements",
+    "integrate_taylor": "spinorbit.core.integrators.taylor",
+    "integrate_splitting": "spinorbit.core.integrators.splitting",
+    "integrate_with_handover": "spinorbit.core.integrators.handover",
+    "propagate_averaged": "spinorbit.core.averaging.propagate",
+    "SpinorbitError": "spinorbit.core.errors",
+    "SingularElementsError": "spinorbit.core.errors",
+}
+
+__all__ = list(_ENTRY_POINTS)
+
+
+def __getattr__(name):
+    if name in _ENTRY_POINTS:
+        value = getattr(importlib.import_module(_ENTRY_POINTS[name]), name)
+        globals()[name] = value  # later look-ups skip this function
+        return value
+    raise AttributeError(f"module 'spinorbit.core' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(__all__)

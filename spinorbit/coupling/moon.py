@@ -17,7 +17,7 @@ compiled force), plus the lunar figure's back-reaction (fully coupled). Figure (
 - model ``"de421"`` (:func:`compare_interior_with_de421`): DE421's own lunar rotation model —
   mantle with tidal and rotational distortion (k2M, TAUM), fluid core with its own angular velocity
   (IFAC, COBLAT, KVC), Earth J2 acting on the lunar figure — driven one-way by DE421's orbits and
-  started from DE421's published initial conditions (JDEPOC; ``spinorbit.core.lunar_interior``).
+  started from DE421's published initial conditions (JDEPOC; ``spinorbit.core.model.lunar_interior``).
 
 Units: au (DE421), TDB days since J2000, masses GM/G ("AU", "day", "Msun"), ω in rad/day.
 """
@@ -31,27 +31,27 @@ from dataclasses import dataclass
 import numpy as np
 from astropy.time import Time
 
-from ..core.dynamics import MODEL_PERTURBERS
-from ..core.gravity_field import make_body
-from ..core.integrate_quaternion import integrate_quaternion
-from ..core.lunar_interior import make_interior_block
-from ..core.perturbers import pack_perturbers
-from ..core.rotations import (
+from spinorbit.core.dynamics.equations import MODEL_PERTURBERS
+from spinorbit.core.model.gravity_field import make_body
+from spinorbit.core.integrators.quaternion import integrate_quaternion
+from spinorbit.core.model.lunar_interior import make_interior_block
+from spinorbit.core.model.perturbers import pack_perturbers
+from spinorbit.core.math.rotations import (
     attitude_to_euler313,
     quat_to_attitude,
     quat_to_attitude_many,
 )
-from ..ephemeris import (
+from spinorbit.ephemeris import (
     de421_constants,
     earth_from_moon_au,
     moon_libration_angles_raw,
     moon_orientation_raw,
 )
-from ..time import J2000_JD_TDB, tdb_day_and_fraction, time_from_tdb_days
-from .one_way import de421_orbit, sample_from_ephemeris, sample_relative_states
-from .chunked_run import integrate_to_outputs
-from .rebound_adapter import DEFAULT_BODIES, simulation_from_de421
-from .rigid_body import CoupledRigidBody
+from spinorbit.time import J2000_JD_TDB, tdb_day_and_fraction, time_from_tdb_days
+from spinorbit.coupling.one_way import de421_orbit, sample_from_ephemeris, sample_relative_states
+from spinorbit.coupling.long_run import integrate_to_outputs
+from spinorbit.coupling.rebound.adapter import DEFAULT_BODIES, simulation_from_de421
+from spinorbit.coupling.rigid_body import CoupledRigidBody
 
 __all__ = [
     "ARCSEC_PER_RAD",
@@ -223,7 +223,7 @@ def compare_with_de421(moon: CoupledRigidBody, span_days: float, step_days: floa
     progress : callable, optional
         Called with the number of output times done.
     schedule, resume, settings
-        Checkpoints (:func:`spinorbit.coupling.chunked_run.integrate_to_outputs`): each output time
+        Checkpoints (:func:`spinorbit.coupling.long_run.integrate_to_outputs`): each output time
         is a chunk; an interrupted run resumed from its checkpoint ends with the same bits.
 
     Returns
@@ -301,7 +301,7 @@ def interior_model(start_day, end_day, perturbers=INTERIOR_PERTURBERS,
     -------
     ndarray
         [figure (DE421 total moments, degrees 2–4), sampled perturbers, interior block]; integrate
-        a 10-component state (q, ω, ω_c) with :func:`spinorbit.core.integrate_quaternion.integrate_quaternion`.
+        a 10-component state (q, ω, ω_c) with :func:`spinorbit.core.integrators.quaternion.integrate_quaternion`.
     """
     perturbers = tuple(p.lower() for p in perturbers)
     if perturbers[:2] != ("earth", "sun"):

@@ -2,10 +2,10 @@
 
 The rotating body's translational motion and its perturbers' positions come from outside (DE421 for
 the planets, a user ephemeris or a REBOUND run for the body). They are sampled once, onto an
-adaptive time grid, into cubic-Hermite :func:`spinorbit.core.perturbers.sampled_source` s; the
+adaptive time grid, into cubic-Hermite :func:`spinorbit.core.model.perturbers.sampled_source` s; the
 rotation is then integrated entirely in numba by
-:func:`spinorbit.core.integrate_quaternion.integrate_quaternion` (or the Taylor method,
-:func:`spinorbit.core.integrate_taylor.integrate_taylor`, or the canonical elements). Neglecting the back-reaction is
+:func:`spinorbit.core.integrators.quaternion.integrate_quaternion` (or the Taylor method,
+:func:`spinorbit.core.integrators.taylor.integrate_taylor`, or the canonical elements). Neglecting the back-reaction is
 exact to the ratio of the rotational to the orbital angular momentum of the body (≈ 1e-13 for a
 300 m asteroid at 1 au), far below everything else here.
 
@@ -47,19 +47,17 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from astropy import units as u
 from astropy.table import QTable
 from astropy.time import Time
 
-from ..core import rotations as _rotations
-from ..core.dynamics import make_model
-from ..core.integrate_quaternion import integrate_quaternion
-from ..core.perturbers import sampled_source
-from ..ephemeris import DE421_SPAN_JD_TDB, EphemerisRangeError, _resolve_body, barycentric_state_au, de421_constants
-from ..state import RotationState
-from ..state_table import from_principal, table_columns
-from ..time import J2000_JD_TDB, tdb_days, time_from_tdb_days
-from .rebound_adapter import (
+from spinorbit.core.dynamics.equations import make_model
+from spinorbit.core.integrators.quaternion import integrate_quaternion
+from spinorbit.core.model.perturbers import sampled_source
+from spinorbit.ephemeris import DE421_SPAN_JD_TDB, EphemerisRangeError, resolve_body, barycentric_state_au, de421_constants
+from spinorbit.state import RotationState
+from spinorbit.state_table import from_principal, table_columns
+from spinorbit.time import J2000_JD_TDB, tdb_days, time_from_tdb_days
+from spinorbit.coupling.rebound.adapter import (
     ExtraForces,
     body_index,
     extra_forces_in_effect,
@@ -135,7 +133,7 @@ class SampledPerturbers:
     closest: dict = field(default_factory=dict)
 
     def sources(self):
-        """One :func:`~spinorbit.core.perturbers.sampled_source` per perturber."""
+        """One :func:`~spinorbit.core.model.perturbers.sampled_source` per perturber."""
         return [sampled_source(mu, self.days, self.states[:, i, :3], self.states[:, i, 3:])
                 for i, mu in enumerate(self.gm)]
 
@@ -184,7 +182,7 @@ def _midpoint_errors(grid, states, mid_states):
     return np.linalg.norm(interp - truth, axis=2) / np.linalg.norm(truth, axis=2)
 
 
-def _a_priori_grid(pilot_days, pilot_states, start, end, tolerance):
+def a_priori_grid(pilot_days, pilot_states, start, end, tolerance):
     """Grid with spacing τ(t)·(384 ε)^(1/4), τ = min over perturbers of |r|/|v| (module docstring)."""
     r = np.linalg.norm(pilot_states[:, :, :3], axis=2)
     v = np.linalg.norm(pilot_states[:, :, 3:], axis=2)
@@ -211,7 +209,7 @@ def _adaptive_samples(provider, start, end, tolerance):
     if not end > start:
         raise ValueError(f"the sample span must have end > start (TDB days), got [{start!r}, {end!r}].")
     pilot = np.linspace(start, end, max(3, int(math.ceil((end - start) / PILOT_SPACING_DAYS)) + 1))
-    grid = _a_priori_grid(pilot, provider(pilot), start, end, tolerance)
+    grid = a_priori_grid(pilot, provider(pilot), start, end, tolerance)
     passes = 1
     while True:
         # Every pass asks the provider for the whole grid *and* all midpoints in one call. For REBOUND
@@ -247,7 +245,7 @@ def _adaptive_samples(provider, start, end, tolerance):
 
 
 def _perturber_names(perturbers):
-    names = tuple(_resolve_body(p) for p in perturbers)  # UnknownBodyError for a bad name
+    names = tuple(resolve_body(p) for p in perturbers)  # UnknownBodyError for a bad name
     if not names:
         raise ValueError("perturbers: expected at least one body name, e.g. ('sun', 'earth').")
     return names
@@ -279,7 +277,7 @@ def de421_orbit(name):
 
     For tests and for rotating bodies that DE421 carries (the Moon): au_DE421 and au/day, ICRF.
     """
-    name = _resolve_body(name)
+    name = resolve_body(name)
 
     def orbit(days):
         return _de421_state(name, days)
@@ -397,7 +395,7 @@ def rebound_orbit(sim, body):
     rebuilds the simulation from a copy of its present state (``sim`` is not modified) and integrates
     it through the requested times (``exact_finish_time``), so the sampler gets the smooth
     trajectory, not an interpolant of it. The frame is REBOUND's: a simulation from
-    :func:`~spinorbit.coupling.rebound_adapter.simulation_from_de421` is barycentric ICRF to the
+    :func:`~spinorbit.coupling.rebound.adapter.simulation_from_de421` is barycentric ICRF to the
     centre-of-mass shift of the bodies left out (metres); but the perturber vectors then mix DE421
     planets with a body integrated among REBOUND's planets, whose drift from DE421 (metres to
     kilometres over decades: ``docs/ephemeris.md``) enters them. Route (b),
@@ -409,7 +407,7 @@ def rebound_orbit(sim, body):
         ``days -> (positions (n, 3), velocities (n, 3))``, au and au/day.
     """
     centre = body_index(sim, body)
-    snapshot = _Snapshot.of(sim)
+    snapshot = SimulationSnapshot.of(sim)
 
     def orbit(days):
         days = np.atleast_1d(np.asarray(days, dtype=float))
@@ -427,7 +425,7 @@ def rebound_orbit(sim, body):
 
 
 @dataclass
-class _Snapshot:
+class SimulationSnapshot:
     """Everything needed to rebuild a REBOUND simulation at one instant (each pass re-runs it).
 
     REBOUND's own binary of the simulation, so that a copy has *all* of its settings, not a list of
@@ -470,7 +468,7 @@ def sample_from_rebound(sim, body, start, end, perturbers=DEFAULT_PERTURBERS,
     settings included), and every pass rebuilds it from the copy, integrates it to ``start``
     (backwards if ``sim.t`` is later) and then forwards through the sorted sample times with
     ``exact_finish_time = 1``. Extra forces installed by
-    :func:`~spinorbit.coupling.rebound_adapter.install_extra_forces` (also when folded into an
+    :func:`~spinorbit.coupling.rebound.adapter.install_extra_forces` (also when folded into an
     attached rigid body's force) are reinstalled on each copy; other forces are refused
     (``ForceInstallError``), since a copy would run without them.
 
@@ -478,7 +476,7 @@ def sample_from_rebound(sim, body, start, end, perturbers=DEFAULT_PERTURBERS,
     ----------
     sim : rebound.Simulation
         In ("AU", "day", "Msun") units, ``t`` in TDB days since J2000, ICRF axes, named particles
-        (e.g. :func:`~spinorbit.coupling.rebound_adapter.simulation_from_de421` plus the asteroid).
+        (e.g. :func:`~spinorbit.coupling.rebound.adapter.simulation_from_de421` plus the asteroid).
     body : str
         Name of the rotating body's particle.
     start, end : astropy.time.Time
@@ -493,9 +491,9 @@ def sample_from_rebound(sim, body, start, end, perturbers=DEFAULT_PERTURBERS,
 
     Raises
     ------
-    spinorbit.coupling.rebound_adapter.MissingBodyError
+    spinorbit.coupling.rebound.adapter.MissingBodyError
         ``body`` or a perturber is not in the simulation.
-    spinorbit.coupling.rebound_adapter.ForceInstallError
+    spinorbit.coupling.rebound.adapter.ForceInstallError
         ``sim`` has forces spinorbit did not install (they would be missing from the copies).
     SamplingError
     """
@@ -506,7 +504,7 @@ def sample_from_rebound(sim, body, start, end, perturbers=DEFAULT_PERTURBERS,
     names = tuple(sim.particles[i].name.lower() for i in indices)
     gm = np.array([sim.particles[i].m * sim.G for i in indices])
     start_day, end_day = _as_days_span(start, end)
-    snapshot = _Snapshot.of(sim)
+    snapshot = SimulationSnapshot.of(sim)
 
     def provider(days):
         run = snapshot.build()
@@ -534,14 +532,6 @@ DEFAULT_RTOL = 1e-10
 INTEGRATORS = ("quaternion", "elements", "taylor")
 
 
-def _to_core(state):
-    body = state.body
-    p = body._to_principal
-    attitude = p @ state.attitude_matrix
-    omega = p @ state.angular_velocity.to_value(u.rad / u.day)
-    return np.concatenate([_rotations.attitude_to_quat(np.ascontiguousarray(attitude)), omega])
-
-
 def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=True, integrator="quaternion",
                       extra_sources=()):
     """Integrate the rotation of ``state`` under the sampled perturbers' torques.
@@ -564,14 +554,14 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
         Also compute the instantaneous (osculating, torque-free) P_ψ, P_φ, mode and E/E0 of every
         output state.
     integrator : {"quaternion", "elements", "taylor"}
-        :func:`~spinorbit.core.integrate_quaternion.integrate_quaternion` (default; non-singular),
-        :func:`~spinorbit.core.integrate_elements.integrate_elements` (canonical elements, paper
+        :func:`~spinorbit.core.integrators.quaternion.integrate_quaternion` (default; non-singular),
+        :func:`~spinorbit.core.integrators.elements.integrate_elements` (canonical elements, paper
         eq. 11; raises near the separatrix, spin about C and the reference pole) or
-        :func:`~spinorbit.core.integrate_taylor.integrate_taylor` (adaptive Taylor method on the same
+        :func:`~spinorbit.core.integrators.taylor.integrate_taylor` (adaptive Taylor method on the same
         equations; it ends a step at every sample time, where the Hermite interpolant is not smooth,
         so it pays at least one step per sample inside the span).
     extra_sources : sequence
-        More :mod:`spinorbit.core.perturbers` sources (e.g. ``fixed_source``) added to the sampled ones.
+        More :mod:`spinorbit.core.model.perturbers` sources (e.g. ``fixed_source``) added to the sampled ones.
 
     Returns
     -------
@@ -602,18 +592,18 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
     body = state.body
     model = make_model(body.principal_moments, [*samples.sources(), *extra_sources])
     if integrator == "elements":
-        from ..core.integrate_elements import integrate_elements
+        from spinorbit.core.integrators.elements import integrate_elements
 
-        ys, stats = integrate_elements(_to_core(state), t0, t_out, model, rtol=rtol, return_stats=True)
+        ys, stats = integrate_elements(state.core_state(), t0, t_out, model, rtol=rtol, return_stats=True)
         stats.pop("frame")
     elif integrator == "taylor":
-        from ..core.integrate_taylor import integrate_taylor
+        from spinorbit.core.integrators.taylor import integrate_taylor
 
         # The figure here is degree 2 (principal moments only), so integrate_taylor never falls back.
-        ys, stats = integrate_taylor(_to_core(state), t0, t_out, model, tol=rtol, return_stats=True)
+        ys, stats = integrate_taylor(state.core_state(), t0, t_out, model, tol=rtol, return_stats=True)
         stats.update(accepted=stats["steps"], rejected=0)
     else:
-        ys, stats = integrate_quaternion(_to_core(state), t0, t_out, model, rtol=rtol, return_stats=True)
+        ys, stats = integrate_quaternion(state.core_state(), t0, t_out, model, rtol=rtol, return_stats=True)
     table = QTable()
     table["time"] = time_from_tdb_days(t_out)
     quaternions, omegas = from_principal(body, ys)  # all rows at once, no RotationState per row

@@ -1,6 +1,6 @@
 """A rigid body whose rotation is integrated together with a REBOUND simulation's orbits.
 
-Python-facing class over :func:`spinorbit.coupling.rebound_adapter.attach_rotation_hooks` (which owns
+Python-facing class over :func:`spinorbit.coupling.rebound.adapter.attach_rotation_hooks` (which owns
 every raw pointer). Route and reasons: ``docs/coupling.md``. Units are the simulation's; for DE421
 simulations (``simulation_from_de421``): au, day (TDB), Msun-mass units (GM/G), ω in rad/day.
 """
@@ -9,14 +9,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..checkpoint import CHECKPOINT_FORMAT_VERSION, Checkpoint, CheckpointError
-from ..core.dynamics import (
+from spinorbit.runs.checkpoint import CHECKPOINT_FORMAT_VERSION, Checkpoint, CheckpointError
+from spinorbit.core.dynamics.equations import (
     body_frame_position,
     inertial_angular_momentum,
     kinetic_energy,
 )
-from ..core.gravity_field import figure_force_function_and_gradient
-from .rebound_adapter import (
+from spinorbit.core.model.gravity_field import figure_force_function_and_gradient
+from spinorbit.coupling.rebound.adapter import (
     ExtraForces,
     RotationHooks,
     attach_rotation_hooks,
@@ -29,7 +29,7 @@ from .rebound_adapter import (
 __all__ = ["CHECKPOINT_KIND", "CONTENT_VERSION", "SAVE_FORMAT_VERSION", "CoupledRigidBody", "RestoreError",
            "coupled_run"]
 
-#: Version of the file format written by :meth:`CoupledRigidBody.save` (:mod:`spinorbit.checkpoint`).
+#: Version of the file format written by :meth:`CoupledRigidBody.save` (:mod:`spinorbit.runs.checkpoint`).
 SAVE_FORMAT_VERSION = CHECKPOINT_FORMAT_VERSION
 #: Version of what a body's checkpoint holds (``meta["content_version"]``). 2: the extra-force block
 #: in effect (array ``extra_forces``). Version 1 (no ``content_version``) held only the ``earth_j2``/
@@ -54,7 +54,7 @@ class CoupledRigidBody:
     body : str
         Name of the particle with the figure.
     figure : ndarray
-        ``spinorbit.core.gravity_field.make_body`` array in simulation units (moments in
+        ``spinorbit.core.model.gravity_field.make_body`` array in simulation units (moments in
         mass·length², mass = the particle's mass, reference radius in length units).
     state : array_like, shape (7,)
         (q0, q1, q2, q3, ωx, ωy, ωz): q scalar first, body → inertial; ω body axes, rad/time unit.
@@ -74,9 +74,9 @@ class CoupledRigidBody:
 
     Raises
     ------
-    spinorbit.coupling.rebound_adapter.MissingBodyError
+    spinorbit.coupling.rebound.adapter.MissingBodyError
         ``body`` or a perturber is not in the simulation.
-    spinorbit.coupling.rebound_adapter.ForceInstallError
+    spinorbit.coupling.rebound.adapter.ForceInstallError
         The integrator is not BS, something else owns ``additional_forces``, or ``earth_j2``/``gr``
         asked for a force the block installed earlier does not have.
     """
@@ -148,7 +148,7 @@ class CoupledRigidBody:
 
         Raises
         ------
-        spinorbit.coupling.rebound_adapter.RotationCallbackError
+        spinorbit.coupling.rebound.adapter.RotationCallbackError
             A compiled callback found a problem and stopped the run (message says what and when).
         KeyboardInterrupt
             Ctrl-C (SIGINT) during the call, also when REBOUND's own handler caught it.
@@ -193,7 +193,7 @@ class CoupledRigidBody:
 
     # ---------------------------------------------------------------------------------------
     def checkpoint(self) -> Checkpoint:
-        """Orbits + rotation + the forces in effect as one :class:`~spinorbit.checkpoint.Checkpoint`.
+        """Orbits + rotation + the forces in effect as one :class:`~spinorbit.runs.checkpoint.Checkpoint`.
 
         The REBOUND simulation in its binary form (``t``, particles, ``dt``, the integrator's
         settings and the BS controller's state: ``first_or_last_step``, ``previous_rejected``,
@@ -310,11 +310,11 @@ def coupled_run(sim, body, moments_per_mass, state, start, times, perturbers, to
     stats : dict
         ``steps`` (BS steps taken, REBOUND's ``steps_done``), ``wall_seconds`` (integration only).
     """
-    from ..core.gravity_field import make_body
-    from .chunked_run import integrate_to_outputs
-    from .one_way import _Snapshot
+    from spinorbit.core.model.gravity_field import make_body
+    from spinorbit.coupling.long_run import integrate_to_outputs
+    from spinorbit.coupling.one_way import SimulationSnapshot
 
-    copy = _Snapshot.of(sim).build()
+    copy = SimulationSnapshot.of(sim).build()
     copy.integrate(start)
     copy.integrator = "bs"
     copy.integrator.eps_abs = tolerance

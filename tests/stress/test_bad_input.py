@@ -17,29 +17,31 @@ import pytest
 from astropy import units as u
 from astropy.time import Time
 
-from spinorbit import RigidBody, RotationState, cli, special
+from spinorbit import cli
+from spinorbit import special
+from spinorbit import RigidBody, RotationState
 from spinorbit import time as so_time
 from spinorbit.body import InvalidBodyError
-from spinorbit.checkpoint import Checkpoint, CheckpointError, CheckpointSchedule
+from spinorbit.runs.checkpoint import Checkpoint, CheckpointError, CheckpointSchedule
 from spinorbit.core import (
     SingularElementsError,
     andoyer_to_canonical,
     canonical_to_andoyer,
     torque_free_states_many,
 )
-from spinorbit.core.dynamics import make_model
-from spinorbit.core.gravity_field import make_body
-from spinorbit.core.integrate_elements import integrate_elements
-from spinorbit.core.integrate_quaternion import integrate_quaternion
-from spinorbit.core.integrate_splitting import integrate_splitting
-from spinorbit.coupling.chunked_run import integrate_to_outputs
+from spinorbit.core.dynamics.equations import make_model
+from spinorbit.core.model.gravity_field import make_body
+from spinorbit.core.integrators.elements import integrate_elements
+from spinorbit.core.integrators.quaternion import integrate_quaternion
+from spinorbit.core.integrators.splitting import integrate_splitting
+from spinorbit.coupling.long_run import integrate_to_outputs
 from spinorbit.coupling.moon import moon_figure
 from spinorbit.coupling.one_way import (
     de421_orbit,
     propagate_one_way,
     sample_from_ephemeris,
 )
-from spinorbit.coupling.rebound_adapter import (
+from spinorbit.coupling.rebound.adapter import (
     ForceInstallError,
     MissingBodyError,
     simulation_from_de421,
@@ -51,7 +53,7 @@ from spinorbit.ephemeris import (
     barycentric_state,
     moon_orientation,
 )
-from spinorbit.resumable import integrate_resumable
+from spinorbit.runs.resumable import integrate_resumable
 from spinorbit.state import InvalidStateError
 
 BODY = RigidBody([1.0, 2.0, 2.5])

@@ -18,9 +18,9 @@ from hypothesis import strategies as st
 from spinorbit import RigidBody, RotationState
 from spinorbit.body import InvalidBodyError
 from spinorbit.core import SingularElementsError, canonical_to_andoyer
-from spinorbit.core.canonical import (MO_MODE, MO_PARAM, MO_PARAM_C, MODE_LAM, MODE_SAM, inertia_constants, motion_from_elements,
+from spinorbit.core.elements.canonical import (MO_MODE, MO_PARAM, MO_PARAM_C, MODE_LAM, MODE_SAM, inertia_constants, motion_from_elements,
                                       symmetric_gap_resolved)
-from spinorbit.core.rotations import euler313_to_attitude
+from spinorbit.core.math.rotations import euler313_to_attitude
 from spinorbit.state import ANDOYER_G_RANGE, InvalidStateError
 
 #: Any float, including NaN, ±inf, subnormals and ±1e308.

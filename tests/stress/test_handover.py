@@ -20,23 +20,23 @@ import math
 import numpy as np
 import pytest
 
-from spinorbit.core.dynamics import make_model
+from spinorbit.core.dynamics.equations import make_model
 from spinorbit.core.errors import SingularElementsError
-from spinorbit.core.integrate_elements import (
+from spinorbit.core.integrators.elements import (
     MIN_SEPARATRIX_DISTANCE,
     ElementsSingularityError,
     integrate_elements,
 )
-from spinorbit.core.integrate_handover import (
+from spinorbit.core.integrators.handover import (
     ELEMENTS,
     QUATERNION,
     RESUME_MARGIN,
     integrate_with_handover,
     singularity_distances_of_state,
 )
-from spinorbit.core.integrate_quaternion import integrate_quaternion
-from spinorbit.core.perturbers import fixed_source, kepler_source
-from spinorbit.core.rotations import rotation_angle_between_many
+from spinorbit.core.integrators.quaternion import integrate_quaternion
+from spinorbit.core.model.perturbers import fixed_source, kepler_source
+from spinorbit.core.math.rotations import rotation_angle_between_many
 
 from .test_phase_space_floor import Q_GENERIC, SWEEP, attitude_near_momentum
 

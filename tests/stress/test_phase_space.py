@@ -16,7 +16,7 @@ import math
 import numpy as np
 import pytest
 
-from spinorbit.core import rotations as rot
+from spinorbit.core.math import rotations as rot
 from spinorbit.core import torque_free_states
 
 EPS = np.finfo(float).eps

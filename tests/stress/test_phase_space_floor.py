@@ -25,13 +25,13 @@ import numpy as np
 import pytest
 
 from spinorbit.core import torque_free_states
-from spinorbit.core.canonical import (
+from spinorbit.core.elements.canonical import (
     MODE_UNIFORM,
     elements_from_state,
     inertia_constants,
     state_from_elements,
 )
-from spinorbit.core.rotations import (
+from spinorbit.core.math.rotations import (
     attitude_to_quat,
     quat_to_attitude,
     rotation_angle_between,

@@ -1,0 +1,13 @@
+"""The one definition of the equations of motion (quaternion + body angular velocity).
+
+:mod:`.equations` holds Euler's equations, the torque sum from one force function U, the energy and
+angular-momentum diagnostics, and the model-array layout; every integrator and every benchmark peer
+evaluates the dynamics through it.
+"""
+
+from spinorbit import old_paths
+
+
+def __getattr__(name):
+    # This path was a module before the reorganisation: its names are forwarded, with a warning.
+    return old_paths.forward_attribute(__name__, name)

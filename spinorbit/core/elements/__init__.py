@@ -1,0 +1,20 @@
+"""Fukushima's canonical elements of rotational motion and the Andoyer variables under them.
+
+- :mod:`.andoyer` — Andoyer (Serret–Andoyer) variables from an attitude and angular momentum;
+- :mod:`.canonical` — the elliptic set-up: rotation mode, parameter m, constants of the free motion;
+- :mod:`.paper_maps` — the paper's maps :func:`andoyer_to_canonical` (eq. 4) and
+  :func:`canonical_to_andoyer` (eqs. 7–8);
+- :mod:`.jacobian` — the Jacobian of section 4, ∂(Andoyer)/∂(canonical);
+- :mod:`.equations` — the equations of motion of the elements under a torque (Hamilton's equations
+  of the force function in the elements).
+"""
+
+from spinorbit.core.elements.paper_maps import andoyer_to_canonical, canonical_to_andoyer
+
+__all__ = ["andoyer_to_canonical", "canonical_to_andoyer"]
+
+
+def __getattr__(name):
+    from spinorbit import old_paths
+
+    return old_paths.forward_attribute(__name__, name)

@@ -1,0 +1,124 @@
+"""Double-double arithmetic: error-free transformations and (hi, lo) pairs (Dekker 1971; Knuth 4.2.2).
+
+One copy for the package: the elliptic kernels (K as a double-double) and the long-span torque-free
+flow (rates, periods and secular advances) both import from here. A double-double x = hi + lo with
+|lo| ≤ ulp(hi)/2 carries about 106 bits (relative error ≈ 1e-32). No FMA is assumed: products use
+Veltkamp's split, so the results are the same on every IEEE-754 machine.
+"""
+
+import math
+
+import numpy as np
+
+from spinorbit.core.jit import jit
+
+# Veltkamp split factor 2^27 + 1: splits a double into two 26-bit halves (Dekker's exact product).
+SPLIT_26 = 134217729.0
+
+# 2π as a double-double (2·fl(π), 2·(π − fl(π))), for reducing secular angles.
+TWO_PI_HI = 2.0 * math.pi
+TWO_PI_LO = 2.0 * 1.2246467991473532e-16
+
+
+@jit
+def two_sum(a, b):
+    """a + b = s + e exactly (Knuth)."""
+    s = a + b
+    bb = s - a
+    return s, (a - (s - bb)) + (b - bb)
+
+
+@jit
+def quick_two_sum(a, b):
+    """a + b = s + e exactly, assuming |a| ≥ |b| (Dekker)."""
+    s = a + b
+    return s, b - (s - a)
+
+
+@jit
+def split(a, factor):
+    """Veltkamp split: a = head + tail with head of (53 − log2(factor − 1)) significant bits."""
+    t = factor * a
+    head = t - (t - a)
+    return head, a - head
+
+
+@jit
+def two_prod(a, b):
+    """a * b = p + e exactly (Dekker's product, no FMA needed)."""
+    p = a * b
+    ah, al = split(a, SPLIT_26)
+    bh, bl = split(b, SPLIT_26)
+    return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
+
+
+@jit
+def dd_add(ah, al, bh, bl):
+    """(ah + al) + (bh + bl) as a double-double."""
+    s, e = two_sum(ah, bh)
+    return quick_two_sum(s, e + (al + bl))
+
+
+@jit
+def dd_mul(ah, al, bh, bl):
+    """(ah + al) · (bh + bl) as a double-double."""
+    p, e = two_prod(ah, bh)
+    return quick_two_sum(p, e + (ah * bl + al * bh))
+
+
+@jit
+def dd_div(ah, al, bh, bl):
+    """(ah + al) / (bh + bl) as a double-double (one Newton correction of the double quotient)."""
+    q1 = ah / bh
+    ph, pl = dd_mul(bh, bl, q1, 0.0)
+    rh, rl = dd_add(ah, al, -ph, -pl)
+    return quick_two_sum(q1, rh / bh)
+
+
+@jit
+def dd_sqrt(ah, al):
+    """√(ah + al) as a double-double (one Newton correction of the double root); 0 for 0."""
+    h = math.sqrt(ah)
+    if h == 0.0:
+        return 0.0, 0.0
+    p, e = two_prod(h, h)
+    return quick_two_sum(h, (((ah - p) - e) + al) / (2.0 * h))
+
+
+@jit
+def dd_remainder_dd(xh, xl, ph, pl):
+    """(j, r_hi, r_lo) with j = rint(x / p) and r = x − j·p kept as a double-double."""
+    j = np.rint(xh / ph)
+    qh, ql = two_prod(j, ph)
+    ql += j * pl
+    rh, rl = dd_add(xh, xl, -qh, -ql)
+    return j, rh, rl
+
+
+@jit
+def dd_remainder(xh, xl, ph, pl):
+    """(j, r) with j = rint(x / p) and r = x − j·p as a double (|r| ≤ p/2 plus rounding).
+
+    x and the period p are double-doubles; j·p is formed exactly from two products, so r keeps an
+    absolute error ≈ ε·|r| + |j|·|p|·1e-32: a phase carried this way does not drift with |x|.
+    """
+    j = np.rint(xh / ph)
+    qh, ql = two_prod(j, ph)
+    ql += j * pl
+    rh, rl = dd_add(xh, xl, -qh, -ql)
+    return j, rh + rl
+
+
+@jit
+def dd_scale(xh, xl, t):
+    """(xh + xl) · t for a double t, as a double-double (a rate times a time, the phase of a flow)."""
+    ph, pl = two_prod(xh, t)
+    return dd_add(ph, pl, xl * t, 0.0)
+
+
+@jit
+def dd_difference_ratio(big_x, big_y):
+    """(Y − X)/(X Y) = 1/X − 1/Y as a double-double, exact inputs X, Y (a − b = (B − A)/(AB))."""
+    dh, dl = two_sum(big_y, -big_x)
+    ph, pl = two_prod(big_x, big_y)
+    return dd_div(dh, dl, ph, pl)

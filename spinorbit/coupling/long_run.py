@@ -1,0 +1,107 @@
+"""A coupled run to a list of output times that can be interrupted and resumed bit for bit.
+
+The run is a sequence of chunks: chunk i integrates orbits and rotation from ``times[i-1]`` to
+``times[i]`` with ``exact_finish_time = 1`` and records one row (e.g. the quaternion). An
+uninterrupted run and a resumed one take *the same chunks*, and a chunk's result depends only on the
+simulation's binary state at its start (particles, ``t``, ``dt``, the BS controller's flags) and on
+the rotation state — exactly what :meth:`CoupledRigidBody.checkpoint` stores. Hence the resumed run
+ends with the same bits (``tests/test_checkpoint_runs.py`` checks it across processes).
+
+The checkpoint holds the body's checkpoint, the rows done so far, the chunk count, a fingerprint of
+the output times and the caller's settings; a resume with other times or settings is refused.
+"""
+
+from __future__ import annotations
+
+import json
+import time as _time
+
+import numpy as np
+
+from spinorbit.runs.checkpoint import Checkpoint, CheckpointSchedule, fingerprint
+from spinorbit.coupling.rigid_body import CoupledRigidBody
+
+__all__ = ["CHUNKED_RUN_KIND", "integrate_to_outputs"]
+
+#: ``kind`` of the checkpoints written by :func:`integrate_to_outputs`.
+CHUNKED_RUN_KIND = "coupled-run"
+
+
+def _summary(times) -> str:
+    """Readable description of output times for error messages (the fingerprint decides)."""
+    return f"{times.size} times from {times[0]!r} to {times[-1]!r}" if times.size else "no times"
+
+
+def integrate_to_outputs(body, times, record, row_size: int, schedule: CheckpointSchedule | None = None,
+                         resume=None, settings: dict | None = None, progress=None):
+    """Integrate ``body`` to each of ``times`` and record ``record(body)`` there; checkpoint as scheduled.
+
+    Parameters
+    ----------
+    body : CoupledRigidBody or None
+        The run's start (``body.sim.t`` ≤ ``times[0]``). Ignored (may be None) when resuming: the
+        checkpoint holds the body.
+    times : array_like, shape (n,)
+        Output times (simulation time units, increasing); each is one chunk.
+    record : callable
+        ``record(body) -> array of row_size floats`` at each output time.
+    row_size : int
+        Length of a recorded row.
+    schedule : spinorbit.runs.checkpoint.CheckpointSchedule, optional
+        When and where to write checkpoints (none if omitted).
+    resume : str or os.PathLike, optional
+        A checkpoint written by this function: the run continues from it.
+    settings : dict, optional
+        JSON-serialisable description of the run (model, span, ...); stored, and compared on resume.
+    progress : callable, optional
+        Called with the number of output times done.
+
+    Returns
+    -------
+    body : CoupledRigidBody
+        At ``times[-1]`` (the resumed body when resuming).
+    rows : ndarray, shape (n, row_size)
+    wall_seconds : float
+        Wall time spent integrating, over all the pieces of an interrupted run.
+
+    Raises
+    ------
+    spinorbit.runs.checkpoint.CheckpointError
+        ``resume`` is unreadable, truncated, corrupted, or from a run with other times or settings.
+    spinorbit.runs.checkpoint.RunStopped
+        The schedule's ``stop_after_chunks`` was reached (after writing the checkpoint).
+    """
+    times = np.asarray(times, dtype=float)
+    settings = json.loads(json.dumps({} if settings is None else settings))  # as it reads back
+    times_id = fingerprint(times)
+    rows = np.full((times.size, int(row_size)), np.nan)
+    done, wall = 0, 0.0
+    if resume is not None:
+        checkpoint = Checkpoint.read(resume, kind=CHUNKED_RUN_KIND)
+        checkpoint.expect(resume, "settings", checkpoint.meta["settings"], settings)
+        if checkpoint.meta["times"] != times_id:  # the summary may coincide; the fingerprint decides
+            checkpoint.expect(resume, "output times", f"{checkpoint.meta['times_summary']} (SHA-256 "
+                              f"{checkpoint.meta['times'][:12]}…)", f"{_summary(times)} (SHA-256 {times_id[:12]}…)")
+        body_part = Checkpoint(kind="", arrays={k.removeprefix("body."): v for k, v in checkpoint.arrays.items()
+                                                if k.startswith("body.")}, meta=checkpoint.meta["body"])
+        body = CoupledRigidBody.from_checkpoint(body_part)
+        done, wall = int(checkpoint.meta["done"]), float(checkpoint.meta["wall_seconds"])
+        rows[:done] = checkpoint.arrays["rows"]
+        if progress is not None:
+            progress(done)
+    for i in range(done, times.size):
+        begin = _time.perf_counter()
+        body.integrate(times[i])
+        wall += _time.perf_counter() - begin
+        rows[i] = record(body)
+        if progress is not None:
+            progress(i + 1)
+        if schedule is not None and i + 1 < times.size and schedule.due(i + 1):
+            body_checkpoint = body.checkpoint()
+            arrays = {f"body.{k}": v for k, v in body_checkpoint.arrays.items()}
+            arrays["rows"] = rows[:i + 1]
+            schedule.write(Checkpoint(kind=CHUNKED_RUN_KIND, arrays=arrays, meta={
+                "body": body_checkpoint.meta, "done": i + 1, "times": times_id, "times_summary": _summary(times),
+                "settings": settings,
+                "wall_seconds": wall}), i + 1)
+    return body, rows, wall

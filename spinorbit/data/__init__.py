@@ -1,0 +1,4 @@
+"""Real bodies with published states and orbits, and where each number came from.
+
+- :mod:`.asteroids` — (99942) Apophis (JPL#218) and (4179) Toutatis.
+"""

@@ -1,0 +1,513 @@
+"""Asteroid data for the one-way examples: bodies, published spin states, and encounter geometries.
+
+What is published and what is constructed
+-----------------------------------------
+**Spin states** (cited): (99942) Apophis, Pravec et al. 2014 (Icarus 233, 48): short-axis mode,
+retrograde, P_ψ = 263 h, P_φ = 27.38 h, E/E0 = 1.024 ± 0.013, moment ratios A:B:C ≈ 0.61:0.965:1,
+angular momentum towards ecliptic (λ, β) ≈ (250°, −75°). (4179) Toutatis, Takahashi, Busch & Scheeres
+2013 (AJ 146, 95, Table 2): epoch 1992-11-09T17:49:47 UTC, moments (x, y, z) = 3.0836 : 3.235 : 1
+(z the long axis), ZXZ Euler angles body → inertial (145.498°, 65.865°, 241.524°), body angular
+velocity (14.51, 33.529, −98.709) deg/day.
+
+**Apophis orbit (default)**: the JPL Horizons solution JPL#218 state at 2021-01-01 TDB
+(:data:`APOPHIS_HORIZONS`), integrated to 2029 by :func:`published_orbit_simulation` /
+:func:`apophis_encounter_simulation`; measured closest approach 38 054.9 km at 7.4209 km/s,
+2029-04-13 21:46:13.7 TDB (docs/asteroids.md). The encounter geometry below remains the fallback
+(``orbit="geometry"``) and is still used for Toutatis.
+
+**Fallback orbits** (not an orbit solution): I cannot cite osculating elements *with* their epoch and mean
+anomaly reliably from memory, and without the exact orbit solution no published element set pins a
+close approach down to a few 10³ km anyway. So each asteroid is placed on a **documented encounter
+geometry** that reproduces the published close-approach distance and speed:
+
+- the geocentric hyperbola has the published perigee distance and perigee speed at the published
+  time (:data:`APOPHIS_2029`, :data:`TOUTATIS_2004`);
+- the *direction* of the incoming asymptote v∞ and of the impact parameter come from approximate
+  heliocentric elements (a, e, i, Ω, ω; ecliptic J2000) of the asteroid, recalled from the JPL
+  Small-Body Database and rounded — they are used only for directions: v∞ is the velocity of the
+  point of that ellipse nearest Earth relative to Earth, and the impact-parameter direction is the
+  part of the offset (ellipse point − Earth) perpendicular to v∞;
+- the asteroid is then a massless particle in a REBOUND simulation of the Sun, planets, Moon and Pluto
+  from DE421 (IAS15, ``exact_finish_time``) and is integrated backwards and forwards from the
+  encounter.
+
+The elements' |v∞| is printed by the examples next to the imposed one as a consistency check.
+
+Attitude conventions: ``docs/conventions.md`` and :func:`toutatis_rotation_state` (how Takahashi
+et al.'s "ZXZ body → inertial" angles are read).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from astropy import units as u
+from astropy.time import Time
+from scipy.optimize import brentq, minimize_scalar
+
+from spinorbit.body import RigidBody
+from spinorbit.core.math import rotations as _rotations
+from spinorbit.coupling.rebound.adapter import (
+    DEFAULT_BODIES,
+    body_index,
+    install_extra_forces,
+    set_nongravitational,
+    simulation_from_de421,
+)
+from spinorbit.ephemeris import barycentric_state_au, de421_constants
+from spinorbit.frames import icrf_to_ecliptic_matrix
+from spinorbit.state import RotationState
+from spinorbit.time import tdb_day_and_fraction, tdb_days, time_from_tdb_days
+
+__all__ = [
+    "HeliocentricDirections",
+    "EncounterGeometry",
+    "APOPHIS_ELEMENTS",
+    "TOUTATIS_ELEMENTS",
+    "APOPHIS_2029",
+    "TOUTATIS_2004",
+    "APOPHIS_BODY",
+    "TOUTATIS_BODY",
+    "TOUTATIS_EPOCH",
+    "encounter_state",
+    "encounter_simulation",
+    "PublishedState",
+    "APOPHIS_HORIZONS",
+    "IAU_AU_KM",
+    "published_orbit_simulation",
+    "closest_approach",
+    "apophis_encounter_simulation",
+    "apophis_rotation_state",
+    "toutatis_rotation_state",
+    "sam_state_from_periods",
+    "ecliptic_direction",
+    "aligning_quaternion",
+]
+
+DEG = math.pi / 180.0
+
+
+@dataclass(frozen=True)
+class HeliocentricDirections:
+    """Approximate heliocentric ellipse (ecliptic J2000), used only for directions (module docstring).
+
+    a in au, angles in degrees. No epoch or mean anomaly: the encounter fixes the timing.
+    """
+
+    a: float
+    e: float
+    inc: float
+    node: float
+    argp: float
+    source: str
+
+
+@dataclass(frozen=True)
+class EncounterGeometry:
+    """A published close approach: time, geocentric perigee distance and speed at perigee."""
+
+    name: str
+    time: Time
+    distance_km: float
+    speed_km_s: float
+    elements: HeliocentricDirections
+    source: str
+
+    @property
+    def time_tdb(self):
+        """The encounter time on the TDB scale, converted through :mod:`spinorbit.time` (astropy's own
+        ``.tdb`` warns "dubious year" for 2029 through an irrelevant UTC leg)."""
+        return _tdb(self.time)
+
+
+APOPHIS_ELEMENTS = HeliocentricDirections(
+    0.9224, 0.1914, 3.339, 204.43, 126.39,
+    "approximate pre-2029 JPL SBDB elements, recalled and rounded (the values of benchmarks/scenes.py)",
+)
+TOUTATIS_ELEMENTS = HeliocentricDirections(
+    2.5336, 0.6294, 0.4469, 124.37, 278.7,
+    "approximate JPL SBDB elements, recalled and rounded (the values of benchmarks/scenes.py)",
+)
+
+#: 2029-04-13 21:46 UTC. UTC after 2026 is not yet defined (future leap seconds are unknown, ERFA warns
+#: "dubious year"); we assume none after 2017, so TT = UTC + 69.184 s.
+APOPHIS_2029 = EncounterGeometry(
+    "Apophis", Time("2029-04-13T21:47:09.184", scale="tt"), 38_000.0, 7.4, APOPHIS_ELEMENTS,
+    "≈ 38 000 km from Earth's centre at ≈ 7.4 km/s on 2029-04-13 21:46 UTC (project anchors, "
+    "/work/shared/notes/anchors.md; JPL close-approach data give 38 012 km)",
+)
+#: 2004-09-29 ≈ 13:37 UTC at 0.01036 au (project anchors). The perigee speed is not in the anchors;
+#: it is the one of the element-derived v∞ (computed, see :func:`encounter_state`), so ``speed_km_s``
+#: is None here.
+TOUTATIS_2004 = EncounterGeometry(
+    "Toutatis", Time("2004-09-29T13:37:00", scale="utc"), 0.01036 * 149_597_870.7, None, TOUTATIS_ELEMENTS,
+    "0.01036 au from Earth on 2004-09-29 (project anchors); time of day ≈ 13:37 UTC (recalled, approximate)",
+)
+
+#: Apophis moment ratios A:B:C (Pravec et al. 2014), principal axes = user axes.
+APOPHIS_BODY = RigidBody([0.61, 0.965, 1.0], name="Apophis")
+#: Toutatis moments about the published body axes x, y, z (z the long axis; Takahashi et al. 2013).
+TOUTATIS_BODY = RigidBody([3.0836, 3.235, 1.0], name="Toutatis")
+#: Epoch of the Takahashi et al. (2013) Toutatis state (UTC as published).
+TOUTATIS_EPOCH = Time("1992-11-09T17:49:47", scale="utc")
+
+
+def ecliptic_direction(lon_deg, lat_deg):
+    """ICRF unit vector of ecliptic-J2000 longitude and latitude (degrees)."""
+    lon, lat = lon_deg * DEG, lat_deg * DEG
+    ecl = np.array([math.cos(lat) * math.cos(lon), math.cos(lat) * math.sin(lon), math.sin(lat)])
+    return icrf_to_ecliptic_matrix().T @ ecl
+
+
+def _kepler_state_from_true_anomaly(el, nu, gm_sun):
+    """Heliocentric ICRF position (au) and velocity (au/day) at true anomaly nu on ellipse ``el``."""
+    p = el.a * (1 - el.e**2)
+    r = p / (1 + el.e * math.cos(nu))
+    pos = np.array([r * math.cos(nu), r * math.sin(nu), 0.0])
+    vel = math.sqrt(gm_sun / p) * np.array([-math.sin(nu), el.e + math.cos(nu), 0.0])
+    rot = (_rotations.rot3(-el.node * DEG) @ _rotations.rot1(-el.inc * DEG) @ _rotations.rot3(-el.argp * DEG))
+    to_icrf = icrf_to_ecliptic_matrix().T
+    return to_icrf @ rot @ pos, to_icrf @ rot @ vel
+
+
+def encounter_state(geometry, return_details=False):
+    """Geocentric ICRF state (au, au/day) of the asteroid at perigee of a documented encounter.
+
+    Construction (module docstring): v̂∞ from the element ellipse point nearest Earth; impact-parameter
+    direction b̂ = the part of (ellipse point − Earth) perpendicular to v̂∞; perigee speed v_p as
+    published; when ``geometry.speed_km_s`` is None, v∞ is the ellipse's heliocentric velocity
+    direction with the vis-viva speed of its semi-major axis at the perigee point, minus Earth's
+    velocity (so the asteroid keeps the elements' orbital period); then, with
+    e = 1 + r_p v∞²/μ and the turning angle δ (sin δ/2 = 1/e), the perigee velocity is
+    v̂∞ rotated by δ/2 towards −b̂ (gravity bends the path towards Earth) and the perigee position
+    r_p (sin δ/2 v̂∞ + cos δ/2 b̂), perpendicular to it.
+    """
+    constants = de421_constants()
+    au_km = constants.au_km
+    mu_earth, gm_sun = constants.gm["earth"], constants.gm["sun"]
+    day, fraction = tdb_day_and_fraction(geometry.time)
+    earth_r, earth_v = barycentric_state_au("earth", day, fraction)
+    sun_r, sun_v = barycentric_state_au("sun", day, fraction)
+    earth_helio, earth_helio_v = earth_r - sun_r, earth_v - sun_v
+    el = geometry.elements
+
+    def distance(nu):
+        return np.linalg.norm(_kepler_state_from_true_anomaly(el, nu, gm_sun)[0] - earth_helio)
+
+    coarse = np.linspace(-math.pi, math.pi, 721)
+    nu0 = coarse[int(np.argmin([distance(x) for x in coarse]))]
+    nu = minimize_scalar(distance, bracket=(nu0 - 0.01, nu0, nu0 + 0.01), tol=1e-12).x
+    point, velocity = _kepler_state_from_true_anomaly(el, nu, gm_sun)
+    v_inf_elements = float(np.linalg.norm(velocity - earth_helio_v))
+    offset = point - earth_helio
+    r_p = geometry.distance_km / au_km
+    position = np.zeros(3)
+    # Three passes: without a published speed, the vis-viva speed is taken at the asteroid's own
+    # perigee position, which depends (weakly) on the v∞ direction it produces.
+    for _ in range(3 if geometry.speed_km_s is None else 1):
+        v_inf_vec = velocity - earth_helio_v
+        if geometry.speed_km_s is None:
+            # No published speed: keep the ellipse's heliocentric velocity direction but give it the
+            # vis-viva speed of the elements' a at the asteroid's position, so that the semi-major axis
+            # — hence the period and the near-commensurability with Earth that brings the asteroid
+            # back every few years — is the elements' a (Earth's potential at perigee changes it by
+            # < 1e-3 relative).
+            r_here = float(np.linalg.norm(earth_helio + position))
+            speed = math.sqrt(gm_sun * (2 / r_here - 1 / el.a))
+            v_inf_vec = speed * velocity / np.linalg.norm(velocity) - earth_helio_v
+        v_inf_hat = v_inf_vec / np.linalg.norm(v_inf_vec)
+        b = offset - (offset @ v_inf_hat) * v_inf_hat
+        if np.linalg.norm(b) < 1e-9:  # ellipse through Earth: any perpendicular; take ecliptic north's
+            b = ecliptic_direction(0.0, 90.0) - (ecliptic_direction(0.0, 90.0) @ v_inf_hat) * v_inf_hat
+        b_hat = b / np.linalg.norm(b)
+        if geometry.speed_km_s is None:
+            v_inf = float(np.linalg.norm(v_inf_vec))
+            v_p = math.sqrt(v_inf**2 + 2 * mu_earth / r_p)
+        else:
+            v_p = geometry.speed_km_s * 86400.0 / au_km
+            v_inf = math.sqrt(v_p**2 - 2 * mu_earth / r_p)
+        ecc = 1 + r_p * v_inf**2 / mu_earth
+        half_turn = math.asin(1 / ecc)
+        velocity_hat = math.cos(half_turn) * v_inf_hat - math.sin(half_turn) * b_hat
+        position_hat = math.sin(half_turn) * v_inf_hat + math.cos(half_turn) * b_hat
+        position, perigee_velocity = r_p * position_hat, v_p * velocity_hat
+    velocity = perigee_velocity
+    if not return_details:
+        return position, velocity
+    kms = au_km / 86400.0
+    return position, velocity, {
+        "v_inf_elements_km_s": v_inf_elements * kms,
+        "v_inf_km_s": v_inf * kms,
+        "v_perigee_km_s": v_p * kms,
+        "eccentricity": ecc,
+        "ellipse_miss_distance_km": float(np.linalg.norm(offset)) * au_km,
+        "v_inf_direction_icrf": v_inf_hat,
+    }
+
+
+def encounter_simulation(geometry, bodies=DEFAULT_BODIES, integrator="ias15"):
+    """REBOUND simulation at the encounter time with the asteroid added as a massless particle.
+
+    The Sun, planets, Moon and Pluto come from DE421 (:func:`~spinorbit.coupling.rebound.adapter.simulation_from_de421`);
+    the asteroid (named ``geometry.name``) sits at Earth + :func:`encounter_state`.
+    """
+    sim = simulation_from_de421(_tdb(geometry.time), bodies=bodies, integrator=integrator)
+    position, velocity = encounter_state(geometry)
+    earth = sim.particles[body_index(sim, "earth")]
+    sim.add(m=0.0, x=earth.x + position[0], y=earth.y + position[1], z=earth.z + position[2],
+            vx=earth.vx + velocity[0], vy=earth.vy + velocity[1], vz=earth.vz + velocity[2], name=geometry.name)
+    return sim
+
+
+def _tdb(time):
+    days, remainder = tdb_days(time)
+    return time_from_tdb_days(days, remainder)
+
+
+# ------------------------------------------------------------------------------------------------
+# Published orbit solutions (heliocentric states from JPL Horizons).
+
+#: IAU 2012 astronomical unit (km), the au of Horizons' output. DE421's au (its header ``AU``) is
+#: 149 597 870.6996262 km, 2.5e-12 smaller in relative terms (docs/ephemeris.md).
+IAU_AU_KM = 149_597_870.700
+
+
+@dataclass(frozen=True)
+class PublishedState:
+    """A heliocentric ICRF state of a small body from an orbit solution, as published.
+
+    ``position_au`` and ``velocity_au_day`` are in IAU 2012 au (:data:`IAU_AU_KM`) and TDB days, at
+    ``epoch`` (TDB). ``elements`` keeps the osculating elements printed with them (ecliptic J2000,
+    IAU76 obliquity; not used by the code, a record of what was published).
+    """
+
+    name: str
+    epoch: Time
+    position_au: tuple
+    velocity_au_day: tuple
+    elements: dict
+    non_gravitational: dict
+    source: str
+
+
+#: (99942) Apophis, JPL Horizons, orbit solution JPL#218 (solution date 2023-Nov-06), retrieved in 2024
+#: as Horizons output: "Equivalent ICRF heliocentric cartesian coordinates (au, au/d)" at
+#: EPOCH = 2459215.5 = 2021-Jan-01.00 TDB. Horizons' model also has the non-gravitational terms A1, A2
+#: (au/d², g(r) = (1 au/r)²) and Earth J2; :func:`published_orbit_simulation` includes both.
+APOPHIS_HORIZONS = PublishedState(
+    "Apophis",
+    Time(2459215.5, format="jd", scale="tdb"),
+    (-4.098530837957945e-01, 9.070198867765817e-01, 3.267919471926086e-01),
+    (-1.507552412223498e-02, -3.713559924880165e-03, -1.761867984500986e-03),
+    dict(EC=0.1915216892529348, QR=0.7458270479403062, TP=2459101.039422418, OM=204.0389271089114,
+         W=126.6520518833791, IN=3.336751319526047, A=0.9225071817339578, MA=127.3225632500591),
+    dict(A1=4.999999873689e-13, A2=-2.901092102547e-14),
+    "JPL Horizons, (99942) Apophis, solution JPL#218 (2023-Nov-06), heliocentric ICRF state at "
+    "2021-01-01.0 TDB (retrieved 2024)",
+)
+
+
+def published_orbit_simulation(state=APOPHIS_HORIZONS, time=None, bodies=DEFAULT_BODIES, integrator="ias15",
+                               extra_forces=True, non_gravitational=True):
+    """REBOUND simulation with a published heliocentric state, integrated to ``time``.
+
+    The Sun, planets, Moon and Pluto come from DE421 at ``state.epoch``
+    (:func:`~spinorbit.coupling.rebound.adapter.simulation_from_de421`); the body (named
+    ``state.name``, massless) is placed at the simulation's Sun + the published heliocentric state,
+    converted from IAU 2012 au to DE421's au (the simulation's unit). With ``extra_forces`` (default),
+    :func:`~spinorbit.coupling.rebound.adapter.install_extra_forces` adds Earth's J2 and the EIH 1PN
+    terms — Horizons' small-body model has both — and, with ``non_gravitational`` (default), the
+    solution's own non-gravitational terms ``state.non_gravitational`` (A1, A2, A3 in au/d², g(r) =
+    (1 au/r)², :func:`~spinorbit.coupling.rebound.adapter.set_nongravitational`). Left out are the
+    asteroid perturbers. The run is IAS15 with ``exact_finish_time`` up to ``time`` (astropy Time;
+    None: stay at the epoch).
+    """
+    if non_gravitational and not extra_forces:
+        raise ValueError(
+            "non_gravitational=True needs extra_forces=True (the terms live in the same compiled "
+            "force); pass non_gravitational=False for a purely Newtonian run."
+        )
+    sim = simulation_from_de421(state.epoch, bodies=bodies, integrator=integrator)
+    if extra_forces:
+        install_extra_forces(sim)
+    scale = IAU_AU_KM / de421_constants().au_km
+    position = np.asarray(state.position_au, float) * scale
+    velocity = np.asarray(state.velocity_au_day, float) * scale
+    sun = sim.particles[body_index(sim, "sun")]
+    sim.add(m=0.0, x=sun.x + position[0], y=sun.y + position[1], z=sun.z + position[2],
+            vx=sun.vx + velocity[0], vy=sun.vy + velocity[1], vz=sun.vz + velocity[2], name=state.name)
+    if non_gravitational and state.non_gravitational:
+        a = {k: state.non_gravitational.get(k, 0.0) * scale for k in ("A1", "A2", "A3")}  # IAU au → DE421 au
+        set_nongravitational(sim, state.name, a["A1"], a["A2"], a["A3"])
+    if time is not None:
+        day, fraction = tdb_day_and_fraction(time)
+        sim.integrate(day + fraction)
+    return sim
+
+
+def closest_approach(sim, body, near, window_days=1.0, target="earth"):
+    """Closest approach of ``body`` to ``target`` within ``near`` ± ``window_days`` (moves ``sim``).
+
+    A 10-minute scan of the window, then Brent's method on the distance (IAS15 with
+    ``exact_finish_time`` runs back and forth; the simulation is left at the closest approach).
+
+    Returns
+    -------
+    time : Time (TDB)
+    distance_km : float
+        Centre-to-centre, DE421 km.
+    speed_km_s : float
+        Relative speed at closest approach.
+    """
+    au_km = de421_constants().au_km
+    i, j = body_index(sim, body), body_index(sim, target)
+    day, fraction = tdb_day_and_fraction(near)
+    centre = day + fraction
+
+    def distance(t):
+        sim.integrate(t)
+        a, b = sim.particles[i], sim.particles[j]
+        return math.dist((a.x, a.y, a.z), (b.x, b.y, b.z))
+
+    scan = centre + np.arange(-window_days, window_days + 1e-9, 1.0 / 144.0)
+    values = [distance(t) for t in scan]
+    k = int(np.argmin(values))
+    if k in (0, len(scan) - 1):
+        raise ValueError(f"no closest approach of {body} to {target} inside ±{window_days} d of {near.tdb.iso}.")
+    result = minimize_scalar(distance, bracket=(scan[k - 1], scan[k], scan[k + 1]), tol=1e-12)
+    distance(result.x)
+    a, b = sim.particles[i], sim.particles[j]
+    speed = math.dist((a.vx, a.vy, a.vz), (b.vx, b.vy, b.vz))
+    return time_from_tdb_days(result.x), result.fun * au_km, speed * au_km / 86400.0
+
+
+def apophis_encounter_simulation(orbit="published", extra_forces=None):
+    """Apophis for the 2029 encounter: a REBOUND simulation at :data:`APOPHIS_2029`'s time.
+
+    ``orbit="published"`` (default): :data:`APOPHIS_HORIZONS` integrated from 2021-01-01 TDB with
+    :func:`published_orbit_simulation` (Earth J2 + EIH + the solution's Yarkovsky terms on unless
+    ``extra_forces=False``).
+    ``orbit="geometry"``: the documented fallback encounter geometry, :func:`encounter_simulation`
+    (no extra forces unless ``extra_forces=True``).
+    """
+    if orbit == "published":
+        full = True if extra_forces is None else bool(extra_forces)
+        return published_orbit_simulation(APOPHIS_HORIZONS, APOPHIS_2029.time_tdb,
+                                          extra_forces=full, non_gravitational=full)
+    if orbit == "geometry":
+        sim = encounter_simulation(APOPHIS_2029)
+        if extra_forces:
+            install_extra_forces(sim)
+        return sim
+    raise ValueError(f"orbit must be 'published' or 'geometry', got {orbit!r}.")
+
+
+# ------------------------------------------------------------------------------------------------
+# Spin states.
+
+
+def aligning_quaternion(v_body, v_inertial):
+    """Unit quaternion q (body → inertial) with M(q) v̂_body = v̂_inertial (the smallest rotation)."""
+    a = np.asarray(v_body, float) / np.linalg.norm(v_body)
+    b = np.asarray(v_inertial, float) / np.linalg.norm(v_inertial)
+    q = np.concatenate([[1.0 + a @ b], np.cross(a, b)])
+    return q / np.linalg.norm(q)
+
+
+def _sam_state(body, d, momentum, direction):
+    big_a, big_b, big_c = body.principal_moments
+    b, c = 1 / big_b, 1 / big_c
+    along_c = momentum * math.sqrt((b - d) / (b - c))  # from 2T = b(G² − L²) + c L² = d G²
+    principal_momentum = np.array([0.0, math.sqrt(momentum**2 - along_c**2), along_c])
+    p = body.to_principal
+    user_momentum = p.T @ principal_momentum
+    q = aligning_quaternion(user_momentum, direction)
+    return RotationState(body, q, user_momentum / body.moment_values)
+
+
+def sam_state_from_periods(body, p_psi, p_phi, momentum_direction):
+    """A short-axis-mode state with given periods and angular-momentum direction.
+
+    P_ψ/P_φ depends only on d = 2T/G² (at fixed moments), and both periods scale as 1/G, so d is
+    found by root finding on the ratio and G then from P_ψ. The attitude puts the body momentum
+    (0, ·, +L_C) on ``momentum_direction`` by the smallest rotation — one choice of the (unknown)
+    rotation phase; the momentum has a positive component on +C.
+
+    Parameters
+    ----------
+    body : RigidBody
+    p_psi, p_phi : Quantity
+        Rotation and precession periods (Pravec et al. 2005 convention, :attr:`RotationState.periods`).
+    momentum_direction : array_like (3,)
+        Unit vector of the angular momentum in the inertial frame of the state (ICRF here).
+
+    Returns
+    -------
+    RotationState
+    """
+    big_a, big_b, big_c = body.principal_moments
+    b, c = 1 / big_b, 1 / big_c
+    ratio = (p_psi / p_phi).to_value(u.dimensionless_unscaled)
+    direction = np.asarray(momentum_direction, float)
+
+    def mismatch(d):
+        pp, pf = _sam_state(body, d, 1.0, direction).periods
+        return (pp / pf).to_value(u.dimensionless_unscaled) - ratio
+
+    # Keep off the separatrix (d = b, periods → ∞) and principal rotation (d = c, P_ψ → finite but
+    # the mode degenerates) by relative margins of 1e-9.
+    d = brentq(mismatch, c * (1 + 1e-9), b * (1 - 1e-9), xtol=1e-15, rtol=1e-14)
+    unit_periods = _sam_state(body, d, 1.0, direction).periods
+    momentum = (unit_periods[0] / p_psi).to_value(u.dimensionless_unscaled)
+    return _sam_state(body, d, momentum, direction)
+
+
+#: Pravec et al. (2014) Apophis: P_ψ, P_φ and the angular-momentum direction (ecliptic J2000).
+APOPHIS_P_PSI = 263.0 * u.hour
+APOPHIS_P_PHI = 27.38 * u.hour
+APOPHIS_MOMENTUM_ECLIPTIC_DEG = (250.0, -75.0)
+
+
+def apophis_rotation_state():
+    """Apophis (Pravec et al. 2014) as a :class:`RotationState` with the attitude relative to ICRF.
+
+    SAM with P_ψ = 263 h, P_φ = 27.38 h, moments 0.61 : 0.965 : 1; angular momentum towards ecliptic
+    (λ, β) = (250°, −75°) — a retrograde spin (β < 0). E/E0 then follows from the moments and periods
+    (the examples print it against the published 1.024 ± 0.013). The rotation phase is not published
+    with these numbers: :func:`sam_state_from_periods` picks the smallest rotation.
+    """
+    return sam_state_from_periods(APOPHIS_BODY, APOPHIS_P_PSI, APOPHIS_P_PHI,
+                                  ecliptic_direction(*APOPHIS_MOMENTUM_ECLIPTIC_DEG))
+
+
+#: Takahashi et al. (2013) Toutatis Euler angles (deg) and body angular velocity (deg/day, x, y, z).
+TOUTATIS_EULER_DEG = (145.498, 65.865, 241.524)
+TOUTATIS_OMEGA_DEG_DAY = (14.51, 33.529, -98.709)
+
+
+def toutatis_rotation_state(frame="icrf"):
+    """Toutatis at :data:`TOUTATIS_EPOCH` (Takahashi, Busch & Scheeres 2013, Table 2).
+
+    Reading of "ZXZ Euler angles body → inertial (α, β, γ) = (145.498°, 65.865°, 241.524°)": the
+    active rotation taking body axes to inertial axes is M = Rz(α) Rx(β) Rz(γ) (active elementary
+    rotations). The project's attitude matrix is R = Mᵀ = R3(γ) R1(β) R3(α) with passive R1, R3, i.e.
+    exactly the project's passive 3-1-3 angles (φ, θ, ψ) = (α, β, γ): ``from_euler313(body, α, β, γ)``.
+    The inertial frame is taken as ecliptic J2000 (the frame of the radar spin solutions); the state is
+    then rotated to ICRF for the torques. The spin (and so the periods 5.369 / 7.412 d) does not depend
+    on this reading; the attitude — and through it the torques — does.
+
+    Parameters
+    ----------
+    frame : {"icrf", "ecliptic"}
+        Inertial frame of the returned attitude.
+    """
+    omega = np.array(TOUTATIS_OMEGA_DEG_DAY) * u.deg / u.day
+    state = RotationState.from_euler313(TOUTATIS_BODY, *(a * u.deg for a in TOUTATIS_EULER_DEG), omega)
+    if frame == "ecliptic":
+        return state
+    if frame != "icrf":
+        raise ValueError(f"frame must be 'icrf' or 'ecliptic', got {frame!r}.")
+    # v_body = R_ecl v_ecl = R_ecl E v_icrf with E the passive ICRF → ecliptic matrix.
+    return RotationState.from_matrix(TOUTATIS_BODY, state.attitude_matrix @ icrf_to_ecliptic_matrix(), omega)

@@ -1,0 +1,632 @@
+"""The scene planner's bounds and its EXPLAIN-like plan (used by :class:`spinorbit.scene.scene.Scene`).
+
+The one estimate every skip rests on
+------------------------------------
+A torque N(s) left out of a run (a dropped perturber, or all of them for the torque-free route) changes
+the body angular momentum by at most ∫|N| ds and, through it, the body angular velocity by at most
+|δω(s)| ≤ (1/A) ∫₀^s |N| ds' (A the smallest principal moment). Linearising about the free motion
+(Duhamel), an angular-velocity kick δω applied at time s moves the attitude at T by at most
+
+    |δθ(T)| ≤ κ |δω| (T − s) + 2 |δL| / |L|,
+
+the first term the accumulated phase drift, the second the tilt of the momentum (the body then
+nutates about a new axis: an O(δL/L) attitude difference that does not grow). κ is the attitude
+sensitivity of the free motion: 1 for a uniform rotation, larger where the periods depend steeply on
+the state (near the separatrix). It is **measured**, not assumed: :func:`attitude_sensitivity`
+propagates the state exactly (no integration) with ω kicked along each body axis and takes the largest
+δθ/(|δω| τ) over horizons τ = T/16 … T. Summing the kicks,
+
+    bound = SAFETY · [ κ ∫₀^T (T − s) |N(s)|/A ds + 2 ∫₀^T |N(s)| ds / |L| ],
+
+with the degree-2 torque of a point mass μ at distance r bounded by its largest value over all
+attitudes, |N| ≤ (3μ / 2r³) (C − A) (the unit vector r̂ at 45° between the A and C axes maximises
+|r̂ × I r̂| = (C − A)/2). r(s) comes from a survey: the same adaptive sampler as the run
+(:mod:`spinorbit.coupling.one_way`), at the loose relative tolerance :data:`SURVEY_TOLERANCE` (with a
+REBOUND orbit at the run's own tolerance, and kept for the run), which still tightens its grid around
+close encounters. SAFETY = 2 covers the trapezoid rule between survey
+samples and the linearisation. ``tests/test_scene.py`` checks the bound against full runs: the
+measured effect of a dropped torque must stay below it. This *worst-attitude* bound is 20–2400×
+above the measured effect: the real torque turns with the body, and its integral cancels.
+
+The free-motion bound (what the planner uses where it applies)
+---------------------------------------------------------------
+The same linear response, with the cancellation kept where it is sound. The torque vector N(s) of each
+perturber is evaluated along the exact free motion (:func:`free_motion_grid`: the torque-free solution
+on a grid of :data:`POINTS_PER_TURN` points per turn at |ω| ≤ |L|/A plus every survey interval cut in
+:data:`SURVEY_SUBDIVISION`; the perturber positions are the survey's Hermite interpolants, through the
+one torque definition :func:`spinorbit.core.dynamics.equations.inertial_torques_along`). The response to a kick
+splits in two:
+
+- a **secular drift**, from the change of the free motion's frequencies, which depend on its two
+  actions |L| and E only. Its kernel is (T − s) times constant derivatives of the frequencies, so
+  integrating by parts is exact: the drift is ∫₀ᵀ (Ω_L δ|L|(s) + Ω_E δE(s)) ds with the first-order
+  action changes δ|L|(s) = L̂·∫₀ˢ N ds' (the momentum change as a vector, in ICRF) and
+  δE(s) = ∫₀ˢ ω·N ds' (the power), both integrated along the free motion with their cancellation
+  (:func:`action_changes`). Ω_L, Ω_E are measured like κ (:func:`action_sensitivities`): κ_L with
+  ω scaled by 1 + ε, κ_E with L turned in the body at fixed |L|, each the largest attitude change per
+  unit action change and time;
+- a **bounded part** (the tilt of L and the changed nutation: 2|δL|/|L| per kick). Its kernel turns
+  with the body and shares the torque's frequencies (both live on the free motion's torus: the averaged
+  potential shifts the phases without changing any action), so it does not cancel: it stays
+  2 ∫|N|_max ds / |L| as in the worst-attitude bound.
+
+So, with Ē(s) = ∫₀ˢ |N|_max/A ds' and Θ below (:func:`free_motion_torque_bound`),
+
+    bound = SAFETY · [ κ_L ∫₀ᵀ (|δ|L||/A + 3Θ Ē) ds + κ_E ∫₀ᵀ (|δE − 2E δ|L|/|L|| / |L| + 6Θ Ē) ds
+                       + 2 Ē(T) / (|L|/A) ],
+
+taken at most equal to the worst-attitude bound (δE − 2E δ|L|/|L| is the energy change that the ω
+scaling of κ_L does not account for). What it assumes:
+
+- **The run stays near the free motion.** The run's torque is evaluated along the *run's* attitude,
+  which every torque (kept and dropped) moves off the free motion by some Θ; an attitude error ε changes
+  the degree-2 torque by at most ATTITUDE_GRADIENT · |N|_max · ε (3: 2 from turning r̂ in the body,
+  1 from turning N into the inertial frame), hence the Θ terms (the power's carries |ω| ≤ |L|/A and
+  2E/|L|² ≤ 1/A, so 6). Θ is the smallest self-consistent total of the perturbers' bounds
+  (:func:`self_consistent_deviation`), plus the survey's relative position error (it enters like an
+  attitude error). Above :data:`LINEAR_LIMIT` = 0.1 rad (e.g. the Earth at an Apophis flyby, which
+  turns the spin by radians; the Earth's torque on the Moon) the torque along the free motion says
+  nothing about the run's, and every perturber gets the worst-attitude bound.
+- **Linear response**, as the worst-attitude bound: κ_L, κ_E are measured for kicks at the epoch and
+  taken for every s; the trapezoid rule on the grid and the rest are left to SAFETY = 2. Checked
+  against full runs (``tests/test_scene.py``): short-axis, long-axis, near-separatrix, slowly rotating
+  and flat-disc (C ≈ A + B: the torque's body frequency at the nutation frequency) states, and a close
+  flyby; 3.7–39× above the measured effect where the worst-attitude bound was 19–2600×
+  (``docs/scenes.md``).
+- **Resolution.** Beyond :data:`MAX_EVALUATIONS` = 2e6 torque evaluations (grid points × perturbers)
+  the worst-attitude bound is used; the plan's reason says which bound was taken and why.
+
+Back-reaction (one-way coupling against the fully coupled run)
+--------------------------------------------------------------
+A figure (C − A) of a body of mass M pulls a perturber of mass m_p at distance r with a force beyond
+the point mass's, and the body back; the relative acceleration changes by at most
+
+    |δa_q| ≤ 6 J (μ_b + μ_q) / r_q⁴ + 6 J Σ_{p≠q} μ_p / r_p⁴,      J = (C − A)/M (length²),
+
+from the degree-2 field ∇U = (3G/2r⁴)[−tr I′ r̂ − 2 I′ r̂ + 5 (r̂·I′r̂) r̂] (MacCullagh; I′ = I − (A+C)/2 𝟙
+has eigenvalues within ±(C − A)/2, so the bracket is at most 4 (C − A)); the second term is the body's
+recoil from the other perturbers, which moves it relative to q too. The orbit answers an impulse δa
+after a time τ with a displacement of at most :data:`ORBIT_RESPONSE` · τ · δa: for a circular orbit
+(Hill's equations, any mean motion) the largest |response|/τ is 3.91, computed over 0 < nτ < 200
+(the along-track drift of the changed semi-major axis); a free particle has 1. So
+
+    |δr_q(s)| ≤ ORBIT_RESPONSE ∫₀ˢ (s − s′) |δa_q(s′)| ds′,
+
+and the changed perturber vector changes the torque by at most 5 |N|_max(r) |δr|/r (3|δr|/r from
+1/r³, 2|δr|/r from turning r̂: |δ(r̂ × I′r̂)| ≤ (C − A) |δr̂|). That torque change goes through the
+same attitude bound as a dropped torque (:func:`dropped_torque_bound`); :func:`back_reaction_bound`
+is their sum over the perturbers. Eccentric orbits respond more strongly near pericentre than the
+circular 3.91: that is left to SAFETY (moderate e), and the bound is tested against the fully coupled
+REBOUND run (``CoupledRigidBody``, ``tests/test_scene.py``). It keeps the worst-attitude form: the chain
+bounds only the *size* of the displacement, not its direction, so there is no torque-change vector to
+integrate along the free motion.
+
+Budget: a scene's tolerance (an attitude angle) is shared: up to :data:`DROP_SHARE` of it for the
+perturbers dropped and the back-reaction left out (one-way coupling), the rest for the integrator (whose error is estimated a posteriori by a second
+run at 10× the rtol) and the sampling (relative position error ε gives a relative torque error ≤ 3ε).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = [
+    "ARCSEC_PER_RAD",
+    "DROP_SHARE",
+    "SAFETY",
+    "SURVEY_TOLERANCE",
+    "Decision",
+    "PerturberEstimate",
+    "Plan",
+    "ORBIT_RESPONSE",
+    "attitude_sensitivity",
+    "back_reaction_bound",
+    "dropped_torque_bound",
+    "FreeMotion",
+    "action_changes",
+    "action_sensitivities",
+    "free_motion_bounds",
+    "free_motion_grid",
+    "free_motion_torque_bound",
+    "self_consistent_deviation",
+    "initial_rtol",
+    "max_torque_over_a",
+]
+
+#: Factor on the linear-response bound (module docstring).
+SAFETY = 2.0
+#: Share of the tolerance that dropped perturbers may use; the rest goes to integration and sampling.
+DROP_SHARE = 0.5
+#: Relative position tolerance of the planner's survey of the perturber distances.
+SURVEY_TOLERANCE = 1e-6
+#: Horizons (fractions of the span) at which the attitude sensitivity κ is measured.
+SENSITIVITY_HORIZONS = (1 / 16, 1 / 8, 1 / 4, 1 / 2, 1.0)
+#: Attitude change (rad) the sensitivity probe aims for: large against rounding (1e-13), small
+#: enough to stay linear.
+SENSITIVITY_PROBE_RAD = 1e-6
+#: Global DOP853 error was ≈ 300 × rtol in work-precision scene (a) (docs/performance.md); the
+#: first rtol tried is the integration share / 1000, then checked a posteriori.
+RTOL_PER_ERROR = 1e-3
+RTOL_RANGE = (1e-13, 1e-6)
+ARCSEC_PER_RAD = 180.0 * 3600.0 / math.pi
+#: Largest orbit displacement per unit impulse and elapsed time (module docstring: 3.91 for a circular
+#: orbit, computed from Hill's equations; rounded up).
+ORBIT_RESPONSE = 4.0
+#: Free-motion bound: grid points per turn of the fastest rotation the free motion can reach (|ω| ≤ |L|/A);
+#: the degree-2 torque, quadratic in the perturber's body direction, then has ≥ 16 points per cycle.
+POINTS_PER_TURN = 32
+#: Free-motion bound: each survey interval is cut into this many (the survey grid is dense where the
+#: perturbers move fast, e.g. close encounters).
+SURVEY_SUBDIVISION = 4
+#: Free-motion bound: largest number of torque evaluations (grid points × perturbers; ≈ 0.1 µs each);
+#: beyond it the worst-attitude bound is used.
+MAX_EVALUATIONS = 2_000_000
+#: Free-motion bound: largest deviation (rad) of the run from the free motion for which the torques
+#: are evaluated along the free motion; beyond it the worst-attitude bound is used.
+LINEAR_LIMIT = 0.1
+#: |δN| ≤ ATTITUDE_GRADIENT · |N|_max · ε when the attitude is off by ε: 2 from turning r̂ in the body
+#: (|δ(r̂ × I′r̂)| ≤ (C − A)|δr̂|), 1 from turning N into the inertial frame.
+ATTITUDE_GRADIENT = 3.0
+#: |∇U| of a degree-2 figure ≤ FIGURE_FORCE · G (C − A) / r⁴ (module docstring).
+FIGURE_FORCE = 6.0
+#: |δN| ≤ TORQUE_GRADIENT · |N|_max · |δr|/r for a change δr of the perturber vector (module docstring).
+TORQUE_GRADIENT = 5.0
+
+
+def max_torque_over_a(moments, gm, distance):
+    """Largest degree-2 torque over all attitudes divided by A: (3 μ / 2 r³) (C − A)/A, rad/day².
+
+    Parameters
+    ----------
+    moments : (A, B, C)
+        Principal moments, any unit (only ratios enter).
+    gm : float
+        Perturber's G·M, au³/day².
+    distance : float or ndarray
+        Distance body–perturber, au.
+    """
+    big_a, _, big_c = moments
+    return 1.5 * gm * (big_c - big_a) / big_a / np.asarray(distance, dtype=float) ** 3
+
+
+def attitude_sensitivity(state, span_days):
+    """κ: the largest attitude change per unit |δω|·τ of the exact free motion (module docstring).
+
+    Three exact propagations of ``state`` with ω kicked by δ along each body axis, compared with the
+    unkicked one at the horizons τ = :data:`SENSITIVITY_HORIZONS` × ``span_days``. δ is chosen so
+    that δ·span ≈ :data:`SENSITIVITY_PROBE_RAD`. Returns at least 1 (a uniform rotation's κ).
+    """
+    from spinorbit.core.math.rotations import rotation_angle_between_many
+    from spinorbit.state import RotationState
+
+    horizons = np.array(SENSITIVITY_HORIZONS) * span_days
+    omega = state.angular_velocity.to_value("rad/day")
+    kick = SENSITIVITY_PROBE_RAD / span_days
+    base = np.ascontiguousarray(state.propagate_torque_free(horizons)[0])
+    kappa = 1.0
+    for axis in range(3):
+        kicked_omega = omega.copy()
+        kicked_omega[axis] += kick
+        kicked = RotationState(state.body, state.quaternion, kicked_omega)
+        other = np.ascontiguousarray(kicked.propagate_torque_free(horizons)[0])
+        angles = rotation_angle_between_many(base, other)
+        kappa = max(kappa, float(np.max(angles / (kick * horizons))))
+    return kappa
+
+
+def dropped_torque_bound(days, torque_over_a, span_end, kappa, momentum_over_a):
+    """The attitude bound (rad) at ``span_end`` of leaving out a torque |N|/A sampled at ``days``.
+
+    ``days`` (increasing, TDB days) and ``torque_over_a`` (rad/day²) are survey samples; the integrals
+    of the module docstring are taken with the trapezoid rule. ``momentum_over_a`` is |L|/A (rad/day).
+    """
+    days = np.asarray(days, dtype=float)
+    n = np.asarray(torque_over_a, dtype=float)
+    lever = span_end - days
+    drift = _trapezoid(lever * n, days)
+    tilt = _trapezoid(n, days)
+    return SAFETY * (kappa * drift + 2.0 * tilt / momentum_over_a)
+
+
+@dataclass
+class FreeMotion:
+    """The exact free motion on the grid of the free-motion bound (:func:`free_motion_grid`).
+
+    Attributes
+    ----------
+    days : ndarray (n,)
+        TDB days, increasing, from the epoch to the span's end.
+    quaternions : ndarray (n, 4)
+        Principal-axis attitudes (body → ICRF).
+    omega : ndarray (n, 3)
+        Angular velocity in ICRF, rad/day.
+    momentum_over_a : ndarray (3,)
+        L/A in ICRF (constant on the free motion), rad/day.
+    energy_over_a : float
+        Kinetic energy E/A = ½ L·ω / A, rad²/day².
+    """
+
+    days: np.ndarray
+    quaternions: np.ndarray
+    omega: np.ndarray
+    momentum_over_a: np.ndarray
+    energy_over_a: float
+
+
+def free_motion_grid(state, epoch_day, span_end, survey_days=(), perturbers=1):
+    """The exact free motion of ``state`` on the grid of the free-motion bound, or why not.
+
+    The grid takes :data:`POINTS_PER_TURN` points per 2π A/|L| (a turn at the largest angular velocity
+    the free motion can reach, |ω| ≤ |L|/A) and every survey interval cut into
+    :data:`SURVEY_SUBDIVISION` (the survey tightened its grid where the perturbers move fast, e.g. at
+    a close encounter). Returns ``(FreeMotion, None)``, or ``(None, why)`` when the grid times
+    ``perturbers`` would exceed :data:`MAX_EVALUATIONS` torque evaluations.
+    """
+    from spinorbit.core.math.rotations import attitude_to_quat, quat_to_attitude_many
+    from spinorbit.core.free_motion.flow import torque_free_states
+
+    attitude, momentum = state.principal_attitude_and_momentum()
+    moments = np.array(state.body.principal_moments, dtype=float)
+    turn = 2.0 * math.pi * moments[0] / float(np.linalg.norm(momentum))
+    uniform = int(math.ceil((span_end - epoch_day) / turn * POINTS_PER_TURN)) + 1
+    survey_days = np.asarray(survey_days, dtype=float)
+    total = uniform + SURVEY_SUBDIVISION * max(survey_days.size - 1, 0)
+    if total * perturbers > MAX_EVALUATIONS:
+        return None, (f"the free-motion grid would take {total * perturbers:.3g} torque evaluations "
+                      f"(> {MAX_EVALUATIONS:.0e}: {POINTS_PER_TURN} per turn of a {turn * 24:.3g} h rotation), "
+                      "so the worst-attitude bound is used")
+    pieces = [np.linspace(epoch_day, span_end, max(uniform, 2))]
+    if survey_days.size > 1:
+        fractions = np.arange(SURVEY_SUBDIVISION) / SURVEY_SUBDIVISION
+        pieces.append((survey_days[:-1, None] + np.diff(survey_days)[:, None] * fractions).ravel())
+    days = np.unique(np.clip(np.concatenate(pieces), epoch_day, span_end))
+    quaternions, body_momenta = torque_free_states(attitude_to_quat(np.ascontiguousarray(attitude)), momentum,
+                                                   *moments, days - epoch_day)
+    quaternions = np.ascontiguousarray(quaternions)
+    # ω_inertial = M(q) ω_body, M(q) the transpose of the attitude matrix.
+    omega = np.einsum("nji,nj->ni", quat_to_attitude_many(quaternions), body_momenta / moments)
+    momentum_over_a = attitude.T @ momentum / moments[0]
+    energy_over_a = 0.5 * float(momentum @ (momentum / moments)) / moments[0]
+    return FreeMotion(days, quaternions, omega, momentum_over_a, energy_over_a), None
+
+
+def action_changes(free, source, moments):
+    """δ|L|/A and δE/A along the free motion from the torque of ``source``, cancellation kept.
+
+    δL(s) = ∫₀ˢ N ds' is integrated as a vector (ICRF) along ``free``; δ|L| = L̂·δL and the kinetic
+    energy change δE(s) = ∫₀ˢ ω·N ds' are the first-order changes of the free motion's two actions
+    (its frequencies depend on |L| and E only). Trapezoid rule on ``free.days``.
+
+    Parameters
+    ----------
+    free : FreeMotion
+    source : ndarray
+        One :mod:`spinorbit.core.model.perturbers` source (sampled, fixed or Kepler), evaluated through the one
+        torque definition (:func:`spinorbit.core.dynamics.equations.inertial_torques_along`).
+    moments : (A, B, C)
+        Principal moments (only ratios enter).
+
+    Returns
+    -------
+    momentum : ndarray (n,)
+        δ|L|/A, rad/day.
+    energy : ndarray (n,)
+        δE/A, rad²/day².
+    """
+    from spinorbit.core.dynamics.equations import inertial_torques_along, make_model
+
+    torque = inertial_torques_along(free.days, free.quaternions, make_model(moments, [source])) / moments[0]
+    direction = free.momentum_over_a / np.linalg.norm(free.momentum_over_a)
+    return (_cumulative_trapezoid(torque @ direction, free.days),
+            _cumulative_trapezoid(np.einsum("ni,ni->n", free.omega, torque), free.days))
+
+
+def action_sensitivities(state, span_days):
+    """(κ_L, κ_E): the largest attitude change per unit action change and time of the exact free motion.
+
+    κ_L: ω scaled by 1 + ε (δ|L| = ε|L| and δE = 2εE: the free motion runs faster), per δ|L|/A · τ.
+    κ_E: the body momentum turned in the body at fixed |L| towards the component of ω across L (E changes
+    fastest), per |δE|/|L| · τ (δE measured exactly, so a state with ω along L, where E changes only to
+    second order, is measured too). Horizons τ and probe size as in :func:`attitude_sensitivity`.
+    """
+    from spinorbit.core.math.rotations import rotation_angle_between_many
+    from spinorbit.state import RotationState
+
+    horizons = np.array(SENSITIVITY_HORIZONS) * span_days
+    base = np.ascontiguousarray(state.propagate_torque_free(horizons)[0])
+    _, momentum = state.principal_attitude_and_momentum()
+    moments = np.array(state.body.principal_moments, dtype=float)
+    p = state.body.to_principal
+    size = float(np.linalg.norm(momentum))
+    omega = momentum / moments
+    energy = 0.5 * float(momentum @ omega)
+
+    def response(kicked_momentum):
+        kicked = RotationState(state.body, state.quaternion, p.T @ (kicked_momentum / moments))
+        other = np.ascontiguousarray(kicked.propagate_torque_free(horizons)[0])
+        return rotation_angle_between_many(base, other) / horizons
+
+    eps = SENSITIVITY_PROBE_RAD / (span_days * float(np.linalg.norm(omega)))
+    kappa_l = float(np.max(response(momentum * (1.0 + eps)) / (eps * size / moments[0])))
+    across = omega - (omega @ momentum) / size**2 * momentum
+    across_size = float(np.linalg.norm(across))
+    if across_size < 1e-9 * np.linalg.norm(omega):  # ω along L: E changes at second order, any direction across
+        across = np.cross(momentum, np.eye(3)[int(np.argmin(np.abs(momentum)))])
+    across /= np.linalg.norm(across)
+    # Turn by an angle whose energy change is the probe's, δE/|L| · T ≈ SENSITIVITY_PROBE_RAD (δE ≈ |L| |ω⊥| angle).
+    angle = min(SENSITIVITY_PROBE_RAD / (span_days * max(across_size, 1e-300)), 1e-3)
+    turned = math.cos(angle) * momentum + math.sin(angle) * size * across
+    change = abs(0.5 * float(turned @ (turned / moments)) - energy)
+    kappa_e = float(np.max(response(turned) / (change / size))) if change > 0.0 else 1.0
+    return kappa_l, kappa_e
+
+
+def free_motion_torque_bound(free, momentum, energy, envelope, kappa_l, kappa_e, deviation):
+    """The attitude bound (rad) at ``free.days[-1]`` of leaving out a torque, from its action changes.
+
+    bound = SAFETY · [ κ_L ∫₀ᵀ (|δ|L||/A + 3Θ Ē) ds + κ_E ∫₀ᵀ (|δE − (2E/|L|) δ|L||/|L| + 6Θ Ē) ds
+                       + 2 Ē(T) / (|L|/A) ],       Ē(s) = ∫₀ˢ |N|_max/A ds'  (module docstring).
+
+    Parameters
+    ----------
+    free : FreeMotion
+    momentum, energy : ndarray (n,)
+        δ|L|/A and δE/A from :func:`action_changes`.
+    envelope : ndarray (n,)
+        Ē at ``free.days`` (worst attitude), rad/day.
+    kappa_l, kappa_e : float
+        From :func:`action_sensitivities`.
+    deviation : float
+        Θ: bound (rad) on how far the run's attitude strays from the free motion over the span.
+    """
+    days = free.days
+    size = float(np.linalg.norm(free.momentum_over_a))
+    envelope = np.asarray(envelope, dtype=float)
+    rest = energy - 2.0 * free.energy_over_a / size * momentum  # δE not explained by the change of |L|
+    drift = (kappa_l * _trapezoid(np.abs(momentum) + ATTITUDE_GRADIENT * deviation * envelope, days)
+             + kappa_e * _trapezoid(np.abs(rest) / size + 2.0 * ATTITUDE_GRADIENT * deviation * envelope, days))
+    return SAFETY * (drift + 2.0 * float(envelope[-1]) / size)
+
+
+def self_consistent_deviation(free_motion, worst_attitude, gradient):
+    """Smallest Θ with Θ = Σᵢ min(bᵢ + gradient · Θ · wᵢ, wᵢ), or None when it exceeds :data:`LINEAR_LIMIT`.
+
+    ``free_motion`` are the bounds bᵢ of :func:`free_motion_torque_bound` at Θ = 0, ``worst_attitude``
+    the bounds wᵢ of :func:`dropped_torque_bound` (rad). The torques move the run off the free motion
+    by Θ, and the Θ terms of the free-motion bound are at most ``gradient`` · Θ · wᵢ (the same integrals
+    as wᵢ; ``gradient`` = 3 max(1, (κ_L + 2κ_E)/κ)), so the iteration from Θ = Σ min(bᵢ, wᵢ) increases
+    monotonically to the smallest fixed point.
+    """
+    b, w = np.asarray(free_motion, dtype=float), np.asarray(worst_attitude, dtype=float)
+    theta = float(np.sum(np.minimum(b, w)))
+    for _ in range(200):
+        if theta > LINEAR_LIMIT:
+            return None
+        new = float(np.sum(np.minimum(b + gradient * theta * w, w)))
+        if new <= theta * (1.0 + 1e-9):
+            return max(new, theta)
+        theta = new
+    return theta if theta <= LINEAR_LIMIT else None
+
+
+def free_motion_bounds(state, epoch_day, span_end, perturbers, worst, position_error, kappa):
+    """The free-motion bounds (rad) of a scene's perturbers, each at most its worst-attitude bound; and the words.
+
+    Parameters
+    ----------
+    state : spinorbit.RotationState
+        The body at ``epoch_day``.
+    epoch_day, span_end : float
+        TDB days.
+    perturbers : sequence of (source, days, torque_over_a)
+        Per perturber: its :mod:`spinorbit.core.model.perturbers` source, its survey times (TDB days) and
+        |N|_max/A on them (rad/day², :func:`max_torque_over_a`).
+    worst : sequence of float
+        Their worst-attitude bounds (:func:`dropped_torque_bound`), rad.
+    position_error : float
+        The survey's relative position error (it enters like an attitude error).
+    kappa : float
+        :func:`attitude_sensitivity`.
+
+    Returns
+    -------
+    bounds : list of float
+        ``worst`` itself where the free-motion bound does not apply (module docstring: the grid above
+        :data:`MAX_EVALUATIONS`, or the run more than :data:`LINEAR_LIMIT` off the free motion).
+    note : str
+        Which bound was taken, with its numbers, for the plan.
+    """
+    span = span_end - epoch_day
+    formula = (f"worst attitude: 2 [κ ∫(T-s)|N|/A ds + 2∫|N| ds/|L|], |N| ≤ 3μ(C-A)/2r³, κ = {kappa:.3g} "
+               f"(measured on the free motion), T = {span:.6g} d")
+    free, why = free_motion_grid(state, epoch_day, span_end, np.unique(np.concatenate([p[1] for p in perturbers])),
+                                 len(perturbers))
+    if free is None:
+        return list(worst), f"{formula}; {why}"
+    kappa_l, kappa_e = action_sensitivities(state, span)
+    moments = state.body.principal_moments
+    changes = [action_changes(free, source, moments) for source, _, _ in perturbers]
+    envelopes = [np.interp(free.days, days, _cumulative_trapezoid(np.asarray(n, dtype=float), days))
+                 for _, days, n in perturbers]
+
+    def bounds_at(deviation):
+        return [free_motion_torque_bound(free, dl, de, e, kappa_l, kappa_e, deviation)
+                for (dl, de), e in zip(changes, envelopes)]
+
+    deviation = self_consistent_deviation(bounds_at(0.0), worst,
+                                          ATTITUDE_GRADIENT * max(1.0, (kappa_l + 2.0 * kappa_e) / kappa))
+    if deviation is None:
+        return list(worst), (f"{formula}; the perturbers move the attitude by more than {LINEAR_LIMIT:g} rad from "
+                             "the free motion (worst-attitude bounds), so the torque along the free motion is not "
+                             "the torque of the run: the worst-attitude bound is used")
+    deviation += position_error
+    bounds = [min(b, w) for b, w in zip(bounds_at(deviation), worst)]
+    return bounds, (f"free motion: 2 [κ_L ∫|δ|L||/A ds + κ_E ∫|δE - 2E δ|L|/|L||/|L| ds + 2∫|N|_max ds/|L|], "
+                    f"δ|L| and δE the action changes of the torque integrated along the exact free motion "
+                    f"({free.days.size} points, {POINTS_PER_TURN} per turn), κ_L = {kappa_l:.3g}, "
+                    f"κ_E = {kappa_e:.3g}, the run within {deviation:.2g} rad of the free motion; at most the "
+                    f"{formula}")
+
+
+def back_reaction_bound(days, distances, gm, gm_body, figure_per_mass, moments, span_end, kappa,
+                        momentum_over_a):
+    """The attitude bound (rad) at ``span_end`` of leaving the figure's force on the orbits out.
+
+    The chain of the module docstring (*Back-reaction*): figure force → orbit displacement →
+    changed torque → attitude, each step bounded, summed over the perturbers.
+
+    Parameters
+    ----------
+    days : ndarray (n,)
+        Survey times, TDB days (increasing).
+    distances : ndarray (n, k)
+        Body–perturber distances at ``days``, au.
+    gm : ndarray (k,)
+        Perturbers' G·M, au³/day².
+    gm_body : float
+        The body's G·M in the orbit model, au³/day².
+    figure_per_mass : float
+        J = (C − A)/M, au².
+    moments : (A, B, C)
+        Principal moments (only ratios enter the torque).
+    span_end, kappa, momentum_over_a
+        As in :func:`dropped_torque_bound`.
+
+    Returns
+    -------
+    bound : float
+        Attitude bound, rad.
+    displacement : ndarray (k,)
+        The bound on each perturber vector's displacement at ``span_end`` (au), for the plan's reason.
+    """
+    days = np.asarray(days, dtype=float)
+    r = np.asarray(distances, dtype=float)
+    gm = np.asarray(gm, dtype=float)
+    pull = gm[None, :] / r**4  # μ_p / r_p⁴
+    recoil = pull.sum(axis=1, keepdims=True)
+    kick = FIGURE_FORCE * figure_per_mass * (gm_body / r**4 + recoil)  # |δa_q|, au/day² (μ_q term in recoil)
+    # ∫₀ˢ (s − s') δa ds' = ∫₀ˢ v, v(s) = ∫₀ˢ δa: two cumulative trapezoid sums.
+    displacement = ORBIT_RESPONSE * _cumulative_trapezoid(_cumulative_trapezoid(kick, days), days)
+    torque = max_torque_over_a(moments, gm[None, :], r)  # |N|_max/A per perturber
+    change = TORQUE_GRADIENT * torque * displacement / r
+    bound = sum(dropped_torque_bound(days, change[:, i], span_end, kappa, momentum_over_a) for i in range(gm.size))
+    return float(bound), displacement[-1]
+
+
+def _cumulative_trapezoid(values, days):
+    """∫ from days[0] to each days[j] (trapezoid), along axis 0; ``values`` (n,) or (n, k)."""
+    steps = 0.5 * (values[1:] + values[:-1]) * np.diff(days).reshape((-1,) + (1,) * (values.ndim - 1))
+    return np.concatenate([np.zeros((1,) + values.shape[1:]), np.cumsum(steps, axis=0)])
+
+
+def _trapezoid(values, days):
+    if days.size < 2:
+        return 0.0
+    return float(np.sum(0.5 * (values[1:] + values[:-1]) * np.diff(days)))
+
+
+def initial_rtol(error_share_rad):
+    """First DOP853 rtol for an integration error share (rad), clipped to :data:`RTOL_RANGE`."""
+    return float(np.clip(error_share_rad * RTOL_PER_ERROR, *RTOL_RANGE))
+
+
+@dataclass(frozen=True)
+class Decision:
+    """One line of a plan: what was decided and why, in words and numbers."""
+
+    topic: str
+    choice: str
+    reason: str
+
+
+@dataclass
+class PerturberEstimate:
+    """Survey result for one perturber: closest distance (au) and the bound (rad) of leaving it out.
+
+    ``bound_rad`` is the free-motion bound where it applies (module docstring), never above
+    ``worst_attitude_rad``, the worst-attitude bound of :func:`dropped_torque_bound`.
+    """
+
+    name: str
+    closest_au: float
+    bound_rad: float
+    kept: bool
+    worst_attitude_rad: float | None = None
+
+
+@dataclass
+class Plan:
+    """What :meth:`spinorbit.scene.scene.Scene.run` will do, and why (``str(plan)`` reads like EXPLAIN).
+
+    Attributes
+    ----------
+    route : {"torque-free", "one-way", "coupled"}
+        Exact free motion (no integration), the one-way integration under the kept perturbers, or the
+        fully coupled REBOUND run (BS, :class:`~spinorbit.coupling.rigid_body.CoupledRigidBody`).
+    orbit_source : {"none", "de421", "ephemeris", "rebound"}
+        Where the positions come from: none needed, DE421, a user ephemeris, a REBOUND (N-body) run.
+    kept, dropped : tuple of str
+        Perturbers in the run and left out.
+    estimates : dict
+        :class:`PerturberEstimate` per perturber (empty when nothing was surveyed).
+    integrator : {"quaternion", "elements", "exact", "rebound-bs"}
+    rtol : float or None
+        First rtol of the integration (for "rebound-bs": BS eps_abs = eps_rel), refined a posteriori.
+    end_only : bool
+        Only the final state is asked: one output time, no dense output, quantities once.
+    tolerance_rad : float
+    kappa : float
+        Measured attitude sensitivity of the free motion (module docstring).
+    dropped_bound_rad : float
+        Sum of the bounds of everything left out (for the torque-free route: all perturbers).
+    full : bool
+        True for the reference plan of ``Scene.plan(skip=False)``: nothing skipped.
+    decisions : list of Decision
+    samples : SampledPerturbers or None
+        For a REBOUND orbit, the survey is taken at the run's sampling tolerance and kept here, so the
+        N-body run is paid once; the run uses its kept perturbers' columns.
+    back_reaction_rad : float
+        Bound of the figure's back-reaction on the orbits that a one-way route leaves out (0 when
+        it is not left out, or when the body has no mass in the orbit model).
+    """
+
+    route: str
+    orbit_source: str
+    kept: tuple
+    dropped: tuple
+    estimates: dict
+    integrator: str
+    rtol: float | None
+    end_only: bool
+    tolerance_rad: float
+    kappa: float
+    dropped_bound_rad: float
+    full: bool
+    decisions: list = field(default_factory=list)
+    #: Perturber samples at the run's tolerance taken while planning (REBOUND route: the N-body run is
+    #: then paid once), reused by the run for the kept perturbers.
+    samples: object = field(default=None, repr=False)
+    back_reaction_rad: float = 0.0
+    back_reaction_bound_rad: float | None = None
+
+    @property
+    def integration_share_rad(self):
+        """Tolerance left for integration and sampling once what was left out is paid for."""
+        return self.tolerance_rad - self.dropped_bound_rad - self.back_reaction_rad
+
+    def __str__(self):
+        title = "reference plan (skip=False: nothing skipped)" if self.full else "plan"
+        lines = [f"{title}: route {self.route}, orbits from {self.orbit_source}, integrator {self.integrator}"
+                 + (f" (rtol {self.rtol:.1e})" if self.rtol else ""),
+                 (f"  tolerance {self.tolerance_rad * ARCSEC_PER_RAD:.4g} arcsec ({self.tolerance_rad:.3e} rad); "
+                  f"left out: bound {self.dropped_bound_rad * ARCSEC_PER_RAD:.3g} arcsec"
+                  + (f" + back-reaction {self.back_reaction_rad * ARCSEC_PER_RAD:.3g} arcsec"
+                     if self.back_reaction_rad else ""))]
+        width = max(len(d.topic) for d in self.decisions) if self.decisions else 0
+        for decision in self.decisions:
+            lines.append(f"  -> {decision.topic.ljust(width)}  {decision.choice}")
+            lines.append(f"     {' ' * width}  because {decision.reason}")
+        return "\n".join(lines)

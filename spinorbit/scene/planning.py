@@ -268,7 +268,7 @@ def choose_coupling(scene, skip, source, kappa, momentum, moments, survey):
             "RigidBody the moments in kg m² and the mass for the estimate); for the Moon the back-reaction was "
             "measured at ≈ 0.1 arcsec over a year (docs/coupling.md: 0.305 one-way vs 0.207 arcsec coupled)")]
     big_a, _, big_c = scene.moments_per_mass
-    if survey is None:  # no named perturbers surveyed (only user ones): as before, sample the (empty) set
+    if survey is None:  # only user perturbers were surveyed: the (empty) named set gives the survey grid
         kept_for_the_run = scene.keeps_survey(source, skip)
         survey = scene.sample_perturbers(source, scene.named, survey_tolerance(kept_for_the_run, scene.sample_tolerance))
     distances = np.linalg.norm(survey.states[:, :, :3], axis=2)

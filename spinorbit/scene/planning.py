@@ -34,7 +34,7 @@ from spinorbit.scene.plan import (
     PlanError,
 )
 from spinorbit.scene.tolerances import (
-    CHECK_FACTOR,
+    CHECK_RTOL_FACTOR,
     COUPLED_EPS_RANGE,
     DROP_SHARE,
     SURVEY_TOLERANCE,
@@ -114,7 +114,7 @@ def plan_scene(scene, skip=True):
     if route == "coupled":
         eps = first_tolerance("rebound-bs", tolerance)
         decisions.append(Decision("integrator", f"REBOUND BS, eps {eps:.1e}, rotation as a user ODE (checked a "
-                                  f"posteriori against a run at {CHECK_FACTOR:g}× eps)",
+                                  f"posteriori against a run at {CHECK_RTOL_FACTOR:g}× eps)",
                                   "BS is the one REBOUND integrator that integrates a user ODE together with the "
                                   "orbits (docs/coupling.md); eps within "
                                   f"{COUPLED_EPS_RANGE[0]:g}…{COUPLED_EPS_RANGE[1]:g} since it controls the orbits too"))
@@ -128,7 +128,7 @@ def plan_scene(scene, skip=True):
     what, knob = ("Taylor (core.integrate_taylor)", "tol") if integrator == "taylor" else (
         f"{integrator} DOP853", "rtol")
     decisions.append(Decision("integrator", f"{what}, {knob} {rtol:.1e} (checked a posteriori "
-                              f"against a run at {CHECK_FACTOR:g}× {knob})", reason))
+                              f"against a run at {CHECK_RTOL_FACTOR:g}× {knob})", reason))
     return Plan(route="one-way", orbit_source=source, kept=kept, dropped=tuple(dropped), estimates=estimates,
                 integrator=integrator, rtol=rtol, end_only=scene.end_only, tolerance_rad=tolerance, kappa=kappa,
                 dropped_bound_rad=used, full=not skip, decisions=decisions, samples=samples,

@@ -19,7 +19,7 @@ from astropy import units as u
 from astropy.table import QTable
 
 from spinorbit.scene.sampling import NoSamples, subset_samples
-from spinorbit.scene.tolerances import MAX_RETRIES, refine, sampling_error_bound
+from spinorbit.scene.tolerances import MAX_RTOL_RETRIES, refine, sampling_error_bound
 from spinorbit.state_table import from_principal, table_columns
 from spinorbit.time import time_from_tdb_days
 
@@ -85,7 +85,7 @@ def run_one_way(scene, plan, report):
         return run, float(np.max(attitude_angles(run["quaternion"], check["quaternion"])))
 
     def attempted(attempt):
-        report(0.3 + 0.7 * (attempt + 1) / (MAX_RETRIES + 1))
+        report(0.3 + 0.7 * (attempt + 1) / (MAX_RTOL_RETRIES + 1))
 
     run, integration, rtol = refine(plan.integrator, plan.rtol, max(plan.integration_share_rad, 0.0), run_and_check,
                                     attempted)
@@ -115,7 +115,7 @@ def run_coupled(scene, plan, report):
         return (rows, stats), float(np.max(attitude_angles(rows[:, :4], check[:, :4])))
 
     def attempted(attempt):
-        report((attempt + 1) / (MAX_RETRIES + 1))
+        report((attempt + 1) / (MAX_RTOL_RETRIES + 1))
 
     (rows, stats), integration, eps = refine("rebound-bs", plan.rtol, max(plan.integration_share_rad, 0.0),
                                              run_and_check, attempted)

@@ -6,7 +6,7 @@ share*, is split between the integration and the sampling of the perturbers:
 
 - the **integration** gets a first local tolerance from the share (:func:`first_tolerance`: the
   DOP853 rtol, the Taylor tol, REBOUND's BS eps), chosen so that the global error lands at about
-  0.3 × the share; the run is then checked against a second run at :data:`CHECK_FACTOR` × that
+  0.3 × the share; the run is then checked against a second run at :data:`CHECK_RTOL_FACTOR` × that
   tolerance, and repeated at 1/:data:`RETRY_FACTOR` of it while the difference is above
   :data:`ACCEPTED_SHARE` × the share (:func:`refine`);
 - the **sampling** at the scene's ``sample_tolerance`` ε (a relative position error) makes a relative
@@ -26,10 +26,10 @@ import numpy as np
 
 __all__ = [
     "ACCEPTED_SHARE",
-    "CHECK_FACTOR",
+    "CHECK_RTOL_FACTOR",
     "COUPLED_EPS_RANGE",
     "DROP_SHARE",
-    "MAX_RETRIES",
+    "MAX_RTOL_RETRIES",
     "RETRY_FACTOR",
     "RTOL_PER_ERROR",
     "RTOL_RANGE",
@@ -57,12 +57,13 @@ RTOL_RANGE = (1e-13, 1e-6)
 #: BS eps range of the coupled route. Its error control covers the orbits too (positions ~1 au):
 #: looser than 1e-10 would put the orbits' error above the one-way sampler's default 1e-10.
 COUPLED_EPS_RANGE = (1e-13, 1e-10)
-#: Factor between the run's tolerance and the check run's (error estimate = their difference).
-CHECK_FACTOR = 10.0
+#: Factor between the run's tolerance and the check run's (error estimate = their difference); for the
+#: Taylor tol and the BS eps too (the name is the one scripts know).
+CHECK_RTOL_FACTOR = 10.0
 #: Tighter tolerance of a retry: the tolerance / RETRY_FACTOR.
 RETRY_FACTOR = 100.0
 #: Retries of the integration when the a posteriori estimate misses its share.
-MAX_RETRIES = 2
+MAX_RTOL_RETRIES = 2
 #: The integration's part of the integration share (the sampling takes the rest).
 ACCEPTED_SHARE = 0.5
 #: Relative position tolerance of the planner's survey of the perturber distances.
@@ -135,8 +136,8 @@ def initial_rtol(error_share_rad):
 
 
 def check_tolerance(integrator, tolerance):
-    """The check run's tolerance: :data:`CHECK_FACTOR` × the run's, at most the rule's ceiling."""
-    return min(tolerance * CHECK_FACTOR, _rule(integrator).check_ceiling)
+    """The check run's tolerance: :data:`CHECK_RTOL_FACTOR` × the run's, at most the rule's ceiling."""
+    return min(tolerance * CHECK_RTOL_FACTOR, _rule(integrator).check_ceiling)
 
 
 def refine(integrator, first, share_rad, run_and_check, attempted=None):
@@ -155,7 +156,7 @@ def refine(integrator, first, share_rad, run_and_check, attempted=None):
         ``run_and_check(tolerance, check_tolerance) -> (result, error_rad)``: the run and its
         difference to the check run.
     attempted : callable, optional
-        Called with the attempt's index (0 … :data:`MAX_RETRIES`) after each attempt (progress).
+        Called with the attempt's index (0 … :data:`MAX_RTOL_RETRIES`) after each attempt (progress).
 
     Returns
     -------
@@ -164,7 +165,7 @@ def refine(integrator, first, share_rad, run_and_check, attempted=None):
     """
     rule = _rule(integrator)
     tolerance = first
-    for attempt in range(MAX_RETRIES + 1):
+    for attempt in range(MAX_RTOL_RETRIES + 1):
         result, error = run_and_check(tolerance, check_tolerance(integrator, tolerance))
         if attempted is not None:
             attempted(attempt)

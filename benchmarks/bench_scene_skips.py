@@ -42,7 +42,8 @@ from spinorbit.data import asteroids
 from spinorbit import RigidBody, RotationState
 from spinorbit.coupling.rebound.adapter import body_index, simulation_from_de421
 from spinorbit.ephemeris import de421_constants, moon_orientation
-from spinorbit.scene.scene import EphemerisPerturber, Orbit, Scene, _angles
+from spinorbit.scene import EphemerisPerturber, Orbit, Scene
+from spinorbit.scene.routes import attitude_angles as _angles
 from spinorbit.time import tdb_days
 
 EPOCH = Time("2020-01-01", scale="tdb")
@@ -197,11 +198,12 @@ INTEGRATOR_ROWS = ("Taylor instead of DOP853", "DOP853 instead of Taylor")
 
 def knot_rows(scene_rows, repeat):
     """Taylor against DOP853 on each one-way scene's model, each at the first tolerance the planner would
-    give it, with the rule's counts (``Scene._taylor_steps``) and the true ones."""
+    give it, with the rule's counts (``spinorbit.scene.integrator_choice.taylor_steps``) and the true ones."""
     from spinorbit.core.dynamics.equations import make_model
     from spinorbit.core.integrators.quaternion import integrate_quaternion
     from spinorbit.core.integrators.taylor import integrate_taylor
-    from spinorbit.scene.scene import _first_tolerance
+    from spinorbit.scene.integrator_choice import taylor_steps
+    from spinorbit.scene.tolerances import first_tolerance as _first_tolerance
 
     rows, seen = [], set()
     sweep = [(f"moonlet, period {period:g} d", None, moonlet_scene(period), None) for period in MOONLET_PERIODS]
@@ -214,13 +216,13 @@ def knot_rows(scene_rows, repeat):
         seen.add(id(scene))
         named = [n for n in plan.kept if n in scene.named]
         moving = [p.name for p in scene.moving if p.name in plan.kept]
-        groups = ([scene._sampler(plan.orbit_source, named, scene.sample_tolerance)] if named else []) + (
-            [scene._sampler("user", moving, scene.sample_tolerance)] if moving else [])
+        groups = ([scene.sample_perturbers(plan.orbit_source, named, scene.sample_tolerance)] if named else []) + (
+            [scene.sample_perturbers("user", moving, scene.sample_tolerance)] if moving else [])
         model = make_model(scene.state.body.principal_moments, [s for g in groups for s in g.sources()])
         y0, t0, t_out = scene.state.core_state(), scene.epoch_day, scene.output_days
         share = plan.integration_share_rad
         tol, rtol = _first_tolerance("taylor", share), _first_tolerance("quaternion", share)
-        steps, estimate, _ = scene._taylor_steps(plan.orbit_source, plan.kept, True, tol)
+        steps, estimate, _ = taylor_steps(scene, plan.orbit_source, plan.kept, True, tol)
         days = np.unique(np.concatenate([g.days for g in groups]))
         knots = int(np.count_nonzero((days > t0) & (days < t_out[-1])))
         reference = integrate_quaternion(y0, t0, t_out, model, rtol=1e-14)
@@ -309,10 +311,10 @@ def markdown(results, repeat):
                "sample tolerance), each at the first tolerance the planner gives it for the scene's integration "
                "share (Taylor tol = share × 0.3/60, DOP853 rtol = share / 1000), CPU (`time.process_time`) best of "
                f"{max(repeat, 5)}, the two alternated; error = largest attitude angle against DOP853 at rtol 1e-14. "
-               "Rotation steps and estimated knots: the planner's counts (`Scene._taylor_steps`: the Taylor method "
+               "Rotation steps and estimated knots: the planner's counts (`spinorbit.scene.integrator_choice.taylor_steps`: the Taylor method "
                "on the free motion over ≤ 20 rotations, scaled; knots from the survey's a priori grid); knots: the "
                "true sample times strictly inside the span (each ends a Taylor step). The planner takes Taylor while "
-               "estimated knots ≤ `spinorbit.scene.scene.TAYLOR_KNOT_SHARE` × rotation steps. The moonlet rows: the SAM "
+               "estimated knots ≤ `spinorbit.scene.integrator_choice.TAYLOR_KNOT_SHARE` × rotation steps. The moonlet rows: the SAM "
                "body at 2.5 au with the Sun and a relative circle of 0.01 au (G·M 1e-12 au³/day²) of the given "
                "period, 20 d, 200 outputs, 1 arcsec. Scene run: the whole `Scene.run` of the scene planned (skip=True) "
                "with `integrator` forced to 'taylor' and to 'quaternion', alternated, best of --repeat: the run, its "

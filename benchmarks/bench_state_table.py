@@ -31,7 +31,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from _report import machine_line, repeat_main
 
 from spinorbit import RigidBody, RotationState
-from spinorbit.scene.scene import Scene
+from spinorbit.scene import Scene
 from spinorbit.state_table import table_columns
 
 EPOCH = Time("2020-01-01", scale="tdb")

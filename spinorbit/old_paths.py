@@ -41,7 +41,7 @@ MOVED_MODULES: dict[str, tuple[str, ...]] = {
     "spinorbit.core.averaged": ("spinorbit.core.averaging.mean_equations",),
     "spinorbit.core.short_period": ("spinorbit.core.averaging.short_period",),
     "spinorbit.core.propagate_averaged": ("spinorbit.core.averaging.propagate",),
-    "spinorbit.planner": ("spinorbit.scene.planner",),
+    "spinorbit.planner": ("spinorbit.scene.bounds", "spinorbit.scene.plan", "spinorbit.scene.tolerances"),
     "spinorbit.scene_bodies": ("spinorbit.scene.many",),
     "spinorbit.atomic": ("spinorbit.runs.atomic",),
     "spinorbit.checkpoint": ("spinorbit.runs.checkpoint",),
@@ -56,7 +56,8 @@ MOVED_MODULES: dict[str, tuple[str, ...]] = {
 MOVED_NAMES: dict[str, tuple[str, ...]] = {
     "spinorbit.core.dynamics": ("spinorbit.core.dynamics.equations", "spinorbit.core.dynamics.validation"),
     "spinorbit.core.elements": ("spinorbit.core.elements.paper_maps",),
-    "spinorbit.scene": ("spinorbit.scene.scene", "spinorbit.scene.planner"),
+    "spinorbit.scene": ("spinorbit.scene.scene", "spinorbit.scene.inputs", "spinorbit.scene.integrator_choice",
+                        "spinorbit.scene.tolerances", "spinorbit.scene.plan", "spinorbit.scene.bounds"),
 }
 
 

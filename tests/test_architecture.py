@@ -43,7 +43,6 @@ ANYWHERE = ("spinorbit", "spinorbit.old_paths")
 # and the lists are deleted once empty.
 KNOWN_CIRCLES = [
     ["spinorbit.coupling.long_run", "spinorbit.coupling.rigid_body"],
-    ["spinorbit.scene.many", "spinorbit.scene.scene"],
 ]
 KNOWN_PRIVATE_CROSSINGS = [
     "spinorbit.core.integrators.elements: from spinorbit.core.integrators.quaternion import _A",
@@ -60,7 +59,6 @@ KNOWN_LONG = [
     "spinorbit.core.free_motion.flow",
     "spinorbit.core.math.elliptic",
     "spinorbit.coupling.rebound.adapter",
-    "spinorbit.scene.scene",
 ]
 
 

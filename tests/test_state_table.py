@@ -124,7 +124,7 @@ def test_one_way_table_rows_are_their_rotation_states_and_osculate():
 
     from spinorbit.core.model.perturbers import fixed_source
     from spinorbit.coupling.one_way import propagate_one_way
-    from spinorbit.scene.scene import _NoSamples
+    from spinorbit.scene.sampling import NoSamples
     from spinorbit.time import tdb_days
 
     state = STATES[0][1]
@@ -132,7 +132,7 @@ def test_one_way_table_rows_are_their_rotation_states_and_osculate():
     times = epoch + np.linspace(0.1, 2.0, 40) * u.day
     start = float(sum(tdb_days(epoch)))
     # A strong nearby mass (GM 1e-3 au³/day² at 0.01 au) changes the periods visibly within 2 d.
-    table = propagate_one_way(state, epoch, times, _NoSamples(start, start + 2.0),
+    table = propagate_one_way(state, epoch, times, NoSamples(start, start + 2.0),
                               extra_sources=[fixed_source(1e-3, [0.01, 0.004, 0.002])])
     rows = [RotationState(state.body, q, w) for q, w in zip(table["quaternion"], table["omega"].to_value(u.rad / u.day))]
     assert np.abs(table["quaternion"] - [s.quaternion for s in rows]).max() <= EPS  # re-normalisation: ≤ 1 ulp

@@ -85,7 +85,7 @@ def run_scene(scene, args):
 
 def run_and_report(args, state, start, times, orbit, name: str, title: str, period_unit: str) -> int:
     """Build the Scene from the shared options, run it (or print its plan), print the summary, write files."""
-    from spinorbit.scene.scene import Scene
+    from spinorbit.scene import Scene
 
     scene = Scene(state, start, times, perturbers=tuple(args.perturbers), orbit=orbit, tolerance=tolerance(args))
     result = run_scene(scene, args)

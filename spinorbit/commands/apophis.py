@@ -53,7 +53,7 @@ def run(args) -> int:
         apophis_encounter_simulation,
         apophis_rotation_state,
     )
-    from spinorbit.scene.scene import Orbit
+    from spinorbit.scene import Orbit
 
     check_outputs(args)
     days = span_and_times(args, APOPHIS_2029.time_tdb, MAX_SPAN_DAYS)[0].to_value(u.day)

@@ -49,7 +49,7 @@ def run(args) -> int:
         encounter_simulation,
         toutatis_rotation_state,
     )
-    from spinorbit.scene.scene import Orbit
+    from spinorbit.scene import Orbit
 
     check_outputs(args)
     start = TOUTATIS_EPOCH.tdb

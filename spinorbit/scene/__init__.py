@@ -2,21 +2,49 @@
 
 :class:`Scene` says what a run needs — body, perturbers, orbit, output times, tolerance; its
 ``plan()`` decides cheapest-first and says why, ``run()`` does it (``docs/scenes.md``).
+
+One module per concept:
+
+- :mod:`~spinorbit.scene.inputs` — :class:`Orbit`, :class:`FixedPerturber`, :class:`EphemerisPerturber`
+  and the checks of a scene's arguments (:class:`SceneError`);
+- :mod:`~spinorbit.scene.plan` — :class:`Plan`, :class:`Decision`, :class:`PerturberEstimate` and
+  their EXPLAIN-like text (:class:`PlanError`);
+- :mod:`~spinorbit.scene.planning` — the decisions, cheapest first;
+- :mod:`~spinorbit.scene.bounds` — what leaving out a torque or the back-reaction can do to the attitude;
+- :mod:`~spinorbit.scene.tolerances` — the one rule from an error share to each integrator's tolerance;
+- :mod:`~spinorbit.scene.integrator_choice` — Taylor or DOP853 (or the canonical elements);
+- :mod:`~spinorbit.scene.sampling` — the perturbers sampled relative to the body, shared within a call;
+- :mod:`~spinorbit.scene.routes` — the runners of the torque-free, one-way and coupled routes;
+- :mod:`~spinorbit.scene.many` — several bodies (:class:`ScenePlans`, :class:`SceneResults`);
+- :mod:`~spinorbit.scene.scene` — :class:`Scene` and :class:`SceneResult`.
 """
 
-from spinorbit.scene.scene import (
+from spinorbit.scene.inputs import (
     QUANTITIES,
     EphemerisPerturber,
     FixedPerturber,
     Orbit,
-    PlanError,
-    Scene,
     SceneError,
-    SceneResult,
 )
+from spinorbit.scene.many import ScenePlans, SceneResults
+from spinorbit.scene.plan import Decision, PerturberEstimate, Plan, PlanError
+from spinorbit.scene.scene import Scene, SceneResult
 
-__all__ = ["QUANTITIES", "EphemerisPerturber", "FixedPerturber", "Orbit", "PlanError", "Scene", "SceneError",
-           "SceneResult"]
+__all__ = [
+    "QUANTITIES",
+    "Decision",
+    "EphemerisPerturber",
+    "FixedPerturber",
+    "Orbit",
+    "PerturberEstimate",
+    "Plan",
+    "PlanError",
+    "Scene",
+    "SceneError",
+    "ScenePlans",
+    "SceneResult",
+    "SceneResults",
+]
 
 
 def __getattr__(name):

@@ -1,8 +1,8 @@
-"""Several rotating bodies in one :class:`~spinorbit.scene.scene.Scene`: planned per body, sampled once per orbit.
+"""Several rotating bodies in one :class:`~spinorbit.scene.Scene`: planned per body, sampled once per orbit.
 
 ``Scene([state_a, state_b], ...)`` or ``Scene({"a": state_a, "b": state_b}, ..., orbit={"a": orbit_a,
 "b": orbit_b})``: every body gets its own plan (its own bounds, drops, route and integrator: they depend
-on its moments and spin), and bodies that share an orbit (the *same* :class:`~spinorbit.scene.scene.Orbit`
+on its moments and spin), and bodies that share an orbit (the *same* :class:`~spinorbit.scene.Orbit`
 object: e.g. several candidate spin states or shape models of one asteroid) share its perturber
 samples — the planner's survey is taken once, and the run samples the union of the perturbers the
 bodies keep once, each body then using its own columns of it. The result is one table per body.
@@ -15,12 +15,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from spinorbit.scene.inputs import Orbit, SceneError
+from spinorbit.scene.sampling import SharedSamples
+
 __all__ = ["ScenePlans", "SceneResults"]
 
 
 @dataclass
 class ScenePlans:
-    """One :class:`~spinorbit.scene.planner.Plan` per body (``plans[name]``) and how the bodies share orbits."""
+    """One :class:`~spinorbit.scene.plan.Plan` per body (``plans[name]``) and how the bodies share orbits."""
 
     plans: dict
     groups: list  # lists of body names sharing one orbit's samples
@@ -41,7 +44,7 @@ class ScenePlans:
 
 @dataclass
 class SceneResults:
-    """One :class:`~spinorbit.scene.scene.SceneResult` per body (``results[name]``); ``tables[name]`` its table."""
+    """One :class:`~spinorbit.scene.SceneResult` per body (``results[name]``); ``tables[name]`` its table."""
 
     results: dict
     plan: ScenePlans
@@ -67,7 +70,6 @@ def members(states, orbit, make):
     Raises SceneError for an empty collection, a non-state, repeated names, or an orbit mapping that
     does not name every body.
     """
-    from spinorbit.scene.scene import Orbit, SceneError
     from spinorbit.state import RotationState
 
     if isinstance(states, dict):
@@ -111,20 +113,15 @@ def plan_many(scenes, skip):
     groups = _groups(scenes)
     plans = {}
     for group in groups:
-        cache = []
+        shared = SharedSamples()
         for name in group:
-            scenes[name]._cache = cache
-            try:
+            with scenes[name].sharing_samples(shared):
                 plans[name] = scenes[name].plan(skip)
-            finally:
-                scenes[name]._cache = None
     return ScenePlans({name: plans[name] for name in scenes}, groups)
 
 
 def run_many(scenes, plans, progress):
     """Run every body's plan; per orbit, the union of the kept perturbers is sampled once for all bodies."""
-    from spinorbit.scene.scene import SceneError
-
     clock = _time.perf_counter()
     if not isinstance(plans, ScenePlans) or set(plans.plans) != set(scenes):
         raise SceneError(f"plan expects the ScenePlans of this scene's plan() (bodies {sorted(scenes)}); got "
@@ -132,7 +129,7 @@ def run_many(scenes, plans, progress):
     report = progress or (lambda fraction: None)
     results, done = {}, 0
     for group in plans.groups:
-        cache = []
+        shared = SharedSamples()
         need = {}
         for name in group:
             plan, scene = plans[name], scenes[name]
@@ -142,17 +139,11 @@ def run_many(scenes, plans, progress):
                     need.setdefault(plan.orbit_source, set()).update(kept)
         first = scenes[group[0]]
         for source, names in need.items():
-            first._cache = cache
-            try:  # one sampling of the union, in the bodies' perturber order
-                first._sampler(source, [n for n in first.named if n in names], first.sample_tolerance)
-            finally:
-                first._cache = None
+            with first.sharing_samples(shared):  # one sampling of the union, in the bodies' perturber order
+                first.sample_perturbers(source, [n for n in first.named if n in names], first.sample_tolerance)
         for name in group:
-            scenes[name]._cache = cache
-            try:
+            with scenes[name].sharing_samples(shared):
                 results[name] = scenes[name].run(plans[name])
-            finally:
-                scenes[name]._cache = None
             done += 1
             report(done / len(scenes))
     return SceneResults({name: results[name] for name in scenes}, plans, _time.perf_counter() - clock)

@@ -1,4 +1,4 @@
-"""The scene planner's bounds and its EXPLAIN-like plan (used by :class:`spinorbit.scene.scene.Scene`).
+"""The bounds the scene planner's skips rest on: what leaving out a torque or the back-reaction can do.
 
 The one estimate every skip rests on
 ------------------------------------
@@ -21,7 +21,7 @@ propagates the state exactly (no integration) with ω kicked along each body axi
 with the degree-2 torque of a point mass μ at distance r bounded by its largest value over all
 attitudes, |N| ≤ (3μ / 2r³) (C − A) (the unit vector r̂ at 45° between the A and C axes maximises
 |r̂ × I r̂| = (C − A)/2). r(s) comes from a survey: the same adaptive sampler as the run
-(:mod:`spinorbit.coupling.one_way`), at the loose relative tolerance :data:`SURVEY_TOLERANCE` (with a
+(:mod:`spinorbit.coupling.one_way`), at the loose relative tolerance :data:`~spinorbit.scene.tolerances.SURVEY_TOLERANCE` (with a
 REBOUND orbit at the run's own tolerance, and kept for the run), which still tightens its grid around
 close encounters. SAFETY = 2 covers the trapezoid rule between survey
 samples and the linearisation. ``tests/test_scene.py`` checks the bound against full runs: the
@@ -101,57 +101,39 @@ REBOUND run (``CoupledRigidBody``, ``tests/test_scene.py``). It keeps the worst-
 bounds only the *size* of the displacement, not its direction, so there is no torque-change vector to
 integrate along the free motion.
 
-Budget: a scene's tolerance (an attitude angle) is shared: up to :data:`DROP_SHARE` of it for the
-perturbers dropped and the back-reaction left out (one-way coupling), the rest for the integrator (whose error is estimated a posteriori by a second
-run at 10× the rtol) and the sampling (relative position error ε gives a relative torque error ≤ 3ε).
+How the tolerance is shared between what is left out and the integration: :mod:`spinorbit.scene.tolerances`.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 __all__ = [
-    "ARCSEC_PER_RAD",
-    "DROP_SHARE",
-    "SAFETY",
-    "SURVEY_TOLERANCE",
-    "Decision",
-    "PerturberEstimate",
-    "Plan",
     "ORBIT_RESPONSE",
-    "attitude_sensitivity",
-    "back_reaction_bound",
-    "dropped_torque_bound",
+    "SAFETY",
     "FreeMotion",
     "action_changes",
     "action_sensitivities",
+    "attitude_sensitivity",
+    "back_reaction_bound",
+    "dropped_torque_bound",
     "free_motion_bounds",
     "free_motion_grid",
     "free_motion_torque_bound",
-    "self_consistent_deviation",
-    "initial_rtol",
     "max_torque_over_a",
+    "self_consistent_deviation",
 ]
 
 #: Factor on the linear-response bound (module docstring).
 SAFETY = 2.0
-#: Share of the tolerance that dropped perturbers may use; the rest goes to integration and sampling.
-DROP_SHARE = 0.5
-#: Relative position tolerance of the planner's survey of the perturber distances.
-SURVEY_TOLERANCE = 1e-6
 #: Horizons (fractions of the span) at which the attitude sensitivity κ is measured.
 SENSITIVITY_HORIZONS = (1 / 16, 1 / 8, 1 / 4, 1 / 2, 1.0)
 #: Attitude change (rad) the sensitivity probe aims for: large against rounding (1e-13), small
 #: enough to stay linear.
 SENSITIVITY_PROBE_RAD = 1e-6
-#: Global DOP853 error was ≈ 300 × rtol in work-precision scene (a) (docs/performance.md); the
-#: first rtol tried is the integration share / 1000, then checked a posteriori.
-RTOL_PER_ERROR = 1e-3
-RTOL_RANGE = (1e-13, 1e-6)
-ARCSEC_PER_RAD = 180.0 * 3600.0 / math.pi
 #: Largest orbit displacement per unit impulse and elapsed time (module docstring: 3.91 for a circular
 #: orbit, computed from Hill's equations; rounded up).
 ORBIT_RESPONSE = 4.0
@@ -265,8 +247,8 @@ def free_motion_grid(state, epoch_day, span_end, survey_days=(), perturbers=1):
     a close encounter). Returns ``(FreeMotion, None)``, or ``(None, why)`` when the grid times
     ``perturbers`` would exceed :data:`MAX_EVALUATIONS` torque evaluations.
     """
-    from spinorbit.core.math.rotations import attitude_to_quat, quat_to_attitude_many
     from spinorbit.core.free_motion.flow import torque_free_states
+    from spinorbit.core.math.rotations import attitude_to_quat, quat_to_attitude_many
 
     attitude, momentum = state.principal_attitude_and_momentum()
     moments = np.array(state.body.principal_moments, dtype=float)
@@ -526,107 +508,3 @@ def _trapezoid(values, days):
     if days.size < 2:
         return 0.0
     return float(np.sum(0.5 * (values[1:] + values[:-1]) * np.diff(days)))
-
-
-def initial_rtol(error_share_rad):
-    """First DOP853 rtol for an integration error share (rad), clipped to :data:`RTOL_RANGE`."""
-    return float(np.clip(error_share_rad * RTOL_PER_ERROR, *RTOL_RANGE))
-
-
-@dataclass(frozen=True)
-class Decision:
-    """One line of a plan: what was decided and why, in words and numbers."""
-
-    topic: str
-    choice: str
-    reason: str
-
-
-@dataclass
-class PerturberEstimate:
-    """Survey result for one perturber: closest distance (au) and the bound (rad) of leaving it out.
-
-    ``bound_rad`` is the free-motion bound where it applies (module docstring), never above
-    ``worst_attitude_rad``, the worst-attitude bound of :func:`dropped_torque_bound`.
-    """
-
-    name: str
-    closest_au: float
-    bound_rad: float
-    kept: bool
-    worst_attitude_rad: float | None = None
-
-
-@dataclass
-class Plan:
-    """What :meth:`spinorbit.scene.scene.Scene.run` will do, and why (``str(plan)`` reads like EXPLAIN).
-
-    Attributes
-    ----------
-    route : {"torque-free", "one-way", "coupled"}
-        Exact free motion (no integration), the one-way integration under the kept perturbers, or the
-        fully coupled REBOUND run (BS, :class:`~spinorbit.coupling.rigid_body.CoupledRigidBody`).
-    orbit_source : {"none", "de421", "ephemeris", "rebound"}
-        Where the positions come from: none needed, DE421, a user ephemeris, a REBOUND (N-body) run.
-    kept, dropped : tuple of str
-        Perturbers in the run and left out.
-    estimates : dict
-        :class:`PerturberEstimate` per perturber (empty when nothing was surveyed).
-    integrator : {"quaternion", "elements", "exact", "rebound-bs"}
-    rtol : float or None
-        First rtol of the integration (for "rebound-bs": BS eps_abs = eps_rel), refined a posteriori.
-    end_only : bool
-        Only the final state is asked: one output time, no dense output, quantities once.
-    tolerance_rad : float
-    kappa : float
-        Measured attitude sensitivity of the free motion (module docstring).
-    dropped_bound_rad : float
-        Sum of the bounds of everything left out (for the torque-free route: all perturbers).
-    full : bool
-        True for the reference plan of ``Scene.plan(skip=False)``: nothing skipped.
-    decisions : list of Decision
-    samples : SampledPerturbers or None
-        For a REBOUND orbit, the survey is taken at the run's sampling tolerance and kept here, so the
-        N-body run is paid once; the run uses its kept perturbers' columns.
-    back_reaction_rad : float
-        Bound of the figure's back-reaction on the orbits that a one-way route leaves out (0 when
-        it is not left out, or when the body has no mass in the orbit model).
-    """
-
-    route: str
-    orbit_source: str
-    kept: tuple
-    dropped: tuple
-    estimates: dict
-    integrator: str
-    rtol: float | None
-    end_only: bool
-    tolerance_rad: float
-    kappa: float
-    dropped_bound_rad: float
-    full: bool
-    decisions: list = field(default_factory=list)
-    #: Perturber samples at the run's tolerance taken while planning (REBOUND route: the N-body run is
-    #: then paid once), reused by the run for the kept perturbers.
-    samples: object = field(default=None, repr=False)
-    back_reaction_rad: float = 0.0
-    back_reaction_bound_rad: float | None = None
-
-    @property
-    def integration_share_rad(self):
-        """Tolerance left for integration and sampling once what was left out is paid for."""
-        return self.tolerance_rad - self.dropped_bound_rad - self.back_reaction_rad
-
-    def __str__(self):
-        title = "reference plan (skip=False: nothing skipped)" if self.full else "plan"
-        lines = [f"{title}: route {self.route}, orbits from {self.orbit_source}, integrator {self.integrator}"
-                 + (f" (rtol {self.rtol:.1e})" if self.rtol else ""),
-                 (f"  tolerance {self.tolerance_rad * ARCSEC_PER_RAD:.4g} arcsec ({self.tolerance_rad:.3e} rad); "
-                  f"left out: bound {self.dropped_bound_rad * ARCSEC_PER_RAD:.3g} arcsec"
-                  + (f" + back-reaction {self.back_reaction_rad * ARCSEC_PER_RAD:.3g} arcsec"
-                     if self.back_reaction_rad else ""))]
-        width = max(len(d.topic) for d in self.decisions) if self.decisions else 0
-        for decision in self.decisions:
-            lines.append(f"  -> {decision.topic.ljust(width)}  {decision.choice}")
-            lines.append(f"     {' ' * width}  because {decision.reason}")
-        return "\n".join(lines)

@@ -1,0 +1,120 @@
+"""The perturbers of a scene sampled relative to the body, and the samples shared within one plan or run.
+
+A scene's perturbers come from DE421 or a user ephemeris (:func:`sample_perturbers` with source
+"de421" or "ephemeris"), a REBOUND run ("rebound") or user :class:`~spinorbit.scene.EphemerisPerturber`
+s ("user"), all onto the adaptive Hermite grid of :mod:`spinorbit.coupling.one_way`.
+:class:`SharedSamples` keeps what one :meth:`~spinorbit.scene.Scene.plan` or
+:meth:`~spinorbit.scene.Scene.run` (or the bodies of one orbit, :mod:`spinorbit.scene.many`) has
+sampled, so that the survey and the run pay each sampling once.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from spinorbit.time import time_from_tdb_days
+
+__all__ = ["NoSamples", "SharedSamples", "body_orbit", "sample_perturbers", "subset_samples"]
+
+
+def sample_perturbers(orbit, moving, epoch_day, end_day, source, names, tolerance):
+    """Sample ``names`` relative to the body from ``source`` over ``epoch_day`` … ``end_day`` (TDB days).
+
+    Parameters
+    ----------
+    orbit : Orbit or None
+        The scene's orbit (the body's, and where DE421 or REBOUND perturbers are).
+    moving : sequence of EphemerisPerturber
+        The scene's user ephemerides (source "user").
+    epoch_day, end_day : float
+        TDB days since J2000.
+    source : {"de421", "ephemeris", "rebound", "user"}
+    names : sequence of str
+    tolerance : float
+        Relative interpolation error of the samples.
+
+    Returns
+    -------
+    spinorbit.coupling.one_way.SampledPerturbers
+    """
+    from spinorbit.coupling import one_way
+
+    start, end = time_from_tdb_days(epoch_day), time_from_tdb_days(end_day)
+    if source == "user":
+        return _sample_user(orbit, moving, start, end, names, tolerance)
+    if source == "rebound":
+        return one_way.sample_from_rebound(orbit.simulation, orbit.name, start, end, names, tolerance=tolerance)
+    function = one_way.de421_orbit(orbit.name) if source == "de421" else orbit.function
+    return one_way.sample_from_ephemeris(function, start, end, names, tolerance=tolerance)
+
+
+def _sample_user(orbit, moving, start, end, names, tolerance):
+    """Sample the EphemerisPerturbers ``names`` relative to the body (same grid and checks as DE421's)."""
+    from spinorbit.coupling import one_way
+
+    chosen = [next(p for p in moving if p.name == name) for name in names]
+    body = body_orbit(orbit) if any(not p.relative for p in chosen) else None
+
+    def provider(days):
+        out = np.empty((days.size, len(chosen), 6))
+        centre = None if body is None else np.concatenate([np.asarray(a, dtype=float) for a in body(days)], axis=1)
+        for i, perturber in enumerate(chosen):
+            out[:, i] = perturber.states(days) - (0.0 if perturber.relative else centre)
+        return out
+
+    return one_way.sample_states(provider, names, [p.gm_au3_day2 for p in chosen], start, end, tolerance)
+
+
+def body_orbit(orbit):
+    """The body's barycentric orbit as a callable days -> (positions, velocities), au and au/day."""
+    from spinorbit.coupling import one_way
+
+    if orbit.kind == "de421":
+        return one_way.de421_orbit(orbit.name)
+    if orbit.kind == "rebound":
+        return one_way.rebound_orbit(orbit.simulation, orbit.name)
+    return orbit.function
+
+
+def subset_samples(samples, names):
+    """The columns of ``names`` of a SampledPerturbers (same grid, same error estimates per perturber)."""
+    from spinorbit.coupling.one_way import SampledPerturbers
+
+    index = [samples.names.index(n) for n in names]
+    return SampledPerturbers(tuple(names), samples.gm[index], samples.days, samples.states[:, index],
+                             samples.tolerance, samples.midpoint_error[index], samples.passes,
+                             {n: samples.closest[n] for n in names if n in samples.closest})
+
+
+class SharedSamples:
+    """Samples already taken, by (source, tolerance): a request for some of their perturbers reuses them."""
+
+    def __init__(self):
+        self._taken = []
+
+    def find(self, source, names, tolerance):
+        """The samples of ``names`` from ``source`` at ``tolerance`` if taken already (their columns), else None."""
+        for taken_source, taken_tolerance, taken in self._taken:
+            if taken_source == source and taken_tolerance == tolerance and set(names) <= set(taken.names):
+                return taken if tuple(names) == taken.names else subset_samples(taken, names)
+        return None
+
+    def add(self, source, tolerance, samples):
+        """Keep ``samples`` for later requests."""
+        self._taken.append((source, tolerance, samples))
+
+
+class NoSamples:
+    """Stand-in for SampledPerturbers when no sampled perturber is kept (the span's two ends, no sources)."""
+
+    names = ()
+    tolerance = 0.0
+    passes = 0
+    midpoint_error = np.zeros(0)
+
+    def __init__(self, start, end):
+        self.days = np.array([start, end])
+        self.span = (start, end)
+
+    def sources(self):
+        return []

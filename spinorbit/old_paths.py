@@ -47,7 +47,10 @@ MOVED_MODULES: dict[str, tuple[str, ...]] = {
     "spinorbit.checkpoint": ("spinorbit.runs.checkpoint",),
     "spinorbit.resumable": ("spinorbit.runs.resumable",),
     "spinorbit.asteroids": ("spinorbit.data.asteroids",),
-    "spinorbit.coupling.rebound_adapter": ("spinorbit.coupling.rebound.adapter",),
+    # The adapter is split by concept (simulation, extra_forces, rotation_hooks, snapshot, interrupts);
+    # its door exports every public name the adapter had.
+    "spinorbit.coupling.rebound_adapter": ("spinorbit.coupling.rebound",),
+    "spinorbit.coupling.rebound.adapter": ("spinorbit.coupling.rebound",),
     "spinorbit.coupling.chunked_run": ("spinorbit.coupling.long_run",),
 }
 

@@ -35,7 +35,7 @@ from spinorbit.coupling.one_way import (
     sample_from_ephemeris,
     sample_from_rebound,
 )
-from spinorbit.coupling.rebound.adapter import MissingBodyError, install_extra_forces
+from spinorbit.coupling.rebound import MissingBodyError, install_extra_forces
 from spinorbit.ephemeris import EphemerisRangeError, UnknownBodyError, de421_constants
 
 GM_SUN = de421_constants().gm["sun"]

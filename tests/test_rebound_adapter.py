@@ -1,4 +1,4 @@
-"""spinorbit.coupling.rebound.adapter: offline DE421 simulations, raw-pointer forces, perturbers."""
+"""spinorbit.coupling.rebound: offline DE421 simulations, raw-pointer forces, perturbers."""
 
 import numpy as np
 import pytest
@@ -6,7 +6,7 @@ import rebound
 from _offline import no_network  # noqa: F401  (autouse socket guard)
 from astropy.time import Time
 
-from spinorbit.coupling.rebound.adapter import (
+from spinorbit.coupling.rebound import (
     DEFAULT_BODIES,
     ForceInstallError,
     MissingBodyError,
@@ -217,7 +217,7 @@ def test_nongravitational_needs_installed_forces_and_a_real_body():
 
 def test_reinstalled_forces_carry_every_parameter():
     """A rebuilt copy (the one-way sampler's route) integrates bit-for-bit like the original."""
-    from spinorbit.coupling.rebound.adapter import reinstall_extra_forces
+    from spinorbit.coupling.rebound import reinstall_extra_forces
 
     original = _sun_and_circular_body()
     set_nongravitational(original, "Body", 1e-6, -3e-7, 2e-7)
@@ -284,7 +284,7 @@ def test_a_copy_keeps_the_forces_folded_into_a_rigid_body_and_refuses_foreign_on
     a copy must still carry them (the old copy saw no ExtraForces handle and dropped them)."""
     from spinorbit.core.model.gravity_field import make_body
     from spinorbit.coupling.one_way import SimulationSnapshot
-    from spinorbit.coupling.rebound.adapter import _P_NG_BODY
+    from spinorbit.coupling.rebound.extra_forces import EXTRA_NG_BODY
     from spinorbit.coupling.rigid_body import CoupledRigidBody
 
     plain, with_body = _three_bodies("bs"), _three_bodies("bs")
@@ -296,7 +296,7 @@ def test_a_copy_keeps_the_forces_folded_into_a_rigid_body_and_refuses_foreign_on
     for copy in copies:
         copy.integrate(30.0)
     assert copies[0].particles["Body"].xyz == copies[1].particles["Body"].xyz
-    assert copies[1]._afp.parameters[_P_NG_BODY] == body_index(with_body, "Body")  # the A1-A3 term is on
+    assert copies[1]._afp.parameters[EXTRA_NG_BODY] == body_index(with_body, "Body")  # the A1-A3 term is on
 
     foreign = rebound.Simulation()
     foreign.add(m=1.0, name="Sun")

@@ -57,13 +57,7 @@ from spinorbit.ephemeris import DE421_SPAN_JD_TDB, EphemerisRangeError, resolve_
 from spinorbit.state import RotationState
 from spinorbit.state_table import from_principal, table_columns
 from spinorbit.time import J2000_JD_TDB, tdb_days, time_from_tdb_days
-from spinorbit.coupling.rebound.adapter import (
-    ExtraForces,
-    body_index,
-    extra_forces_in_effect,
-    reinstall_extra_forces,
-    simulation_from_binary,
-)
+from spinorbit.coupling.rebound import SimulationSnapshot, body_index
 
 __all__ = [
     "DEFAULT_PERTURBERS",
@@ -395,7 +389,7 @@ def rebound_orbit(sim, body):
     rebuilds the simulation from a copy of its present state (``sim`` is not modified) and integrates
     it through the requested times (``exact_finish_time``), so the sampler gets the smooth
     trajectory, not an interpolant of it. The frame is REBOUND's: a simulation from
-    :func:`~spinorbit.coupling.rebound.adapter.simulation_from_de421` is barycentric ICRF to the
+    :func:`~spinorbit.coupling.rebound.simulation.simulation_from_de421` is barycentric ICRF to the
     centre-of-mass shift of the bodies left out (metres); but the perturber vectors then mix DE421
     planets with a body integrated among REBOUND's planets, whose drift from DE421 (metres to
     kilometres over decades: ``docs/ephemeris.md``) enters them. Route (b),
@@ -424,42 +418,6 @@ def rebound_orbit(sim, body):
     return orbit
 
 
-@dataclass
-class SimulationSnapshot:
-    """Everything needed to rebuild a REBOUND simulation at one instant (each pass re-runs it).
-
-    REBOUND's own binary of the simulation, so that a copy has *all* of its settings, not a list of
-    them that falls behind: particles, ``t``, ``G``, units, ``dt``, ``N_active``, softening, the
-    integrator and its settings (BS ``eps_abs``, ``eps_rel``, ``min_dt``, ``max_dt``; IAS15
-    ``epsilon``, ``min_dt``, ``adaptive_mode``) and its running state (the BS controller's flags,
-    IAS15's predictor), so that a copy integrates bit for bit like the original
-    (``tests/test_rebound_adapter.py``). REBOUND does not store names reliably nor function pointers:
-    the names are kept beside the binary, and the extra forces in effect (also those folded into an
-    attached rigid body's force) are reinstalled on each copy. The rigid body itself (its user ODE and
-    back-reaction) is not copied: copies are the orbits under point-mass gravity and the extra forces.
-    """
-
-    binary: bytes
-    names: tuple
-    extra_forces: ExtraForces | None
-
-    @classmethod
-    def of(cls, sim):
-        """The snapshot of ``sim`` now (ForceInstallError for forces spinorbit cannot carry over)."""
-        extra = extra_forces_in_effect(sim)
-        return cls(sim.__reduce__()[1][0], tuple(p.name for p in sim.particles), extra)
-
-    def build(self):
-        """A new simulation at the snapshot, with ``exact_finish_time = 1`` (samples hit their times)."""
-        sim = simulation_from_binary(self.binary, self.names)
-        sim.exact_finish_time = 1
-        if self.extra_forces is not None:
-            # The raw force pointer does not survive a copy; reinstall the same forces (same
-            # particle order, so the whole parameter block carries over: pole, Yarkovsky, ...).
-            reinstall_extra_forces(sim, self.extra_forces)
-        return sim
-
-
 def sample_from_rebound(sim, body, start, end, perturbers=DEFAULT_PERTURBERS,
                         tolerance=DEFAULT_SAMPLE_TOLERANCE):
     """Sample perturbers relative to ``body`` from a REBOUND simulation (IAS15, exact_finish_time).
@@ -468,7 +426,7 @@ def sample_from_rebound(sim, body, start, end, perturbers=DEFAULT_PERTURBERS,
     settings included), and every pass rebuilds it from the copy, integrates it to ``start``
     (backwards if ``sim.t`` is later) and then forwards through the sorted sample times with
     ``exact_finish_time = 1``. Extra forces installed by
-    :func:`~spinorbit.coupling.rebound.adapter.install_extra_forces` (also when folded into an
+    :func:`~spinorbit.coupling.rebound.extra_forces.install_extra_forces` (also when folded into an
     attached rigid body's force) are reinstalled on each copy; other forces are refused
     (``ForceInstallError``), since a copy would run without them.
 
@@ -476,7 +434,7 @@ def sample_from_rebound(sim, body, start, end, perturbers=DEFAULT_PERTURBERS,
     ----------
     sim : rebound.Simulation
         In ("AU", "day", "Msun") units, ``t`` in TDB days since J2000, ICRF axes, named particles
-        (e.g. :func:`~spinorbit.coupling.rebound.adapter.simulation_from_de421` plus the asteroid).
+        (e.g. :func:`~spinorbit.coupling.rebound.simulation.simulation_from_de421` plus the asteroid).
     body : str
         Name of the rotating body's particle.
     start, end : astropy.time.Time
@@ -491,9 +449,9 @@ def sample_from_rebound(sim, body, start, end, perturbers=DEFAULT_PERTURBERS,
 
     Raises
     ------
-    spinorbit.coupling.rebound.adapter.MissingBodyError
+    spinorbit.coupling.rebound.simulation.MissingBodyError
         ``body`` or a perturber is not in the simulation.
-    spinorbit.coupling.rebound.adapter.ForceInstallError
+    spinorbit.coupling.rebound.extra_forces.ForceInstallError
         ``sim`` has forces spinorbit did not install (they would be missing from the copies).
     SamplingError
     """

@@ -191,7 +191,7 @@ class Orbit:
     def rebound(cls, simulation, particle):
         """A particle of a REBOUND simulation (("AU", "day", "Msun") units, t in TDB days since J2000,
         ICRF); perturbers are particles of the same simulation."""
-        from spinorbit.coupling.rebound.adapter import body_index
+        from spinorbit.coupling.rebound import body_index
 
         body_index(simulation, particle)  # MissingBodyError now, not after a survey
         return cls("rebound", str(particle), simulation=simulation)
@@ -482,7 +482,7 @@ class Scene:
         if self.orbit is None or self.orbit.kind == "ephemeris":
             return 0.0
         if self.orbit.kind == "rebound":
-            from spinorbit.coupling.rebound.adapter import body_index
+            from spinorbit.coupling.rebound import body_index
 
             sim = self.orbit.simulation
             return float(sim.particles[body_index(sim, self.orbit.name)].m * sim.G)
@@ -492,7 +492,7 @@ class Scene:
 
     def _resolve(self, names):
         if self.orbit is not None and self.orbit.kind == "rebound":
-            from spinorbit.coupling.rebound.adapter import MissingBodyError, body_index
+            from spinorbit.coupling.rebound import MissingBodyError, body_index
 
             sim = self.orbit.simulation
             try:
@@ -1054,7 +1054,7 @@ class Scene:
 
     def _coupled(self, plan, report):
         """The fully coupled REBOUND run (BS), checked against a second run at 10× eps."""
-        from spinorbit.coupling.rigid_body import coupled_run
+        from spinorbit.coupling.long_run import coupled_run
 
         y0 = self.state.core_state()
         eps = plan.rtol

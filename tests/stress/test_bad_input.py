@@ -41,7 +41,7 @@ from spinorbit.coupling.one_way import (
     propagate_one_way,
     sample_from_ephemeris,
 )
-from spinorbit.coupling.rebound.adapter import (
+from spinorbit.coupling.rebound import (
     ForceInstallError,
     MissingBodyError,
     simulation_from_de421,

@@ -255,7 +255,7 @@ def _three_bodies(integrator, **settings):
     ("ias15", {"epsilon": 1e-5, "adaptive_mode": "global", "min_dt": 1e-4}, True),
 ])
 def test_a_rebuilt_copy_integrates_bit_for_bit_like_the_original(integrator, settings, warm):
-    """The one-way sampler's copies (``one_way.SimulationSnapshot``) keep every integrator setting (and state).
+    """The one-way sampler's copies (``rebound.SimulationSnapshot``) keep every integrator setting (and state).
 
     The old copy (particles, G, integrator name) ran BS at the default eps 1e-8 and IAS15 at epsilon
     1e-9. IAS15 is also copied mid-run (dt and its predictor are in REBOUND's binary). BS mid-run is
@@ -263,7 +263,7 @@ def test_a_rebuilt_copy_integrates_bit_for_bit_like_the_original(integrator, set
     copy's first step resets ``first_or_last_step`` (also with ``sim.copy()``); copied at day 10.3,
     measured 3.5e-14 au apart at day 40 (docs/coupling.md).
     """
-    from spinorbit.coupling.one_way import SimulationSnapshot
+    from spinorbit.coupling.rebound import SimulationSnapshot
 
     original = _three_bodies(integrator, **settings)
     if warm:
@@ -283,7 +283,7 @@ def test_a_copy_keeps_the_forces_folded_into_a_rigid_body_and_refuses_foreign_on
     """A simulation with a body attached holds its earlier extra forces in the body's combined force:
     a copy must still carry them (the old copy saw no ExtraForces handle and dropped them)."""
     from spinorbit.core.model.gravity_field import make_body
-    from spinorbit.coupling.one_way import SimulationSnapshot
+    from spinorbit.coupling.rebound import SimulationSnapshot
     from spinorbit.coupling.rebound.extra_forces import EXTRA_NG_BODY
     from spinorbit.coupling.rigid_body import CoupledRigidBody
 

@@ -48,7 +48,7 @@ from spinorbit.ephemeris import (
     moon_orientation_raw,
 )
 from spinorbit.time import J2000_JD_TDB, tdb_day_and_fraction, time_from_tdb_days
-from spinorbit.coupling.one_way import de421_orbit, sample_from_ephemeris, sample_relative_states
+from spinorbit.coupling.sampling import de421_orbit, sample_from_ephemeris, sample_relative_states
 from spinorbit.coupling.long_run import integrate_to_outputs
 from spinorbit.coupling.rebound import DEFAULT_BODIES, simulation_from_de421
 from spinorbit.coupling.rigid_body import CoupledRigidBody

@@ -106,7 +106,7 @@ TAYLOR_KNOT_SHARE = 1.0
 #: The rotation steps are counted by a Taylor run of the free motion over at most this many rotations
 #: (2π/|ω|), scaled to the span: a few hundred steps, ~0.1 ms.
 TAYLOR_PROBE_ROTATIONS = 20.0
-#: Sample times of the run against the a priori grid (coupling.one_way.a_priori_grid) of the survey:
+#: Sample times of the run against the a priori grid (coupling.sampling.a_priori_grid) of the survey:
 #: the refinement passes added 1.41× for DE421's Earth and Sun seen from the Moon (224/159 samples in
 #: bench_scene_skips), 1.0-1.1× for a circular relative orbit, 1.9× on the Apophis flyby (1169/625).
 SAMPLE_REFINEMENT = 1.4
@@ -243,7 +243,7 @@ class EphemerisPerturber:
     """A point mass moving on a user ephemeris (like :meth:`Orbit.ephemeris`, for a perturber).
 
     It goes through the planner like a DE421 body: surveyed, bounded, dropped or kept, and sampled
-    onto the same adaptive Hermite grid (:func:`spinorbit.coupling.one_way.sample_states`).
+    onto the same adaptive Hermite grid (:func:`spinorbit.coupling.sampling.sample_states`).
 
     Parameters
     ----------
@@ -556,7 +556,7 @@ class Scene:
         return samples
 
     def _sample(self, source, names, tolerance):
-        from spinorbit.coupling import one_way
+        from spinorbit.coupling import sampling
 
         if source == "user":
             return self._sample_user(names, tolerance)
@@ -564,14 +564,14 @@ class Scene:
         start = time_from_tdb_days(self.epoch_day)
         end = time_from_tdb_days(self.output_days[-1])
         if source == "rebound":
-            return one_way.sample_from_rebound(self.orbit.simulation, self.orbit.name, start, end, names,
+            return sampling.sample_from_rebound(self.orbit.simulation, self.orbit.name, start, end, names,
                                                tolerance=tolerance)
-        orbit = (one_way.de421_orbit(self.orbit.name) if source == "de421" else self.orbit.function)
-        return one_way.sample_from_ephemeris(orbit, start, end, names, tolerance=tolerance)
+        orbit = (sampling.de421_orbit(self.orbit.name) if source == "de421" else self.orbit.function)
+        return sampling.sample_from_ephemeris(orbit, start, end, names, tolerance=tolerance)
 
     def _sample_user(self, names, tolerance):
         """Sample the EphemerisPerturbers ``names`` relative to the body (same grid and checks as DE421's)."""
-        from spinorbit.coupling import one_way
+        from spinorbit.coupling import sampling
 
         chosen = [next(p for p in self.moving if p.name == name) for name in names]
         body = self._body_orbit() if any(not p.relative for p in chosen) else None
@@ -583,18 +583,18 @@ class Scene:
                 out[:, i] = perturber.states(days) - (0.0 if perturber.relative else centre)
             return out
 
-        return one_way.sample_states(provider, names, [p.gm_au3_day2 for p in chosen],
+        return sampling.sample_states(provider, names, [p.gm_au3_day2 for p in chosen],
                                      time_from_tdb_days(self.epoch_day), time_from_tdb_days(self.output_days[-1]),
                                      tolerance)
 
     def _body_orbit(self):
         """The body's barycentric orbit as a callable days -> (positions, velocities), au and au/day."""
-        from spinorbit.coupling import one_way
+        from spinorbit.coupling import sampling
 
         if self.orbit.kind == "de421":
-            return one_way.de421_orbit(self.orbit.name)
+            return sampling.de421_orbit(self.orbit.name)
         if self.orbit.kind == "rebound":
-            return one_way.rebound_orbit(self.orbit.simulation, self.orbit.name)
+            return sampling.rebound_orbit(self.orbit.simulation, self.orbit.name)
         return self.orbit.function
 
     @_sharing_samples
@@ -899,13 +899,13 @@ class Scene:
         against the rotation, so they hardly change the steps: 268 free against 275 torqued in
         bench_scene_skips' 'drop perturbers' scene at tol 1e-10). Knots: the sample times the run will
         have strictly inside (epoch, last output): counted for samples the plan keeps for the run,
-        otherwise the a priori grid (:func:`spinorbit.coupling.one_way.a_priori_grid`) of the survey's
+        otherwise the a priori grid (:func:`spinorbit.coupling.sampling.a_priori_grid`) of the survey's
         states at the run's sample tolerance × :data:`SAMPLE_REFINEMENT`. Perturbers sampled on
         separate grids (DE421/REBOUND bodies and user ephemerides) add their counts.
         """
         from spinorbit.core.dynamics.equations import make_model
         from spinorbit.core.integrators.taylor import integrate_taylor
-        from spinorbit.coupling.one_way import a_priori_grid
+        from spinorbit.coupling.sampling import a_priori_grid
 
         free = make_model(self.state.body.principal_moments)  # the figure the one-way run uses
         y0 = self.state.core_state()
@@ -1092,7 +1092,7 @@ def _first_tolerance(integrator, share):
 
 def _subset(samples, names):
     """The columns of ``names`` of a SampledPerturbers (same grid, same error estimates per perturber)."""
-    from spinorbit.coupling.one_way import SampledPerturbers
+    from spinorbit.coupling.sampling import SampledPerturbers
 
     index = [samples.names.index(n) for n in names]
     return SampledPerturbers(tuple(names), samples.gm[index], samples.days, samples.states[:, index],

@@ -202,13 +202,20 @@ def _rotation_derivatives_cfunc(ode, y_dot, y, t):
     kinematics_and_euler_into(state, nx, ny, nz, p[_R_MODEL:_R_MODEL + FIGURE_SIZE], out)
 
 
+@jit
+def _apply_folded_extra_forces(words):
+    """Run the extra forces folded into the rotation block (if any); return the block (via ``sim.extras``)."""
+    p = carray(as_float64_pointer(words[SIM_EXTRAS_WORD]), _R_SIZE)
+    if p[_R_USE_EXTRA] != 0.0:
+        apply_extra_forces(words, p[_R_EXTRA:_R_EXTRA + EXTRA_SIZE])
+    return p
+
+
 @cfunc(types.void(types.CPointer(types.uint64)), cache=True)
 def _coupled_forces_cfunc(simulation):
     """``additional_forces``: EIH + Earth J2 (if on), then the figure's back-reaction (if coupled)."""
     words = carray(simulation, SIM_WORDS)
-    p = carray(as_float64_pointer(words[SIM_EXTRAS_WORD]), _R_SIZE)
-    if p[_R_USE_EXTRA] != 0.0:
-        apply_extra_forces(words, p[_R_EXTRA:_R_EXTRA + EXTRA_SIZE])
+    p = _apply_folded_extra_forces(words)
     if p[_R_COUPLED] != 0.0:
         ode_words = carray(as_uint64_pointer(float64_bits(p[_R_ODE])), ODE_WORDS)
         # The ODE's current BS stage lives in y1; before the first step y1 is not allocated yet.
@@ -482,9 +489,7 @@ PSEUDO_PARTICLE_NAMES = ("_spinorbit_q012", "_spinorbit_q3")
 def _pseudo_particle_forces_cfunc(simulation):
     """``additional_forces`` of the IAS15 route: EIH + J2, back-reaction, then q̈ on the pseudo-particles."""
     words = carray(simulation, SIM_WORDS)
-    p = carray(as_float64_pointer(words[SIM_EXTRAS_WORD]), _R_SIZE)
-    if p[_R_USE_EXTRA] != 0.0:
-        apply_extra_forces(words, p[_R_EXTRA:_R_EXTRA + EXTRA_SIZE])
+    p = _apply_folded_extra_forces(words)
     n = np.int64(words[SIM_N_WORD])
     if n != np.int64(p[_R_N_EXPECTED]):
         _stop_with_error(words, pointer_address(simulation), p, ERROR_PARTICLE_COUNT)

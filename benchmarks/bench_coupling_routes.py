@@ -15,7 +15,7 @@ from astropy.time import Time
 from spinorbit.core.model.gravity_field import make_body
 from spinorbit.core.dynamics.equations import inertial_angular_momentum
 from spinorbit.coupling.moon import ARCSEC_PER_RAD, moon_at_de421, moon_figure
-from spinorbit.coupling.rebound.adapter import attach_rotation_ias15, simulation_from_de421
+from spinorbit.coupling.rebound import attach_rotation_ias15, simulation_from_de421
 from spinorbit.ephemeris import moon_orientation_raw
 
 YEAR = 365.25

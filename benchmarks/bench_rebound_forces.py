@@ -17,7 +17,7 @@ import numpy as np
 from astropy.time import Time
 
 from _report import machine_line, write_section
-from spinorbit.coupling.rebound import adapter as adapter
+from spinorbit.coupling.rebound import extra_forces, simulation
 
 J2000 = Time(2451545.0, format="jd", scale="tdb")
 YEAR = 365.25
@@ -26,11 +26,11 @@ YEAR = 365.25
 def _run(mode, repeats=5):
     best, calls = np.inf, 0
     for _ in range(repeats):
-        sim = adapter.simulation_from_de421(J2000)
+        sim = simulation.simulation_from_de421(J2000)
         if mode in ("cfunc", "thunk"):
-            adapter.install_extra_forces(sim)
+            extra_forces.install_extra_forces(sim)
         if mode == "thunk":
-            compiled = adapter._extra_forces_cfunc.ctypes  # same machine code, called from Python
+            compiled = extra_forces.extra_forces_cfunc.ctypes  # same machine code, called from Python
 
             def thunk(sim_pointer, compiled=compiled):
                 compiled(ctypes.cast(sim_pointer, ctypes.POINTER(ctypes.c_uint64)))

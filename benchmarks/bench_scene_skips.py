@@ -40,7 +40,7 @@ from _report import machine_line, repeat_main
 
 from spinorbit.data import asteroids
 from spinorbit import RigidBody, RotationState
-from spinorbit.coupling.rebound.adapter import body_index, simulation_from_de421
+from spinorbit.coupling.rebound import body_index, simulation_from_de421
 from spinorbit.ephemeris import de421_constants, moon_orientation
 from spinorbit.scene import EphemerisPerturber, Orbit, Scene
 from spinorbit.scene.routes import attitude_angles as _angles

@@ -43,7 +43,8 @@ from spinorbit.data.asteroids import (
     closest_approach,
     encounter_state,
 )
-from spinorbit.coupling.one_way import propagate_one_way, sample_from_rebound
+from spinorbit.coupling.one_way import propagate_one_way
+from spinorbit.coupling.sampling import sample_from_rebound
 from spinorbit.frames import icrf_to_ecliptic_matrix
 from spinorbit.time import tdb_days
 

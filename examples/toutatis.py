@@ -35,7 +35,8 @@ from astropy.time import Time
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from spinorbit.data.asteroids import TOUTATIS_2004, TOUTATIS_EPOCH, encounter_simulation, toutatis_rotation_state
-from spinorbit.coupling.one_way import propagate_one_way, sample_from_rebound
+from spinorbit.coupling.one_way import propagate_one_way
+from spinorbit.coupling.sampling import sample_from_rebound
 from spinorbit.time import tdb_days
 
 KM_PER_AU = 149_597_870.7

@@ -47,17 +47,22 @@ MOVED_MODULES: dict[str, tuple[str, ...]] = {
     "spinorbit.checkpoint": ("spinorbit.runs.checkpoint",),
     "spinorbit.resumable": ("spinorbit.runs.resumable",),
     "spinorbit.asteroids": ("spinorbit.data.asteroids",),
-    "spinorbit.coupling.rebound_adapter": ("spinorbit.coupling.rebound.adapter",),
+    # The adapter is split by concept (simulation, extra_forces, rotation_hooks, snapshot, interrupts);
+    # its door exports every public name the adapter had.
+    "spinorbit.coupling.rebound_adapter": ("spinorbit.coupling.rebound",),
+    "spinorbit.coupling.rebound.adapter": ("spinorbit.coupling.rebound",),
     "spinorbit.coupling.chunked_run": ("spinorbit.coupling.long_run",),
 }
 
-#: Old modules whose path is now a package: the names the package does not export itself are
-#: forwarded by the package's ``__getattr__`` (:func:`forward_attribute`).
+#: Old modules whose path is now a package, or a module that gave names away: the names it does not
+#: hold itself are forwarded by its ``__getattr__`` (:func:`forward_attribute`).
 MOVED_NAMES: dict[str, tuple[str, ...]] = {
     "spinorbit.core.dynamics": ("spinorbit.core.dynamics.equations", "spinorbit.core.dynamics.validation"),
     "spinorbit.core.elements": ("spinorbit.core.elements.paper_maps",),
     "spinorbit.scene": ("spinorbit.scene.scene", "spinorbit.scene.inputs", "spinorbit.scene.integrator_choice",
                         "spinorbit.scene.tolerances", "spinorbit.scene.plan", "spinorbit.scene.bounds"),
+    # A module that kept its path but lost the sampler to spinorbit.coupling.sampling.
+    "spinorbit.coupling.one_way": ("spinorbit.coupling.rebound", "spinorbit.coupling.sampling"),
 }
 
 

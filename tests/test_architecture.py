@@ -8,6 +8,7 @@ new module is checked the day it is added:
   order (units bridge, long-run infrastructure, coupling, scene planning, data, command line);
 - no import circles between modules;
 - no module imports another module's private name (``from x import _y``);
+- only the REBOUND door (``spinorbit.coupling.rebound``) imports rebound or ctypes;
 - old import paths answer with a DeprecationWarning and the very object of the new path.
 """
 
@@ -42,7 +43,6 @@ ANYWHERE = ("spinorbit", "spinorbit.old_paths")
 # Still to mend in the reorganisation (issue 13); each entry is removed by the change that fixes it,
 # and the lists are deleted once empty.
 KNOWN_CIRCLES = [
-    ["spinorbit.coupling.long_run", "spinorbit.coupling.rigid_body"],
 ]
 KNOWN_PRIVATE_CROSSINGS = [
     "spinorbit.core.integrators.elements: from spinorbit.core.integrators.quaternion import _A",
@@ -58,7 +58,6 @@ KNOWN_PRIVATE_CROSSINGS = [
 KNOWN_LONG = [
     "spinorbit.core.free_motion.flow",
     "spinorbit.core.math.elliptic",
-    "spinorbit.coupling.rebound.adapter",
 ]
 
 
@@ -214,6 +213,23 @@ def test_no_private_names_cross_modules():
     crossings = [c for c in crossings if c not in KNOWN_PRIVATE_CROSSINGS]
     assert crossings == [], "private names imported across modules (make them public where they belong):\n" + \
         "\n".join(crossings)
+
+
+#: The one package that may import REBOUND or handle raw memory (docs/coupling.md).
+REBOUND_DOOR = "spinorbit.coupling.rebound"
+BEHIND_THE_REBOUND_DOOR = ("rebound", "reboundx", "ctypes")
+
+
+def test_only_the_rebound_door_imports_rebound_or_ctypes():
+    outside = []
+    for module, path in MODULES.items():
+        if module == REBOUND_DOOR or module.startswith(REBOUND_DOOR + "."):
+            continue
+        for target, _ in _imports(path):
+            if target.split(".")[0] in BEHIND_THE_REBOUND_DOOR:
+                outside.append(f"{module}: import {target}")
+    assert outside == [], f"only {REBOUND_DOOR} may import {BEHIND_THE_REBOUND_DOOR} (use its exported names):\n" + \
+        "\n".join(outside)
 
 
 def test_no_module_is_too_long():

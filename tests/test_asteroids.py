@@ -26,16 +26,16 @@ from spinorbit.core.dynamics.equations import make_model
 from spinorbit.core.integrators.quaternion import integrate_quaternion
 from spinorbit.core.model.perturbers import kepler_source, kepler_state
 from spinorbit.core.math.rotations import rotation_angle_between_many
-from spinorbit.coupling.one_way import (
+from spinorbit.coupling.one_way import propagate_one_way
+from spinorbit.coupling.sampling import (
     SampledPerturbers,
-    _de421_state,
     de421_orbit,
-    propagate_one_way,
+    de421_state,
     rebound_orbit,
     sample_from_ephemeris,
     sample_from_rebound,
 )
-from spinorbit.coupling.rebound.adapter import MissingBodyError, install_extra_forces
+from spinorbit.coupling.rebound import MissingBodyError, install_extra_forces
 from spinorbit.ephemeris import EphemerisRangeError, UnknownBodyError, de421_constants
 
 GM_SUN = de421_constants().gm["sun"]
@@ -59,7 +59,7 @@ def _heliocentric(days):
 
 def _body_orbit(days):
     """Barycentric orbit = DE421 Sun + the Kepler ellipse, so the Sun seen from the body is exactly −ellipse."""
-    sun_r, sun_v = _de421_state("sun", days)
+    sun_r, sun_v = de421_state("sun", days)
     helio_r, helio_v = _heliocentric(days)
     return sun_r + helio_r, sun_v + helio_v
 

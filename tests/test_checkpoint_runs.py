@@ -188,7 +188,7 @@ def _system_with_earlier_forces():
     body's combined force, and a checkpoint must carry them back."""
     import rebound
 
-    from spinorbit.coupling.rebound.adapter import install_extra_forces, set_nongravitational
+    from spinorbit.coupling.rebound import install_extra_forces, set_nongravitational
 
     sim = rebound.Simulation()
     sim.units = ("AU", "day", "Msun")
@@ -210,7 +210,7 @@ def test_resume_keeps_the_forces_installed_before_the_body_was_attached(tmp_path
     """The checkpoint held only the constructor's earth_j2/gr (both off here): a resume ran without
     EIH, J2 and the non-gravitational terms (measured: 8.2e-8 au off the uninterrupted run 18 days
     after the restore at day 12). Also needs BS's first_or_last_step given back after the restore
-    (``rebound_adapter._resume_bs_controller_cfunc``): without it this run left the uninterrupted one
+    (``rotation_hooks._resume_bs_controller_cfunc``): without it this run left the uninterrupted one
     by ~1e-14 even with the forces right."""
     times = np.linspace(0.0, 30.0, 31)[1:]
     path = tmp_path / "forces.ckpt"

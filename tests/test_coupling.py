@@ -10,7 +10,7 @@ import pytest
 import rebound
 
 from spinorbit.core.model.gravity_field import make_body
-from spinorbit.coupling.rebound.adapter import (
+from spinorbit.coupling.rebound import (
     ForceInstallError,
     MissingBodyError,
     RotationCallbackError,
@@ -160,7 +160,7 @@ def test_refuses_a_second_body_and_folds_in_earlier_extra_forces():
 
 def test_ias15_pseudo_particle_route_conserves_and_agrees_with_bs():
     """The alternative route (measured in benchmarks/bench_coupling_routes.py) stays correct."""
-    from spinorbit.coupling.rebound.adapter import attach_rotation_ias15
+    from spinorbit.coupling.rebound import attach_rotation_ias15
 
     reference = _system()
     reference.integrate(2 * ORBIT_PERIOD)

@@ -1,4 +1,4 @@
-"""spinorbit.coupling.rebound.adapter: offline DE421 simulations, raw-pointer forces, perturbers."""
+"""spinorbit.coupling.rebound: offline DE421 simulations, raw-pointer forces, perturbers."""
 
 import numpy as np
 import pytest
@@ -6,7 +6,7 @@ import rebound
 from _offline import no_network  # noqa: F401  (autouse socket guard)
 from astropy.time import Time
 
-from spinorbit.coupling.rebound.adapter import (
+from spinorbit.coupling.rebound import (
     DEFAULT_BODIES,
     ForceInstallError,
     MissingBodyError,
@@ -217,7 +217,7 @@ def test_nongravitational_needs_installed_forces_and_a_real_body():
 
 def test_reinstalled_forces_carry_every_parameter():
     """A rebuilt copy (the one-way sampler's route) integrates bit-for-bit like the original."""
-    from spinorbit.coupling.rebound.adapter import reinstall_extra_forces
+    from spinorbit.coupling.rebound import reinstall_extra_forces
 
     original = _sun_and_circular_body()
     set_nongravitational(original, "Body", 1e-6, -3e-7, 2e-7)
@@ -255,7 +255,7 @@ def _three_bodies(integrator, **settings):
     ("ias15", {"epsilon": 1e-5, "adaptive_mode": "global", "min_dt": 1e-4}, True),
 ])
 def test_a_rebuilt_copy_integrates_bit_for_bit_like_the_original(integrator, settings, warm):
-    """The one-way sampler's copies (``one_way.SimulationSnapshot``) keep every integrator setting (and state).
+    """The one-way sampler's copies (``rebound.SimulationSnapshot``) keep every integrator setting (and state).
 
     The old copy (particles, G, integrator name) ran BS at the default eps 1e-8 and IAS15 at epsilon
     1e-9. IAS15 is also copied mid-run (dt and its predictor are in REBOUND's binary). BS mid-run is
@@ -263,7 +263,7 @@ def test_a_rebuilt_copy_integrates_bit_for_bit_like_the_original(integrator, set
     copy's first step resets ``first_or_last_step`` (also with ``sim.copy()``); copied at day 10.3,
     measured 3.5e-14 au apart at day 40 (docs/coupling.md).
     """
-    from spinorbit.coupling.one_way import SimulationSnapshot
+    from spinorbit.coupling.rebound import SimulationSnapshot
 
     original = _three_bodies(integrator, **settings)
     if warm:
@@ -283,8 +283,8 @@ def test_a_copy_keeps_the_forces_folded_into_a_rigid_body_and_refuses_foreign_on
     """A simulation with a body attached holds its earlier extra forces in the body's combined force:
     a copy must still carry them (the old copy saw no ExtraForces handle and dropped them)."""
     from spinorbit.core.model.gravity_field import make_body
-    from spinorbit.coupling.one_way import SimulationSnapshot
-    from spinorbit.coupling.rebound.adapter import _P_NG_BODY
+    from spinorbit.coupling.rebound import SimulationSnapshot
+    from spinorbit.coupling.rebound.extra_forces import EXTRA_NG_BODY
     from spinorbit.coupling.rigid_body import CoupledRigidBody
 
     plain, with_body = _three_bodies("bs"), _three_bodies("bs")
@@ -296,7 +296,7 @@ def test_a_copy_keeps_the_forces_folded_into_a_rigid_body_and_refuses_foreign_on
     for copy in copies:
         copy.integrate(30.0)
     assert copies[0].particles["Body"].xyz == copies[1].particles["Body"].xyz
-    assert copies[1]._afp.parameters[_P_NG_BODY] == body_index(with_body, "Body")  # the A1-A3 term is on
+    assert copies[1]._afp.parameters[EXTRA_NG_BODY] == body_index(with_body, "Body")  # the A1-A3 term is on
 
     foreign = rebound.Simulation()
     foreign.add(m=1.0, name="Sun")

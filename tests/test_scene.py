@@ -24,7 +24,7 @@ from spinorbit.data.asteroids import (
 )
 from spinorbit.core.model.gravity_field import make_body
 from spinorbit.core.math.rotations import attitude_to_quat, quat_to_attitude
-from spinorbit.coupling.rebound.adapter import MissingBodyError, simulation_from_de421
+from spinorbit.coupling.rebound import MissingBodyError, simulation_from_de421
 from spinorbit.coupling.rigid_body import CoupledRigidBody
 from spinorbit.ephemeris import UnknownBodyError, de421_constants, moon_orientation
 from spinorbit.scene.bounds import attitude_sensitivity

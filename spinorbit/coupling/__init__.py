@@ -1,1 +1,4 @@
-"""Couplings of the rotation core to orbit integrators (REBOUND), each behind one adapter."""
+"""The rotation coupled to orbits: REBOUND behind one door (:mod:`spinorbit.coupling.rebound`), the
+perturber sampler (``sampling``), the one-way propagation (``one_way``), the rigid body integrated
+with REBOUND's orbits (``rigid_body``), runs to output times with checkpoints (``long_run``) and the
+Moon against DE421 (``moon``)."""

@@ -9,6 +9,8 @@ ends with the same bits (``tests/test_checkpoint_runs.py`` checks it across proc
 
 The checkpoint holds the body's checkpoint, the rows done so far, the chunk count, a fingerprint of
 the output times and the caller's settings; a resume with other times or settings is refused.
+:func:`coupled_run` is the short form the scene planner uses: the fully coupled rotation of a body at
+output times, on a copy of a simulation, without checkpoints.
 """
 
 from __future__ import annotations
@@ -18,10 +20,12 @@ import time as _time
 
 import numpy as np
 
-from spinorbit.runs.checkpoint import Checkpoint, CheckpointSchedule, fingerprint
+from spinorbit.core.model.gravity_field import make_body
+from spinorbit.coupling.rebound import ROTATION_STATE_SIZE, SimulationSnapshot, body_index
 from spinorbit.coupling.rigid_body import CoupledRigidBody
+from spinorbit.runs.checkpoint import Checkpoint, CheckpointSchedule, fingerprint
 
-__all__ = ["CHUNKED_RUN_KIND", "integrate_to_outputs"]
+__all__ = ["CHUNKED_RUN_KIND", "integrate_to_outputs", "coupled_run"]
 
 #: ``kind`` of the checkpoints written by :func:`integrate_to_outputs`.
 CHUNKED_RUN_KIND = "coupled-run"
@@ -105,3 +109,52 @@ def integrate_to_outputs(body, times, record, row_size: int, schedule: Checkpoin
                 "settings": settings,
                 "wall_seconds": wall}), i + 1)
     return body, rows, wall
+
+
+def coupled_run(sim, body, moments_per_mass, state, start, times, perturbers, tolerance):
+    """The fully coupled rotation of ``body`` at ``times``, on a copy of ``sim`` (``sim`` is not modified).
+
+    The copy (particles, G, integrator, extra forces reinstalled, as the one-way sampler rebuilds it)
+    is first carried to ``start`` by its own integrator with point masses — the orbits the one-way
+    route samples — then switched to BS (the only integrator that couples a user ODE,
+    ``docs/coupling.md``) with the rotation attached, ``coupled=True``, and integrated through
+    ``times`` with ``exact_finish_time``.
+
+    Parameters
+    ----------
+    sim : rebound.Simulation
+        ("AU", "day", "Msun") units, ``t`` in TDB days since J2000 (e.g. ``simulation_from_de421``).
+    body : str
+        Particle with the figure; it must have mass.
+    moments_per_mass : (A, B, C)
+        Principal moments over the body's mass, au² (degree-2 figure; times the particle's mass it is
+        the figure in the simulation's units).
+    state : array_like, shape (7,)
+        (q, ω) at ``start``: q principal axes → ICRF (scalar first), ω principal axes, rad/day.
+    start : float
+        TDB days since J2000.
+    times : ndarray
+        Output times after ``start``, increasing, TDB days since J2000.
+    perturbers : sequence of str
+        Particles that torque the figure and feel its back-reaction.
+    tolerance : float
+        BS eps_abs = eps_rel.
+
+    Returns
+    -------
+    states : ndarray, shape (n, 7)
+        (q, ω) at ``times``, same axes as ``state``.
+    stats : dict
+        ``steps`` (BS steps taken, REBOUND's ``steps_done``), ``wall_seconds`` (integration only).
+    """
+    copy = SimulationSnapshot.of(sim).build()
+    copy.integrate(start)
+    copy.integrator = "bs"
+    copy.integrator.eps_abs = tolerance
+    copy.integrator.eps_rel = tolerance
+    mass = copy.particles[body_index(copy, body)].m
+    figure = make_body(tuple(float(m) * mass for m in moments_per_mass), mass=mass)
+    rigid = CoupledRigidBody(copy, body, figure, state, perturbers=perturbers, coupled=True)
+    steps = copy.steps_done
+    _, rows, wall = integrate_to_outputs(rigid, times, lambda b: b.state, ROTATION_STATE_SIZE)
+    return rows, {"steps": int(copy.steps_done - steps), "wall_seconds": wall}

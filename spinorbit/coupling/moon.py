@@ -48,9 +48,9 @@ from spinorbit.ephemeris import (
     moon_orientation_raw,
 )
 from spinorbit.time import J2000_JD_TDB, tdb_day_and_fraction, time_from_tdb_days
-from spinorbit.coupling.one_way import de421_orbit, sample_from_ephemeris, sample_relative_states
+from spinorbit.coupling.sampling import de421_orbit, sample_from_ephemeris, sample_relative_states
 from spinorbit.coupling.long_run import integrate_to_outputs
-from spinorbit.coupling.rebound.adapter import DEFAULT_BODIES, simulation_from_de421
+from spinorbit.coupling.rebound import DEFAULT_BODIES, simulation_from_de421
 from spinorbit.coupling.rigid_body import CoupledRigidBody
 
 __all__ = [
@@ -73,12 +73,11 @@ RIGID_MODELS = ("rigid", "core-corrected")
 #: Every model :func:`compare_model_with_de421` runs; "de421" is the mantle-and-core model.
 MOON_MODELS = ("de421",) + RIGID_MODELS
 ARCSEC_PER_RAD = 180.0 * 3600.0 / np.pi
-#: BS tolerance (eps_abs = eps_rel) for the lunar runs: the shared note measured 1e-13 for
-#: ephemeris-grade orbits; the state is O(1) (q, ω ≈ 0.23 rad/day, positions ≲ 40 au).
+#: BS tolerance (eps_abs = eps_rel) for the lunar runs: ephemeris-grade orbits at an O(1) state
+#: (q, ω ≈ 0.23 rad/day, positions ≲ 40 au); the tolerance scan is in docs/coupling.md.
 DEFAULT_TOLERANCE = 1e-13
-#: Perturbers that see the lunar field's degrees 3–4 by default. For the Sun the degree-3 torque is
-#: (R_Moon/1 au) ~ 1e-5 of its degree-2 torque; for the planets less. Measured: limiting degrees 3–4
-#: to Earth changes the 1-year comparison by < 0.001″ and halves the wall time (docs/coupling.md).
+#: Perturbers that see the lunar field's degrees 3–4 by default; for the Sun the degree-3 torque is
+#: (R_Moon/1 au) ~ 1e-5 of its degree-2 torque, for the planets less (measurements: docs/coupling.md).
 FULL_FIELD_PERTURBERS = ("Earth",)
 
 
@@ -269,12 +268,11 @@ def _comparison(times, quaternions, wall):
 #: J2), the Sun second (it also acts on the distortion ΔI); the planets act on the undistorted figure.
 #: Mercury, Uranus, Neptune: (μ/r³) below 1e-9 of the Earth's, left out.
 INTERIOR_PERTURBERS = ("earth", "sun", "venus", "mars", "jupiter", "saturn")
-#: Relative interpolation error of the sampled DE421 positions. Measured: 1e-9, 1e-10 and 1e-12 give
-#: the same 5- and 20-year comparisons to 1e-5″; the sampling is the dominant cost (docs/coupling.md).
+#: Relative interpolation error of the sampled DE421 positions: tighter changes nothing at 1e-5″ and
+#: the sampling is the dominant cost (measurements: docs/coupling.md).
 INTERIOR_SAMPLE_TOLERANCE = 1e-9
 #: Interpolation error for the Sun and the planets: their torques on the Moon are ≤ 1/180 of the
-#: Earth's (μ/r³), so 1e-7 on them is ≤ 2e-9 of the total torque, the Earth's share at 1e-9. Measured:
-#: the 5-year comparison unchanged to 1e-5″, the sampling 1.7× faster.
+#: Earth's (μ/r³), so 1e-7 on them is ≤ 2e-9 of the total torque, the Earth's share at 1e-9.
 DISTANT_SAMPLE_TOLERANCE = 1e-7
 #: DOP853 local tolerance for the "de421" model; 1e-11 … 1e-13 agree to 1e-5″ over 5 years.
 INTERIOR_RTOL = 1e-12

@@ -1,6 +1,6 @@
 """A rigid body whose rotation is integrated together with a REBOUND simulation's orbits.
 
-Python-facing class over :func:`spinorbit.coupling.rebound.adapter.attach_rotation_hooks` (which owns
+Python-facing class over :func:`spinorbit.coupling.rebound.rotation_hooks.attach_rotation_hooks` (which owns
 every raw pointer). Route and reasons: ``docs/coupling.md``. Units are the simulation's; for DE421
 simulations (``simulation_from_de421``): au, day (TDB), Msun-mass units (GM/G), ω in rad/day.
 """
@@ -16,18 +16,18 @@ from spinorbit.core.dynamics.equations import (
     kinetic_energy,
 )
 from spinorbit.core.model.gravity_field import figure_force_function_and_gradient
-from spinorbit.coupling.rebound.adapter import (
+from spinorbit.coupling.rebound import (
     ExtraForces,
     RotationHooks,
     attach_rotation_hooks,
     body_index,
     integrate_interruptibly,
     reinstall_extra_forces,
+    simulation_binary,
     simulation_from_binary,
 )
 
-__all__ = ["CHECKPOINT_KIND", "CONTENT_VERSION", "SAVE_FORMAT_VERSION", "CoupledRigidBody", "RestoreError",
-           "coupled_run"]
+__all__ = ["CHECKPOINT_KIND", "CONTENT_VERSION", "SAVE_FORMAT_VERSION", "CoupledRigidBody", "RestoreError"]
 
 #: Version of the file format written by :meth:`CoupledRigidBody.save` (:mod:`spinorbit.runs.checkpoint`).
 SAVE_FORMAT_VERSION = CHECKPOINT_FORMAT_VERSION
@@ -74,9 +74,9 @@ class CoupledRigidBody:
 
     Raises
     ------
-    spinorbit.coupling.rebound.adapter.MissingBodyError
+    spinorbit.coupling.rebound.simulation.MissingBodyError
         ``body`` or a perturber is not in the simulation.
-    spinorbit.coupling.rebound.adapter.ForceInstallError
+    spinorbit.coupling.rebound.extra_forces.ForceInstallError
         The integrator is not BS, something else owns ``additional_forces``, or ``earth_j2``/``gr``
         asked for a force the block installed earlier does not have.
     """
@@ -148,7 +148,7 @@ class CoupledRigidBody:
 
         Raises
         ------
-        spinorbit.coupling.rebound.adapter.RotationCallbackError
+        spinorbit.coupling.rebound.rotation_hooks.RotationCallbackError
             A compiled callback found a problem and stopped the run (message says what and when).
         KeyboardInterrupt
             Ctrl-C (SIGINT) during the call, also when REBOUND's own handler caught it.
@@ -208,7 +208,7 @@ class CoupledRigidBody:
         return Checkpoint(
             kind=CHECKPOINT_KIND,
             arrays={
-                "simulation": np.frombuffer(self.sim.__reduce__()[1][0], dtype=np.uint8),
+                "simulation": np.frombuffer(simulation_binary(self.sim), dtype=np.uint8),
                 "rotation_state": self.state,
                 "figure": self.figure,
                 "perturber_degrees": np.array(self.perturber_degrees, dtype=np.int64),
@@ -272,56 +272,3 @@ class CoupledRigidBody:
         except CheckpointError as error:
             raise RestoreError(str(error)) from None
         return cls.from_checkpoint(checkpoint)
-
-
-def coupled_run(sim, body, moments_per_mass, state, start, times, perturbers, tolerance):
-    """The fully coupled rotation of ``body`` at ``times``, on a copy of ``sim`` (``sim`` is not modified).
-
-    The copy (particles, G, integrator, extra forces reinstalled, as the one-way sampler rebuilds it)
-    is first carried to ``start`` by its own integrator with point masses — the orbits the one-way
-    route samples — then switched to BS (the only integrator that couples a user ODE,
-    ``docs/coupling.md``) with the rotation attached, ``coupled=True``, and integrated through
-    ``times`` with ``exact_finish_time``.
-
-    Parameters
-    ----------
-    sim : rebound.Simulation
-        ("AU", "day", "Msun") units, ``t`` in TDB days since J2000 (e.g. ``simulation_from_de421``).
-    body : str
-        Particle with the figure; it must have mass.
-    moments_per_mass : (A, B, C)
-        Principal moments over the body's mass, au² (degree-2 figure; times the particle's mass it is
-        the figure in the simulation's units).
-    state : array_like, shape (7,)
-        (q, ω) at ``start``: q principal axes → ICRF (scalar first), ω principal axes, rad/day.
-    start : float
-        TDB days since J2000.
-    times : ndarray
-        Output times after ``start``, increasing, TDB days since J2000.
-    perturbers : sequence of str
-        Particles that torque the figure and feel its back-reaction.
-    tolerance : float
-        BS eps_abs = eps_rel.
-
-    Returns
-    -------
-    states : ndarray, shape (n, 7)
-        (q, ω) at ``times``, same axes as ``state``.
-    stats : dict
-        ``steps`` (BS steps taken, REBOUND's ``steps_done``), ``wall_seconds`` (integration only).
-    """
-    from spinorbit.core.model.gravity_field import make_body
-    from spinorbit.coupling.long_run import integrate_to_outputs
-    from spinorbit.coupling.one_way import SimulationSnapshot
-
-    copy = SimulationSnapshot.of(sim).build()
-    copy.integrate(start)
-    copy.integrator = "bs"
-    copy.integrator.eps_abs = tolerance
-    copy.integrator.eps_rel = tolerance
-    mass = copy.particles[body_index(copy, body)].m
-    figure = make_body(tuple(float(m) * mass for m in moments_per_mass), mass=mass)
-    rigid = CoupledRigidBody(copy, body, figure, state, perturbers=perturbers, coupled=True)
-    steps = copy.steps_done
-    _, rows, wall = integrate_to_outputs(rigid, times, lambda b: b.state, 7)
-    return rows, {"steps": int(copy.steps_done - steps), "wall_seconds": wall}

@@ -49,7 +49,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from spinorbit.body import RigidBody
 from spinorbit.core.math import rotations as _rotations
-from spinorbit.coupling.rebound.adapter import (
+from spinorbit.coupling.rebound import (
     DEFAULT_BODIES,
     body_index,
     install_extra_forces,
@@ -250,7 +250,7 @@ def encounter_state(geometry, return_details=False):
 def encounter_simulation(geometry, bodies=DEFAULT_BODIES, integrator="ias15"):
     """REBOUND simulation at the encounter time with the asteroid added as a massless particle.
 
-    The Sun, planets, Moon and Pluto come from DE421 (:func:`~spinorbit.coupling.rebound.adapter.simulation_from_de421`);
+    The Sun, planets, Moon and Pluto come from DE421 (:func:`~spinorbit.coupling.rebound.simulation.simulation_from_de421`);
     the asteroid (named ``geometry.name``) sits at Earth + :func:`encounter_state`.
     """
     sim = simulation_from_de421(_tdb(geometry.time), bodies=bodies, integrator=integrator)
@@ -314,13 +314,13 @@ def published_orbit_simulation(state=APOPHIS_HORIZONS, time=None, bodies=DEFAULT
     """REBOUND simulation with a published heliocentric state, integrated to ``time``.
 
     The Sun, planets, Moon and Pluto come from DE421 at ``state.epoch``
-    (:func:`~spinorbit.coupling.rebound.adapter.simulation_from_de421`); the body (named
+    (:func:`~spinorbit.coupling.rebound.simulation.simulation_from_de421`); the body (named
     ``state.name``, massless) is placed at the simulation's Sun + the published heliocentric state,
     converted from IAU 2012 au to DE421's au (the simulation's unit). With ``extra_forces`` (default),
-    :func:`~spinorbit.coupling.rebound.adapter.install_extra_forces` adds Earth's J2 and the EIH 1PN
+    :func:`~spinorbit.coupling.rebound.extra_forces.install_extra_forces` adds Earth's J2 and the EIH 1PN
     terms — Horizons' small-body model has both — and, with ``non_gravitational`` (default), the
     solution's own non-gravitational terms ``state.non_gravitational`` (A1, A2, A3 in au/d², g(r) =
-    (1 au/r)², :func:`~spinorbit.coupling.rebound.adapter.set_nongravitational`). Left out are the
+    (1 au/r)², :func:`~spinorbit.coupling.rebound.extra_forces.set_nongravitational`). Left out are the
     asteroid perturbers. The run is IAS15 with ``exact_finish_time`` up to ``time`` (astropy Time;
     None: stay at the epoch).
     """

@@ -88,7 +88,7 @@ class Orbit:
     def rebound(cls, simulation, particle):
         """A particle of a REBOUND simulation (("AU", "day", "Msun") units, t in TDB days since J2000,
         ICRF); perturbers are particles of the same simulation."""
-        from spinorbit.coupling.rebound.adapter import body_index
+        from spinorbit.coupling.rebound import body_index
 
         body_index(simulation, particle)  # MissingBodyError now, not after a survey
         return cls("rebound", str(particle), simulation=simulation)
@@ -141,7 +141,7 @@ class EphemerisPerturber:
     """A point mass moving on a user ephemeris (like :meth:`Orbit.ephemeris`, for a perturber).
 
     It goes through the planner like a DE421 body: surveyed, bounded, dropped or kept, and sampled
-    onto the same adaptive Hermite grid (:func:`spinorbit.coupling.one_way.sample_states`).
+    onto the same adaptive Hermite grid (:func:`spinorbit.coupling.sampling.sample_states`).
 
     Parameters
     ----------
@@ -271,7 +271,7 @@ def validate_perturbers(perturbers, orbit):
 def resolve_perturbers(orbit, names):
     """The perturbers' names as the orbit model knows them (REBOUND particle names, DE421 bodies)."""
     if orbit is not None and orbit.kind == "rebound":
-        from spinorbit.coupling.rebound.adapter import MissingBodyError, body_index
+        from spinorbit.coupling.rebound import MissingBodyError, body_index
 
         sim = orbit.simulation
         try:
@@ -291,7 +291,7 @@ def gm_in_orbit_model(orbit):
     if orbit is None or orbit.kind == "ephemeris":
         return 0.0
     if orbit.kind == "rebound":
-        from spinorbit.coupling.rebound.adapter import body_index
+        from spinorbit.coupling.rebound import body_index
 
         sim = orbit.simulation
         return float(sim.particles[body_index(sim, orbit.name)].m * sim.G)

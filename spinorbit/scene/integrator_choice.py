@@ -32,7 +32,7 @@ TAYLOR_KNOT_SHARE = 1.0
 #: The rotation steps are counted by a Taylor run of the free motion over at most this many rotations
 #: (2π/|ω|), scaled to the span: a few hundred steps.
 TAYLOR_PROBE_ROTATIONS = 20.0
-#: Sample times of the run per time of the survey's a priori grid (coupling.one_way.a_priori_grid): the
+#: Sample times of the run per time of the survey's a priori grid (coupling.sampling.a_priori_grid): the
 #: run's refinement passes add 1.0–1.9× (bench_scene_skips, docs/scenes.md).
 SAMPLE_REFINEMENT = 1.4
 
@@ -81,13 +81,13 @@ def taylor_steps(scene, source, kept, skip, tol):
     over at most :data:`TAYLOR_PROBE_ROTATIONS` × 2π/|ω|, scaled to the span (the torques are weak
     against the rotation, so they hardly change the steps, ``docs/scenes.md``). Knots: the sample times the run will
     have strictly inside (epoch, last output): counted for samples the plan keeps for the run,
-    otherwise the a priori grid (:func:`spinorbit.coupling.one_way.a_priori_grid`) of the survey's
+    otherwise the a priori grid (:func:`spinorbit.coupling.sampling.a_priori_grid`) of the survey's
     states at the run's sample tolerance × :data:`SAMPLE_REFINEMENT`. Perturbers sampled on
     separate grids (DE421/REBOUND bodies and user ephemerides) add their counts.
     """
     from spinorbit.core.dynamics.equations import make_model
     from spinorbit.core.integrators.taylor import integrate_taylor
-    from spinorbit.coupling.one_way import a_priori_grid
+    from spinorbit.coupling.sampling import a_priori_grid
 
     free = make_model(scene.state.body.principal_moments)  # the figure the one-way run uses
     y0 = scene.state.core_state()

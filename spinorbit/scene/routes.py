@@ -103,7 +103,7 @@ def run_one_way(scene, plan, report):
 
 def run_coupled(scene, plan, report):
     """The fully coupled REBOUND run (BS), checked a posteriori against a second run; ``report(fraction)``."""
-    from spinorbit.coupling.rigid_body import coupled_run
+    from spinorbit.coupling.long_run import coupled_run
 
     y0 = scene.state.core_state()
 

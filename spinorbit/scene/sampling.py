@@ -2,7 +2,7 @@
 
 A scene's perturbers come from DE421 or a user ephemeris (:func:`sample_perturbers` with source
 "de421" or "ephemeris"), a REBOUND run ("rebound") or user :class:`~spinorbit.scene.EphemerisPerturber`
-s ("user"), all onto the adaptive Hermite grid of :mod:`spinorbit.coupling.one_way`.
+s ("user"), all onto the adaptive Hermite grid of :mod:`spinorbit.coupling.sampling`.
 :class:`SharedSamples` keeps what one :meth:`~spinorbit.scene.Scene.plan` or
 :meth:`~spinorbit.scene.Scene.run` (or the bodies of one orbit, :mod:`spinorbit.scene.many`) has
 sampled, so that the survey and the run pay each sampling once.
@@ -35,22 +35,22 @@ def sample_perturbers(orbit, moving, epoch_day, end_day, source, names, toleranc
 
     Returns
     -------
-    spinorbit.coupling.one_way.SampledPerturbers
+    spinorbit.coupling.sampling.SampledPerturbers
     """
-    from spinorbit.coupling import one_way
+    from spinorbit.coupling import sampling
 
     start, end = time_from_tdb_days(epoch_day), time_from_tdb_days(end_day)
     if source == "user":
         return _sample_user(orbit, moving, start, end, names, tolerance)
     if source == "rebound":
-        return one_way.sample_from_rebound(orbit.simulation, orbit.name, start, end, names, tolerance=tolerance)
-    function = one_way.de421_orbit(orbit.name) if source == "de421" else orbit.function
-    return one_way.sample_from_ephemeris(function, start, end, names, tolerance=tolerance)
+        return sampling.sample_from_rebound(orbit.simulation, orbit.name, start, end, names, tolerance=tolerance)
+    function = sampling.de421_orbit(orbit.name) if source == "de421" else orbit.function
+    return sampling.sample_from_ephemeris(function, start, end, names, tolerance=tolerance)
 
 
 def _sample_user(orbit, moving, start, end, names, tolerance):
     """Sample the EphemerisPerturbers ``names`` relative to the body (same grid and checks as DE421's)."""
-    from spinorbit.coupling import one_way
+    from spinorbit.coupling import sampling
 
     chosen = [next(p for p in moving if p.name == name) for name in names]
     body = body_orbit(orbit) if any(not p.relative for p in chosen) else None
@@ -62,23 +62,23 @@ def _sample_user(orbit, moving, start, end, names, tolerance):
             out[:, i] = perturber.states(days) - (0.0 if perturber.relative else centre)
         return out
 
-    return one_way.sample_states(provider, names, [p.gm_au3_day2 for p in chosen], start, end, tolerance)
+    return sampling.sample_states(provider, names, [p.gm_au3_day2 for p in chosen], start, end, tolerance)
 
 
 def body_orbit(orbit):
     """The body's barycentric orbit as a callable days -> (positions, velocities), au and au/day."""
-    from spinorbit.coupling import one_way
+    from spinorbit.coupling import sampling
 
     if orbit.kind == "de421":
-        return one_way.de421_orbit(orbit.name)
+        return sampling.de421_orbit(orbit.name)
     if orbit.kind == "rebound":
-        return one_way.rebound_orbit(orbit.simulation, orbit.name)
+        return sampling.rebound_orbit(orbit.simulation, orbit.name)
     return orbit.function
 
 
 def subset_samples(samples, names):
     """The columns of ``names`` of a SampledPerturbers (same grid, same error estimates per perturber)."""
-    from spinorbit.coupling.one_way import SampledPerturbers
+    from spinorbit.coupling.sampling import SampledPerturbers
 
     index = [samples.names.index(n) for n in names]
     return SampledPerturbers(tuple(names), samples.gm[index], samples.days, samples.states[:, index],

@@ -36,12 +36,9 @@ from spinorbit.core.integrators.quaternion import integrate_quaternion
 from spinorbit.core.integrators.splitting import integrate_splitting
 from spinorbit.coupling.long_run import integrate_to_outputs
 from spinorbit.coupling.moon import moon_figure
-from spinorbit.coupling.one_way import (
-    de421_orbit,
-    propagate_one_way,
-    sample_from_ephemeris,
-)
-from spinorbit.coupling.rebound.adapter import (
+from spinorbit.coupling.one_way import propagate_one_way
+from spinorbit.coupling.sampling import de421_orbit, sample_from_ephemeris
+from spinorbit.coupling.rebound import (
     ForceInstallError,
     MissingBodyError,
     simulation_from_de421,

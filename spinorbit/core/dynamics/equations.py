@@ -212,7 +212,7 @@ def kinematics_and_euler_into(y, nx, ny, nz, model, dy):
 
     The one place where the equations of motion are written; :func:`rhs_into` (torque from the
     perturber table) and the REBOUND coupling (torque from the simulation's particles, see
-    ``spinorbit/coupling/rebound/adapter.py``) both end here. ``model`` needs only the figure head
+    ``spinorbit/coupling/rebound/rotation_hooks.py``) both end here. ``model`` needs only the figure head
     (A, B, C at BODY_A..BODY_C).
     """
     a_mom, b_mom, c_mom = model[BODY_A], model[BODY_B], model[BODY_C]

@@ -14,7 +14,8 @@ P_φ = 2π/ω_g of the mean (S, Z) — at outputs spread logarithmically over th
 - heyoka swept over tolerances; its mean quantities come from the same conversion, which is *not*
   counted in its CPU (that favours heyoka).
 
-CPU is ``time.process_time`` of one run (averaged: best of up to 5; heyoka: one run per tolerance,
+CPU is ``time.process_time`` of one run (averaged: median of 5, min–max beside it; heyoka, in its
+faster mode (``peers.fastest_heyoka_integrator``): one run per tolerance,
 seconds each), compilation excluded, all measured in the same run on the same (shared, noisy)
 machine, so compare ratios. "Equal accuracy": heyoka's CPU interpolated log-log in its sweep at the
 averaged propagator's error on the slow quantities (max of the momenta and slow-angle errors over
@@ -46,7 +47,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from benchmarks._report import DOCS, machine_line, write_section
+from benchmarks._report import DOCS, interleaved_timings, machine_line, write_section
 from benchmarks.peers import make_heyoka_integrator
 from benchmarks.scenes import scene_apophis, scene_toutatis
 from spinorbit.core.averaging.mean_equations import element_differences, fast_frequencies, moments_of
@@ -125,13 +126,15 @@ def slow_error(err):
     return err[:, [0, 1, 2, 4, 5]].max(axis=1)
 
 
+AVERAGED_REPEATS = 5
+
+
 def time_averaged(scene, t_out, frame, **kwargs):
-    best, res = math.inf, None
-    for _ in range(5):
-        t = time.process_time()
-        res = propagate_averaged(scene.y0, scene.t0, t_out, scene.model, frame=frame, **kwargs)
-        best = min(best, time.process_time() - t)
-    return best, res
+    """(median CPU, Timing, result) of AVERAGED_REPEATS averaged propagations."""
+    (timing,), (res,) = interleaved_timings(
+        [lambda: propagate_averaged(scene.y0, scene.t0, t_out, scene.model, frame=frame, **kwargs)],
+        AVERAGED_REPEATS, time.process_time)
+    return timing.median, timing, res
 
 
 def study_scene(label, scene, orbits, log):
@@ -147,9 +150,9 @@ def study_scene(label, scene, orbits, log):
     propagate_averaged(scene.y0, scene.t0, t_out[:1], scene.model, frame=frame, orbit_averaged=True)
     rows = {}
     for name, kwargs in (("averaged (rotation)", {}), ("averaged (rotation + orbit)", {"orbit_averaged": True})):
-        cpu, res = time_averaged(scene, t_out, frame, **kwargs)
+        cpu, timing, res = time_averaged(scene, t_out, frame, **kwargs)
         err = errors(res.mean_elements, ref, ic)
-        rows[name] = {"cpu": cpu, "err": err, "steps": res.steps,
+        rows[name] = {"cpu": cpu, "timing": timing, "err": err, "steps": res.steps,
                       "handed_over": any(seg[2] == "full" for seg in res.segments)}
         log(f"[{label}] {name}: {cpu * 1e3:.2f} ms, {res.steps} steps, slow error "
             f"{slow_error(err).max():.2e}, θ {err[:, 3].max():.2e}")
@@ -212,7 +215,7 @@ def torque_family(base, orbits, log):
         default = propagate_averaged(scene.y0, scene.t0, t_out, scene.model, frame=frame)
         kinds = sorted({seg[2] for seg in default.segments})
         propagate_averaged(scene.y0, scene.t0, t_out[:1], scene.model, frame=frame, max_perturbation=np.inf)
-        cpu, res = time_averaged(scene, t_out, frame, max_perturbation=np.inf)
+        cpu, _, res = time_averaged(scene, t_out, frame, max_perturbation=np.inf)
         err = errors(res.mean_elements, ref, ic)
         osc0 = elements_of_state(scene.y0, scene.model, frame)
         eps = validity_numbers(scene.t0, scene.model, free_motion_numbers(osc0, ic))[1]
@@ -290,6 +293,8 @@ def table(study):
     for name, r in study["rows"].items():
         e = r["err"].max(axis=0)
         cpu = f"{r['cpu'] * 1e3:.2f} ms" if r["cpu"] < 1 else f"{r['cpu']:.2f} s"
+        if "timing" in r:
+            cpu += f" ({r['timing'].min * 1e3:.2f}–{r['timing'].max * 1e3:.2f} ms)"
         lines.append(f"| {name} | {cpu} | {r.get('steps', '')} | " + " | ".join(f"{x:.1e}" for x in e) + " |")
     return "\n".join(lines)
 

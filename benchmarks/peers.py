@@ -6,7 +6,8 @@ integrates the scene once and returns the states at ``scene.t_out``. The benchma
 callable. Adding a method (e.g. the canonical-element equations or a splitting scheme) is adding one
 entry to :data:`METHODS`.
 
-- ``spinorbit-dop853``: :func:`spinorbit.core.integrators.quaternion.integrate_quaternion`.
+- ``spinorbit-dop853``: :func:`spinorbit.core.integrate_quaternion` (the package's stable entry points
+  are imported from :mod:`spinorbit.core`, so the benchmarks survive moves inside it).
 - ``spinorbit DOP853, tabulated perturbers``: the same integrator with each Keplerian perturber
   replaced by cubic Hermite samples of its orbit, dense enough for 1e-15 relative position error
   (:func:`tabulated_model`): how an ephemeris-driven run looks, and it takes the Kepler solve (80 % of
@@ -44,7 +45,9 @@ from scipy.integrate import solve_ivp
 
 from spinorbit.core.dynamics import python_reference
 from spinorbit.core.dynamics.equations import scipy_rhs
-from spinorbit.core.integrators.quaternion import default_atol, integrate_quaternion
+from spinorbit.core import integrate_elements, integrate_quaternion, integrate_splitting, integrate_taylor
+from spinorbit.core import make_model, sampled_source
+from spinorbit.core.integrators.quaternion import default_atol
 from spinorbit.core.model.perturbers import K_P, K_Q, kepler_state
 
 
@@ -86,9 +89,6 @@ def tabulated_model(scene, rtol=TABULATION_RTOL):
     angular rate on the orbit, at pericentre; the bound is rough, so a factor 2 of margin is kept):
     h = 0.5 (384 rtol)^(1/4) / ω_max.
     """
-    from spinorbit.core.dynamics.equations import make_model
-    from spinorbit.core.model.perturbers import sampled_source
-
     t_lo = min(scene.t0, float(np.min(scene.t_out)))
     t_hi = max(scene.t0, float(np.max(scene.t_out)))
     sources = []
@@ -122,8 +122,6 @@ def prepare_spinorbit_tabulated(scene, tol):
 
 def prepare_splitting(scene, steps_per_rotation, scheme):
     """Fixed-step splitting with ``steps_per_rotation`` steps per rotation of the scene."""
-    from spinorbit.core.integrators.splitting import integrate_splitting
-
     span = abs(float(scene.t_out[-1]) - scene.t0)
     step = span / (scene.rotations * steps_per_rotation)
 
@@ -158,16 +156,12 @@ def _prepare_call(integrate, scene, **kwargs):
 
 
 def prepare_spinorbit_elements(scene, tol):
-    from spinorbit.core.integrators.elements import integrate_elements
-
     return _prepare_call(integrate_elements, scene, rtol=tol)
 
 
 # --------------------------------------------------------------------------- Taylor
 
 def prepare_spinorbit_taylor(scene, tol):
-    from spinorbit.core.integrators.taylor import integrate_taylor
-
     return _prepare_call(integrate_taylor, scene, tol=tol)
 
 

@@ -54,11 +54,8 @@ from benchmarks.scenes import all_scenes
 from spinorbit.runs.atomic import atomic_path
 from spinorbit.core.integrators.elements import integrate_elements_fixed_step
 from spinorbit.core.integrators.quaternion import integrate_fixed_step
-from spinorbit.core.integrators.splitting import integrate_splitting
-from spinorbit.core.integrators.taylor import (
-    integrate_taylor,
-    integrate_taylor_fixed_step,
-)
+from spinorbit.core import integrate_quaternion, integrate_splitting, integrate_taylor, make_model
+from spinorbit.core.integrators.taylor import integrate_taylor_fixed_step
 from spinorbit.core.math.rotations import rotation_angle_between_many
 
 #: Accuracy at which methods are compared (rad).
@@ -132,8 +129,7 @@ def rhs_cost_ns(model, y, t0, calls=200_000):
 
 def cost_breakdown(scene, tol=1e-12):
     """Where spinorbit's time goes at one tolerance: steps, RHS calls, RHS cost with/without torque."""
-    from spinorbit.core.dynamics.equations import make_model
-    from spinorbit.core.integrators.quaternion import default_atol, integrate_quaternion
+    from spinorbit.core.integrators.quaternion import default_atol
 
     y0 = np.asarray(scene.y0, float)
     atol = default_atol(y0, tol)

@@ -138,8 +138,8 @@ def splitting_method(scheme, label, color, marker):
                   SPLITTING_STEPS_PER_ROTATION, color, marker)
 
 
-#: Sweep of the splitting methods: steps per rotation (a rotation = the scene's spin period). 4 is
-#: already coarse (errors 1e-4 … 1e-2 rad); beyond 256 rounding dominates (≈ 1e-11 rad in scene a).
+#: Sweep of the splitting methods: steps per rotation (a rotation = the scene's spin period), from
+#: coarse to where rounding dominates.
 SPLITTING_STEPS_PER_ROTATION = (4, 8, 16, 32, 64, 128, 256)
 
 

@@ -308,7 +308,7 @@ def main(argv=None):
         for method in methods:
             tols = method.tolerances
             if method.name.startswith("scipy"):
-                # scipy's Python-level loop costs ~20 µs per RHS call: limit it on the long scenes.
+                # scipy's Python-level loop is slow: fewer tolerances on the long scenes.
                 if args.quick:
                     tols = tols[:1]
                 elif scene.name == "c":

@@ -91,8 +91,18 @@ def _sinh_minus_x(x):
     return total
 
 
-def _halley_step(f, fp, fpp):
-    return f / (fp - 0.5 * f * fpp / fp) if fp > 0.0 else math.inf
+def _bracketed_halley(f, fp, fpp, x, lo, hi):
+    """One step of the safeguarded iteration: (Halley correction dx, new bracket lo, hi, next iterate,
+    whether the bracket has shrunk to KEPLER_TOLERANCE). f is increasing, so its sign moves one end."""
+    if f > 0.0:
+        hi = x
+    else:
+        lo = x
+    dx = f / (fp - 0.5 * f * fpp / fp) if fp > 0.0 else math.inf
+    x_next = x - dx
+    if not (lo <= x_next <= hi):
+        x_next = 0.5 * (lo + hi)
+    return dx, lo, hi, x_next, hi - lo <= KEPLER_TOLERANCE * max(1.0, abs(x_next))
 
 
 def elliptic_anomaly_sincos(mean_anomaly, e):
@@ -108,19 +118,12 @@ def elliptic_anomaly_sincos(mean_anomaly, e):
     sx, cx = math.sin(x), math.cos(x)
     for _ in range(KEPLER_MAX_ITERATIONS):
         f = (1.0 - e) * x + e * _x_minus_sin(x) - m if abs(x) < _SERIES_RANGE else x - e * sx - m
-        if f > 0.0:
-            hi = x
-        else:
-            lo = x
-        dx = _halley_step(f, 1.0 - e * cx, e * sx)
+        dx, lo, hi, x_next, converged = _bracketed_halley(f, 1.0 - e * cx, e * sx, x, lo, hi)
         if abs(dx) <= KEPLER_FINAL_STEP * max(1.0, abs(x)) and lo <= x - dx <= hi:
             half_dx2 = 0.5 * dx * dx
             return sx - cx * dx - sx * half_dx2, cx + sx * dx - cx * half_dx2
-        x_new = x - dx
-        if not (lo <= x_new <= hi):
-            x_new = 0.5 * (lo + hi)
-        x = x_new
-        if hi - lo <= KEPLER_TOLERANCE * max(1.0, abs(x_new)):
+        x = x_next
+        if converged:
             break
         sx, cx = math.sin(x), math.cos(x)
     return math.sin(x), math.cos(x)
@@ -138,19 +141,12 @@ def hyperbolic_anomaly_sinhcosh(mean_anomaly, e):
     sh, ch = math.sinh(x), math.cosh(x)
     for _ in range(KEPLER_MAX_ITERATIONS):
         f = (e - 1.0) * x + e * _sinh_minus_x(x) - m if x < _SERIES_RANGE else e * sh - x - m
-        if f > 0.0:
-            hi = x
-        else:
-            lo = x
-        dx = _halley_step(f, e * ch - 1.0, e * sh)
+        dx, lo, hi, x_next, converged = _bracketed_halley(f, e * ch - 1.0, e * sh, x, lo, hi)
         if abs(dx) <= KEPLER_FINAL_STEP * max(1.0, abs(x)) and lo <= x - dx <= hi:
             half_dx2 = 0.5 * dx * dx
             return sgn * (sh - ch * dx + sh * half_dx2), ch - sh * dx + ch * half_dx2
-        x_new = x - dx
-        if not (lo <= x_new <= hi):
-            x_new = 0.5 * (lo + hi)
-        x = x_new
-        if hi - lo <= KEPLER_TOLERANCE * max(1.0, abs(x_new)):
+        x = x_next
+        if converged:
             break
         sh, ch = math.sinh(x), math.cosh(x)
     return sgn * math.sinh(x), math.cosh(x)

@@ -6,10 +6,15 @@ the page (prose written by hand) is left untouched. The page is written atomical
 
 from __future__ import annotations
 
+import math
 import os
 import platform
+import time
+from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
+
+import numpy as np
 
 from spinorbit.runs.atomic import write_bytes_atomically
 
@@ -33,6 +38,79 @@ def machine_line() -> str:
     )
 
 
+@dataclass(frozen=True)
+class Timing:
+    """Repeated timings of one run (s): the median to compare, the minimum and the spread beside it.
+
+    On a shared machine a single best-of hides how the load moved the runs; the median and the
+    min–max range of interleaved repeats show both the typical cost and the noise.
+    """
+
+    samples: tuple
+
+    @property
+    def min(self) -> float:
+        return min(self.samples)
+
+    @property
+    def max(self) -> float:
+        return max(self.samples)
+
+    @property
+    def median(self) -> float:
+        return float(np.median(self.samples))
+
+    @property
+    def iqr(self) -> tuple:
+        """(first quartile, third quartile) (s)."""
+        q1, q3 = np.percentile(self.samples, [25, 75])
+        return float(q1), float(q3)
+
+    def text(self, scale: float = 1e3, fmt: str = ".2f") -> str:
+        """'median (min–max, n runs)' in units of 1/scale s (ms by default)."""
+        return (f"{self.median * scale:{fmt}} ({self.min * scale:{fmt}}–{self.max * scale:{fmt}}, "
+                f"{len(self.samples)} runs)")
+
+
+def interleaved_timings(functions, repeats: int, clock=time.perf_counter, budget_s: float = math.inf,
+                        warm_up: bool = False):
+    """Time ``functions`` alternately (f0, f1, …, f0, f1, …) so that all see the same machine load.
+
+    Parameters
+    ----------
+    functions : sequence of callables
+    repeats : int
+        Rounds (each calls every function once); fewer if ``budget_s`` of clock time is spent first.
+    clock : callable
+        ``time.perf_counter`` (wall) or ``time.process_time`` (CPU of this process).
+    budget_s : float
+        Stop after the round in which the summed time of all calls exceeds this (s).
+    warm_up : bool
+        Call each function once, untimed, first (compilation, caches).
+
+    Returns
+    -------
+    timings : list of Timing
+        One per function.
+    results : list
+        Each function's result from its last call.
+    """
+    functions = list(functions)
+    results = [f() if warm_up else None for f in functions]
+    samples = [[] for _ in functions]
+    spent = 0.0
+    for _ in range(max(1, repeats)):
+        for i, f in enumerate(functions):
+            start = clock()
+            results[i] = f()
+            elapsed = clock() - start
+            samples[i].append(elapsed)
+            spent += elapsed
+        if spent > budget_s:
+            break
+    return [Timing(tuple(s)) for s in samples], results
+
+
 def write_section(name: str, markdown: str, page: str = "performance.md") -> Path:
     """Replace (or append) the section ``name`` of ``docs/<page>`` with ``markdown``."""
     path = DOCS / page
@@ -51,7 +129,7 @@ def write_section(name: str, markdown: str, page: str = "performance.md") -> Pat
 
 
 def repeat_main(section: str, description: str, measure, markdown, repeat: int = 3, argv=None) -> None:
-    """The command line of a benchmark timed best of ``--repeat``: measure, print its Markdown and, unless
+    """The command line of a benchmark timed ``--repeat`` times: measure, print its Markdown and, unless
     ``--no-write``, write it as ``section`` of docs/performance.md."""
     import argparse
 

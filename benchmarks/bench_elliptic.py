@@ -3,13 +3,12 @@
 Scalar rows: ns per call inside a numba loop (constants precomputed once per m, as the
 canonical-element code will do); scipy is called through ``scipy.special.cython_special`` from
 numba. Vectorized rows: ns per element of the public wrappers and of the scipy ufuncs.
-Writes its table into ``docs/performance.md`` (section ``bench_elliptic``).
+Writes its table into ``docs/performance.md`` (section ``bench_elliptic``; ``--no-write``: print only).
 Run: ``python benchmarks/bench_elliptic.py`` from the repository root.
 """
 
 import ctypes
 import sys
-import time
 from pathlib import Path
 
 import numba
@@ -21,7 +20,7 @@ from numba.extending import get_cython_function_address
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _report import machine_line, write_section  # noqa: E402
+from _report import Timing, interleaved_timings, machine_line, write_section  # noqa: E402
 
 from spinorbit import special  # noqa: E402
 from spinorbit.core.math import elliptic as E  # noqa: E402
@@ -147,13 +146,13 @@ def loop_scipy_elliprj(x, y, z, p):
 
 
 def ns_per_element(function, *args, count=N):
-    function(*args)  # compile / warm up
-    best = np.inf
-    for _ in range(REPEATS):
-        start = time.perf_counter()
-        function(*args)
-        best = min(best, time.perf_counter() - start)
-    return best / count * 1e9
+    """Timing (ns per element) of REPEATS calls after a warm-up call (compilation)."""
+    (timing,), _ = interleaved_timings([lambda: function(*args)], REPEATS, warm_up=True)
+    return Timing(tuple(t / count * 1e9 for t in timing.samples))
+
+
+def _ns(timing):
+    return f"{timing.median:.0f} ({timing.min:.0f}–{timing.max:.0f})"
 
 
 def main():
@@ -199,9 +198,11 @@ def main():
         lines = [f"**{title}**", "",
                  "| function | spinorbit ns | scipy peer | scipy ns | spinorbit/scipy | goal | met |",
                  "|---|---:|---|---:|---:|---|---|"]
-        for what, ours, peer, theirs, goal in entries:
+        for what, ours_timing, peer, theirs_timing, goal in entries:
+            ours = ours_timing.median
+            theirs = theirs_timing.median if theirs_timing else None
             ratio = f"{ours / theirs:.2f}" if theirs else "—"
-            theirs_text = f"{theirs:.0f}" if theirs else "—"
+            theirs_text = _ns(theirs_timing) if theirs else "—"
             if goal is None:
                 goal_text, met = "—", "—"
             elif goal_is_ns:
@@ -209,13 +210,13 @@ def main():
             else:
                 goal_text, met = goal, "pass" if ours <= theirs else "**miss**"
             what = what.replace("|", "\\|")  # a bare | would split the Markdown cell
-            lines.append(f"| {what} | {ours:.0f} | {peer or '—'} | {theirs_text} | {ratio} | {goal_text} | {met} |")
+            lines.append(f"| {what} | {_ns(ours_timing)} | {peer or '—'} | {theirs_text} | {ratio} | {goal_text} | {met} |")
         return "\n".join(lines)
 
     markdown = "\n".join([
         "## Elliptic functions (`benchmarks/bench_elliptic.py`)",
         "",
-        machine_line() + f" scipy {scipy.__version__}. One thread; best of {REPEATS} runs over "
+        machine_line() + f" scipy {scipy.__version__}. One thread; median (min–max) of {REPEATS} runs over "
         f"{N:,} inputs; m = {M}, f = {F}, u uniform in [−50, 50], φ in [−1.5, 1.5].",
         "",
         table("Scalar kernels in a numba loop (per-m constants precomputed; scipy through "
@@ -227,7 +228,8 @@ def main():
         "also returns NaN for m > 1 and loses accuracy near m = 1 (see `docs/elliptic.md`).",
     ])
     print(markdown)
-    write_section("bench_elliptic", markdown)
+    if "--no-write" not in sys.argv[1:]:
+        write_section("bench_elliptic", markdown)
 
 
 if __name__ == "__main__":

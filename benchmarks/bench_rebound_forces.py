@@ -7,24 +7,30 @@ One year of the 11-body DE421 system (IAS15) from J2000, four ways, in one proce
    ``sim.additional_forces`` property (each call goes C → Python → C);
 4. a pure-Python callback that only touches ``sim.contents.N`` (the least any Python callback does):
    the floor of the Python route, whatever the physics.
-Run: ``python benchmarks/bench_rebound_forces.py``; writes its table into docs/performance.md.
+Run: ``python benchmarks/bench_rebound_forces.py``; writes its table into docs/performance.md
+(``--no-write``: print only).
 """
 
 import ctypes
+import sys
 import time
+from pathlib import Path
 
-import numpy as np
 from astropy.time import Time
 
-from _report import machine_line, write_section
-from spinorbit.coupling.rebound import extra_forces, simulation
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from _report import Timing, machine_line, write_section  # noqa: E402
+from spinorbit.coupling.rebound import extra_forces, simulation  # noqa: E402
 
 J2000 = Time(2451545.0, format="jd", scale="tdb")
 YEAR = 365.25
 
 
 def _run(mode, repeats=5):
-    best, calls = np.inf, 0
+    """(Timing of one simulated year, steps) of one way of adding the forces."""
+    samples, calls = [], 0
     for _ in range(repeats):
         sim = simulation.simulation_from_de421(J2000)
         if mode in ("cfunc", "thunk"):
@@ -43,12 +49,13 @@ def _run(mode, repeats=5):
             sim.force_is_velocity_dependent = 1
         start = time.perf_counter()
         sim.integrate(YEAR)
-        best = min(best, time.perf_counter() - start)
+        samples.append(time.perf_counter() - start)
         calls = sim.steps_done
-    return best, calls
+    return Timing(tuple(samples)), calls
 
 
-def main():
+def main(argv=None):
+    write = "--no-write" not in (sys.argv[1:] if argv is None else argv)
     _run("cfunc", repeats=1)  # compile / load the cache outside the timing
     rows = []
     baseline, _ = _run("none")
@@ -58,22 +65,24 @@ def main():
         ("thunk", "EIH + Earth J2, same cfunc called from a Python callback"),
         ("python", "empty Python callback (floor of any Python force)"),
     ]:
-        seconds, steps = _run(mode)
-        rows.append(f"| {label} | {seconds * 1e3:.1f} | {steps} | {seconds / baseline:.2f} |")
+        timing, steps = _run(mode)
+        rows.append(f"| {label} | {timing.median * 1e3:.1f} ({timing.min * 1e3:.1f}–{timing.max * 1e3:.1f}) | {steps} "
+                    f"| {timing.median / baseline.median:.2f} |")
     table = "\n".join(
         [
             "## Extra forces in REBOUND: raw cfunc pointer vs Python callbacks",
             "",
             machine_line(),
-            "One year, 11 DE421 bodies, IAS15, best of 5 (`benchmarks/bench_rebound_forces.py`).",
+            "One year, 11 DE421 bodies, IAS15, median (min–max) of 5 (`benchmarks/bench_rebound_forces.py`).",
             "",
-            "| forces | wall time (ms) | steps | × Newtonian |",
+            "| forces | wall time (ms, median (min–max)) | steps | × Newtonian (medians) |",
             "|---|---:|---:|---:|",
             *rows,
         ]
     )
     print(table)
-    write_section("rebound_forces", table)
+    if write:
+        write_section("rebound_forces", table)
 
 
 if __name__ == "__main__":

@@ -3,14 +3,14 @@
 For every scene: the wall time of ``Scene.run(scene.plan(skip=False))`` (the full run: every
 perturber, the orbits as given, the output asked for densely; the plan is built beforehand and not
 timed) against ``scene.plan()`` + ``scene.run(plan)`` (the planner's survey and sensitivity probe
-included), best of ``--repeat`` in the same process, and the attitude difference between the two
+included), median (min–max) of ``--repeat`` in the same process, and the attitude difference between the two
 (the error the skip made) next to the tolerance and the planned run's error estimate. Timings on a
 shared machine are noisy: the ratio of the two runs in the same process is what to read.
 
 Two rows compare integrators rather than skips: 'Taylor instead of DOP853' and 'DOP853 instead of
 Taylor' time ``scene.plan()`` + ``scene.run(plan)`` against the same for the same scene forced to the
 other integrator, so only the integrator (and the planner's Taylor probe) differs. A second table, 'Taylor against DOP853 by knots', times
-the two integrators alone (``time.process_time``, alternated, best of ``--repeat``) on every one-way
+the two integrators alone (``time.process_time``, alternated, medians of ``--repeat``) on every one-way
 scene's model at tol = rtol = 1e-10 with the counts the planner's rule uses (``Scene._integrator_choice``:
 rotation steps of the free motion, knots inside the span).
 
@@ -36,7 +36,7 @@ from astropy.time import Time
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from _report import machine_line, repeat_main
+from _report import interleaved_timings, machine_line, repeat_main
 
 from spinorbit.data import asteroids
 from spinorbit import RigidBody, RotationState
@@ -160,15 +160,15 @@ def scenes():
     return out
 
 
-def interleaved_best_of(repeat, first, second):
-    """Best wall time and last value of each of two functions, called alternately (same machine load)."""
-    best, values = [math.inf, math.inf], [None, None]
-    for _ in range(repeat):
-        for i, function in enumerate((first, second)):
-            clock = time.perf_counter()
-            values[i] = function()
-            best[i] = min(best[i], time.perf_counter() - clock)
-    return (best[0], values[0]), (best[1], values[1])
+def interleaved_pair(repeat, first, second, clock=time.perf_counter):
+    """(Timing, last value) of each of two functions, called alternately (same machine load)."""
+    timings, values = interleaved_timings((first, second), repeat, clock)
+    return (timings[0], values[0]), (timings[1], values[1])
+
+
+def _ms(timing, fmt=".1f"):
+    """'median (min–max)' in ms."""
+    return f"{timing.median * 1e3:{fmt}} ({timing.min * 1e3:{fmt}}–{timing.max * 1e3:{fmt}})"
 
 
 #: Periods (d) of the moonlet sweep of the 'by knots' table: its relative circle sets the sample
@@ -235,28 +235,24 @@ def knot_rows(scene_rows, repeat):
             copy = _copy.copy(scene)
             copy.integrator = name
             forced.append((copy, copy.plan()))
-        (scene_taylor, taylor_result), (scene_dop, dop_result) = interleaved_best_of(
+        (scene_taylor, taylor_result), (scene_dop, dop_result) = interleaved_pair(
             repeat, *(lambda s=s, p=p: s.run(p) for s, p in forced))
-        best = [math.inf, math.inf]
-        for _ in range(max(repeat, 5)):
-            for i, run in enumerate((lambda: integrate_taylor(y0, t0, t_out, model, tol=tol),
-                                     lambda: integrate_quaternion(y0, t0, t_out, model, rtol=rtol))):
-                clock = time.process_time()
-                run()
-                best[i] = min(best[i], time.process_time() - clock)
+        (taylor_time, _), (dop_time, _) = interleaved_pair(
+            max(repeat, 5), lambda: integrate_taylor(y0, t0, t_out, model, tol=tol),
+            lambda: integrate_quaternion(y0, t0, t_out, model, rtol=rtol), clock=time.process_time)
         rows.append({"skip": skip, "kept": ", ".join(plan.kept), "knots": knots, "estimate": estimate,
                      "rotation": steps, "tol": tol, "rtol": rtol, "taylor_steps": taylor_stats["steps"],
-                     "dop_steps": dop_stats["accepted"] + dop_stats["rejected"], "taylor": best[0], "dop": best[1],
+                     "dop_steps": dop_stats["accepted"] + dop_stats["rejected"], "taylor": taylor_time, "dop": dop_time,
                      "taylor_error": float(np.max(_angles(reference[:, :4], yt[:, :4]))),
                      "dop_error": float(np.max(_angles(reference[:, :4], yd[:, :4]))), "choice": plan.integrator,
                      "scene_taylor": scene_taylor, "scene_dop": scene_dop, "final_tol": taylor_result.stats["rtol"],
                      "final_rtol": dop_result.stats["rtol"]})
         r = rows[-1]
         print(f"{skip[:26]:26s} knots {knots:5d} (est. {estimate:6.0f}) rotation {steps:6.0f} est. ratio "
-              f"{estimate / steps:6.3g}  Taylor tol {tol:.1e} {r['taylor_steps']:5d} steps {best[0] * 1e3:6.3f} ms "
-              f"err {r['taylor_error']:.1e}  DOP853 rtol {rtol:.1e} {r['dop_steps']:5d} steps {best[1] * 1e3:6.3f} ms "
-              f"err {r['dop_error']:.1e}  Taylor/DOP853 {best[0] / best[1]:5.2f}  scene {scene_taylor * 1e3:6.2f} / "
-              f"{scene_dop * 1e3:6.2f} ms = {scene_taylor / scene_dop:5.2f} (final tol {r['final_tol']:.1e}, rtol "
+              f"{estimate / steps:6.3g}  Taylor tol {tol:.1e} {r['taylor_steps']:5d} steps {_ms(taylor_time, '.3f')} ms "
+              f"err {r['taylor_error']:.1e}  DOP853 rtol {rtol:.1e} {r['dop_steps']:5d} steps {_ms(dop_time, '.3f')} ms "
+              f"err {r['dop_error']:.1e}  Taylor/DOP853 {taylor_time.median / dop_time.median:5.2f}  scene "
+              f"{_ms(scene_taylor, '.2f')} / {_ms(scene_dop, '.2f')} ms = {scene_taylor.median / scene_dop.median:5.2f} (final tol {r['final_tol']:.1e}, rtol "
               f"{r['final_rtol']:.1e})  (plan: {plan.integrator})", flush=True)
     return rows
 
@@ -269,7 +265,7 @@ def measure(repeat):
         full_plan = full_scene.plan(skip=same_plan)
         full_scene.run(full_plan)  # warm-up: numba compilation, DE421 pages
         planned_scene.run(planned_scene.plan())
-        (full_time, full), (planned_time, planned) = interleaved_best_of(
+        (full_time, full), (planned_time, planned) = interleaved_pair(
             repeat, (lambda s=full_scene: s.run(s.plan())) if same_plan else (lambda s=full_scene, p=full_plan: s.run(p)),
             lambda s=planned_scene: s.run(s.plan()))
         n = len(planned.table)
@@ -279,8 +275,8 @@ def measure(repeat):
                          "tolerance": planned.plan.tolerance_rad * 206264.80624709636, "route": planned.plan.route,
                          "dropped": ", ".join(planned.plan.dropped) or "none", "source": planned.plan.orbit_source,
                          "full_route": full_plan.route})
-        print(f"{skip:26s} full {full_time * 1e3:8.1f} ms  planned {planned_time * 1e3:8.1f} ms  "
-              f"x{full_time / planned_time:6.2f}  error {rows[-1]['error']:.2e} arcsec  "
+        print(f"{skip:26s} full {_ms(full_time)} ms  planned {_ms(planned_time)} ms  "
+              f"x{full_time.median / planned_time.median:6.2f}  error {rows[-1]['error']:.2e} arcsec  "
               f"estimate {rows[-1]['estimate']:.2e}  ({planned.plan.route}, dropped {rows[-1]['dropped']})")
         rows[-1].update(integrator=planned.plan.integrator, full_integrator=full_plan.integrator)
     return {"skips": rows, "knots": knot_rows(all_scenes, repeat)}
@@ -292,7 +288,7 @@ def markdown(results, repeat):
              machine_line(), "",
              (f"Wall time of the full run (`Scene.run(scene.plan(skip=False))`, plan built beforehand) against the "
              f"planned run (`scene.plan()` + `scene.run(plan)`, the planner's survey and sensitivity probe included), "
-             f"best of {repeat} in one process, the two runs alternated; error = largest attitude angle between the two runs' outputs "
+             f"median (min–max) of {repeat} in one process, the two runs alternated; error = largest attitude angle between the two runs' outputs "
              "(the planned run's times), next to the tolerance and the planned run's own error estimate. Both runs "
              "include the a posteriori integration check (a second run at 10× rtol). In the rows 'Taylor instead of "
              "DOP853' and 'DOP853 instead of Taylor' the 'full' run is the same scene with the other integrator "
@@ -303,21 +299,21 @@ def markdown(results, repeat):
     for r in rows:
         plan = (f"{r['route']}, orbits {r['source']}, dropped {r['dropped']}, {r['integrator']} (full: "
                 f"{r['full_route']}, {r['full_integrator']})")
-        lines.append(f"| {r['skip']} | {r['description']} | {r['full'] * 1e3:.1f} | {r['planned'] * 1e3:.1f} | "
-                     f"{r['full'] / r['planned']:.2f} | {r['error']:.2e} | {r['estimate']:.2e} | {r['tolerance']:g} "
+        lines.append(f"| {r['skip']} | {r['description']} | {_ms(r['full'])} | {_ms(r['planned'])} | "
+                     f"{r['full'].median / r['planned'].median:.2f} | {r['error']:.2e} | {r['estimate']:.2e} | {r['tolerance']:g} "
                      f"| {plan} |")
     lines += ["", "### Taylor against DOP853 by knots", "",
               (f"The two integrators alone on each one-way scene's model (the kept perturbers' samples at the run's "
                "sample tolerance), each at the first tolerance the planner gives it for the scene's integration "
-               "share (Taylor tol = share × 0.3/60, DOP853 rtol = share / 1000), CPU (`time.process_time`) best of "
-               f"{max(repeat, 5)}, the two alternated; error = largest attitude angle against DOP853 at rtol 1e-14. "
+               "share (Taylor tol = share × 0.3/60, DOP853 rtol = share / 1000), CPU (`time.process_time`) median "
+               f"(min–max) of {max(repeat, 5)}, the two alternated, ratios of the medians; error = largest attitude angle against DOP853 at rtol 1e-14. "
                "Rotation steps and estimated knots: the planner's counts (`spinorbit.scene.integrator_choice.taylor_steps`: the Taylor method "
                "on the free motion over ≤ 20 rotations, scaled; knots from the survey's a priori grid); knots: the "
                "true sample times strictly inside the span (each ends a Taylor step). The planner takes Taylor while "
                "estimated knots ≤ `spinorbit.scene.integrator_choice.TAYLOR_KNOT_SHARE` × rotation steps. The moonlet rows: the SAM "
                "body at 2.5 au with the Sun and a relative circle of 0.01 au (G·M 1e-12 au³/day²) of the given "
                "period, 20 d, 200 outputs, 1 arcsec. Scene run: the whole `Scene.run` of the scene planned (skip=True) "
-               "with `integrator` forced to 'taylor' and to 'quaternion', alternated, best of --repeat: the run, its "
+               "with `integrator` forced to 'taylor' and to 'quaternion', alternated, medians of --repeat: the run, its "
                "a posteriori check at 10× the tolerance and any retry at 1/100 of it (final tol / rtol)."), "",
               "| scene | kept | knots (estimated) | rotation steps | est. knots / rotation steps | Taylor tol | "
               "Taylor steps | Taylor (ms) | Taylor error (rad) | DOP853 rtol | DOP853 steps | DOP853 (ms) "
@@ -326,9 +322,10 @@ def markdown(results, repeat):
     for r in results["knots"]:
         lines.append(f"| {r['skip']} | {r['kept']} | {r['knots']} ({r['estimate']:.0f}) | {r['rotation']:.0f} | "
                      f"{r['estimate'] / r['rotation']:.3g} | {r['tol']:.1e} | {r['taylor_steps']} | "
-                     f"{r['taylor'] * 1e3:.3f} | {r['taylor_error']:.1e} | {r['rtol']:.1e} | {r['dop_steps']} | "
-                     f"{r['dop'] * 1e3:.3f} | {r['dop_error']:.1e} | {r['taylor'] / r['dop']:.2f} | "
-                     f"{r['scene_taylor'] / r['scene_dop']:.2f} ({r['scene_taylor'] * 1e3:.1f} / {r['scene_dop'] * 1e3:.1f}) | "
+                     f"{_ms(r['taylor'], '.3f')} | {r['taylor_error']:.1e} | {r['rtol']:.1e} | {r['dop_steps']} | "
+                     f"{_ms(r['dop'], '.3f')} | {r['dop_error']:.1e} | {r['taylor'].median / r['dop'].median:.2f} | "
+                     f"{r['scene_taylor'].median / r['scene_dop'].median:.2f} ({_ms(r['scene_taylor'])} / "
+                     f"{_ms(r['scene_dop'])}) | "
                      f"{r['final_tol']:.0e} / {r['final_rtol']:.0e} | {r['choice']} |")
     return "\n".join(lines)
 

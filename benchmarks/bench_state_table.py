@@ -16,9 +16,7 @@ Usage::
 
 from __future__ import annotations
 
-import math
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +26,7 @@ from astropy.time import Time
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from _report import machine_line, repeat_main
+from _report import interleaved_timings, machine_line, repeat_main
 
 from spinorbit import RigidBody, RotationState
 from spinorbit.scene import Scene
@@ -84,25 +82,23 @@ def measure(repeat):
             "columns, constants": lambda: columns_table(body, quaternions, omegas, state),
             "scene": lambda: scene.run(scene.plan()),
         }
-        for function in work.values():  # warm-up: numba compilation
-            function()
-        best = dict.fromkeys(work, math.inf)
-        for _ in range(repeat):
-            for key, function in work.items():
-                clock = time.perf_counter()
-                function()
-                best[key] = min(best[key], time.perf_counter() - clock)
+        timings, _ = interleaved_timings(work.values(), repeat, warm_up=True)  # warm-up: numba compilation
+        best = dict(zip(work, timings))
         old, new = per_row_table(body, quaternions, omegas), columns_table(body, quaternions, omegas, state)
         spread = max(float(np.max(np.abs(new[k].value / old[k].value - 1))) for k in ("energy_ratio", "P_psi", "P_phi"))
         rows.append({"case": name, **best, "spread": spread})
-        print(f"{name}: " + "  ".join(f"{k} {v * 1e3:.3f} ms" for k, v in best.items()) + f"  max rel {spread:.1e}")
+        print(f"{name}: " + "  ".join(f"{k} {v.text(fmt='.3f')} ms" for k, v in best.items()) + f"  max rel {spread:.1e}")
     return rows
+
+
+def _ms(timing, fmt):
+    return f"{timing.median * 1e3:{fmt}} ({timing.min * 1e3:{fmt}}–{timing.max * 1e3:{fmt}})"
 
 
 def markdown(rows, repeat):
     lines = ["## A run's output table (`benchmarks/bench_state_table.py`)", "", machine_line(), "",
-             (f"Torque-free run of {OUTPUTS} outputs over 100 d. Wall time (ms, best of {repeat}, all alternated in one "
-              "process) of the exact flow, of the table from one `RotationState` per row (the former build), of "
+             (f"Torque-free run of {OUTPUTS} outputs over 100 d. Wall time (ms, median (min–max) of {repeat}, all "
+              "alternated in one process) of the exact flow, of the table from one `RotationState` per row (the former build), of "
               "the same columns from `state_table.table_columns` with each row's own mode/E/E0/periods (`rows`: the "
               "one-way route) and with them taken once as constants of the motion (the torque-free route), and of "
               "the whole `Scene.run` (planning included). Max rel = largest relative difference of E/E0, P_psi, "
@@ -110,9 +106,10 @@ def markdown(rows, repeat):
              "| body | flow | per row | columns, rows | columns, constants | per row / constants | Scene.run | max rel |",
              "|---|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
-        lines.append(f"| {r['case']} | {r['flow'] * 1e3:.3f} | {r['per row'] * 1e3:.1f} | {r['columns, rows'] * 1e3:.2f} "
-                     f"| {r['columns, constants'] * 1e3:.2f} | {r['per row'] / r['columns, constants']:.0f} "
-                     f"| {r['scene'] * 1e3:.2f} | {r['spread']:.1e} |")
+        lines.append(f"| {r['case']} | {_ms(r['flow'], '.3f')} | {_ms(r['per row'], '.1f')} | "
+                     f"{_ms(r['columns, rows'], '.2f')} | {_ms(r['columns, constants'], '.2f')} | "
+                     f"{r['per row'].median / r['columns, constants'].median:.0f} | {_ms(r['scene'], '.2f')} "
+                     f"| {r['spread']:.1e} |")
     return "\n".join(lines)
 
 

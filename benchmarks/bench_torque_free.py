@@ -3,7 +3,8 @@
 Run: ``python benchmarks/bench_torque_free.py`` (from the worktree root). Writes the sections
 ``bench_torque_free`` and ``bench_closed_form`` of ``docs/performance.md``;
 ``--closed-form-only`` runs and writes only the second (the regular precession of axisymmetric
-bodies against the elliptic flow at parameter 0, timed interleaved in the same process).
+bodies against the elliptic flow at parameter 0, timed interleaved in the same process);
+``--no-write`` prints only.
 
 Workload: the Hairer–Lubich–Wanner body (I = (2, 1, 2/3) → A, B, C = 2/3, 1, 2; body momentum
 (cos 1.1, 0, sin 1.1) in the original axes; identity attitude at t = 0). A "state" is one attitude
@@ -22,7 +23,6 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")  # one core; the kernels are ser
 
 import math  # noqa: E402
 import sys  # noqa: E402
-import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -33,7 +33,11 @@ sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from _heyoka_reference import propagate as reference_propagate, rotation_angle  # noqa: E402
-from _report import machine_line, write_section  # noqa: E402
+from _report import interleaved_timings, machine_line, write_section  # noqa: E402
+from peers import fastest_heyoka_integrator, heyoka_equations  # noqa: E402
+
+from spinorbit.core import make_model  # noqa: E402
+from spinorbit.core.dynamics import python_reference  # noqa: E402
 
 from spinorbit.core.free_motion.flow import (  # noqa: E402
     FL_PERIOD_HI,
@@ -55,49 +59,21 @@ HEYOKA_TOLERANCE = 2.0**-52  # heyoka's default (machine epsilon): the tightest 
 SCIPY_TOLERANCE = 2.3e-14  # DOP853 refuses rtol < 100 ε (it raises it with a warning)
 
 
-def best_of(function, repeats=5):
-    """Smallest wall time of ``repeats`` calls (s), after one warm-up call."""
-    function()
-    best = math.inf
-    for _ in range(repeats):
-        start = time.perf_counter()
-        function()
-        best = min(best, time.perf_counter() - start)
-    return best
+def timed(function, repeats=5):
+    """Wall times of ``repeats`` calls after one warm-up call (a Timing: median, min, max)."""
+    return interleaved_timings([function], repeats, warm_up=True)[0][0]
 
 
-def rhs(_, y, a, b, c):
-    qw, qx, qy, qz, mx, my, mz = y
-    wx, wy, wz = a * mx, b * my, c * mz
-    return [
-        0.5 * (-qx * wx - qy * wy - qz * wz),
-        0.5 * (qw * wx + qy * wz - qz * wy),
-        0.5 * (qw * wy - qx * wz + qz * wx),
-        0.5 * (qw * wz + qx * wy - qy * wx),
-        my * wz - mz * wy,
-        mz * wx - mx * wz,
-        mx * wy - my * wx,
-    ]
+def rate_text(count, timing):
+    """'median rate (range min–max)' in states/s."""
+    return f"{count / timing.median:.3g} ({count / timing.max:.3g}–{count / timing.min:.3g})"
 
 
 CLOSED_FORM_BODIES = {"oblate A = B (1, 1, 2)": (1.0, 1.0, 2.0), "prolate B = C (0.5, 1, 1)": (0.5, 1.0, 1.0)}
 CLOSED_FORM_REPEATS = 7
 
 
-def interleaved_best(functions, repeats=CLOSED_FORM_REPEATS):
-    """Smallest wall time (s) of each function, the calls alternated so both see the same machine load."""
-    for f in functions:
-        f()  # warm-up (compilation)
-    best = [math.inf] * len(functions)
-    for _ in range(repeats):
-        for i, f in enumerate(functions):
-            start = time.perf_counter()
-            f()
-            best[i] = min(best[i], time.perf_counter() - start)
-    return best
-
-
-def closed_form_section():
+def closed_form_section(write=True):
     """Regular precession (closed form) against the elliptic flow, same axisymmetric states, interleaved."""
     rng = np.random.default_rng(2)
     quaternions = rng.normal(size=(N_STATES, 4))
@@ -119,10 +95,11 @@ def closed_form_section():
             def run(closed, q=q, m=m, t=t):
                 return torque_free_states_many(q, m, moments, t, closed_forms=closed)
 
-            (q_closed, m_closed), (q_elliptic, m_elliptic) = run(True), run(False)
+            (q_closed, _), (q_elliptic, _) = run(True), run(False)
             error = rotation_angle(q_closed.reshape(-1, 4), q_elliptic.reshape(-1, 4)).max()
-            closed_wall, elliptic_wall = interleaved_best([lambda: run(True), lambda: run(False)])
-            rows.append((label, name, count / closed_wall, count / elliptic_wall, elliptic_wall / closed_wall, error))
+            (closed, elliptic), _ = interleaved_timings([lambda: run(True), lambda: run(False)], CLOSED_FORM_REPEATS,
+                                                        warm_up=True)
+            rows.append((label, name, count, closed, elliptic, error))
     lines = [
         "## Closed form for axisymmetric bodies (`benchmarks/bench_torque_free.py --closed-form-only`)",
         "",
@@ -131,26 +108,29 @@ def closed_form_section():
         "Regular precession in closed form (`spinorbit.core.free_motion.regular_precession`: two sin/cos and two quaternion "
         "products per output, double-double phases) against the elliptic flow at parameter 0 "
         "(`closed_forms=False`) for the same states: random attitudes and body momenta (seeded), times over "
-        "100 turns. The two are timed alternately in one process, best of "
-        f"{CLOSED_FORM_REPEATS}; the ratio is what to read. Difference: largest attitude angle between the two "
+        "100 turns. The two are timed alternately in one process, "
+        f"{CLOSED_FORM_REPEATS} times each: median rate (min–max range), ratio of the medians (of the minima "
+        "in brackets); the ratio is what to read. Difference: largest attitude angle between the two "
         "kernels' outputs (both are exact; `tests/test_regular_precession.py` holds each to a 40-digit reference).",
         "",
         "| body | workload | closed form (states/s) | elliptic (states/s) | elliptic / closed time | difference (rad) |",
         "|---|---|---:|---:|---:|---:|",
     ]
-    for label, name, closed_rate, elliptic_rate, ratio, error in rows:
-        lines.append(f"| {label} | {name} | {closed_rate:.3g} | {elliptic_rate:.3g} | {ratio:.2f} | {error:.1e} |")
+    for label, name, count, closed, elliptic, error in rows:
+        lines.append(f"| {label} | {name} | {rate_text(count, closed)} | {rate_text(count, elliptic)} | "
+                     f"{elliptic.median / closed.median:.2f} ({elliptic.min / closed.min:.2f}) | {error:.1e} |")
     markdown = "\n".join(lines)
     print(markdown)
-    write_section("bench_closed_form", markdown)
+    if write:
+        write_section("bench_closed_form", markdown)
     return rows
 
 
 def main():
+    write = "--no-write" not in sys.argv[1:]
     if "--closed-form-only" in sys.argv[1:]:
-        closed_form_section()
+        closed_form_section(write)
         return
-    import heyoka as hy
     from scipy.integrate import solve_ivp
 
     flow, _, _, _ = flow_constants(IDENTITY, MOMENTUM, *MOMENTS)
@@ -163,61 +143,60 @@ def main():
     # exact solution, one state → many times
     q, m = torque_free_states(IDENTITY, MOMENTUM, *MOMENTS, times)
     error = rotation_angle(q_ref, q).max()
-    wall = best_of(lambda: torque_free_states(IDENTITY, MOMENTUM, *MOMENTS, times))
-    rows.append(("spinorbit exact, 1 state × 1000 times", N_TIMES / wall, error))
+    rows.append(("spinorbit exact, 1 state × 1000 times", N_TIMES,
+                 timed(lambda: torque_free_states(IDENTITY, MOMENTUM, *MOMENTS, times)), error))
 
     # exact solution, many states → many times (small random rotations of the HLW state)
     rng = np.random.default_rng(1)
     quaternions = rng.normal(size=(N_STATES, 4))
     quaternions /= np.linalg.norm(quaternions, axis=1, keepdims=True)
     momenta = MOMENTUM + 1e-3 * rng.normal(size=(N_STATES, 3))
-    wall = best_of(lambda: torque_free_states_many(quaternions, momenta, MOMENTS, times), repeats=3)
-    rows.append((f"spinorbit exact, {N_STATES} states × 1000 times", N_STATES * N_TIMES / wall, error))
+    rows.append((f"spinorbit exact, {N_STATES} states × 1000 times", N_STATES * N_TIMES,
+                 timed(lambda: torque_free_states_many(quaternions, momenta, MOMENTS, times), repeats=3), error))
     # many states at one time each (setup-dominated: the double-double AGM per state)
     one_time = np.array([0.5 * span])
     many = 50 * N_STATES
     quaternions_many = np.repeat(quaternions, 50, axis=0)
     momenta_many = np.repeat(momenta, 50, axis=0)
-    wall = best_of(lambda: torque_free_states_many(quaternions_many, momenta_many, MOMENTS, one_time), repeats=3)
-    rows.append((f"spinorbit exact, {many} states × 1 time", many / wall, math.nan))
+    rows.append((f"spinorbit exact, {many} states × 1 time", many,
+                 timed(lambda: torque_free_states_many(quaternions_many, momenta_many, MOMENTS, one_time), repeats=3),
+                 math.nan))
 
-    # heyoka, double precision, Taylor, same equations; compiled once, reused for every state
-    ta = hy.taylor_adaptive(
-        [(v, e) for v, e in _heyoka_equations(hy)],
-        np.concatenate((IDENTITY, MOMENTUM)),
-        pars=1.0 / np.array(MOMENTS),
-        tol=HEYOKA_TOLERANCE,
-        compact_mode=False,
-    )
+    # heyoka, double precision, Taylor, the package's equations in peers' formulation, its faster mode;
+    # compiled once, reused for every state
+    y0 = np.concatenate((IDENTITY, MOMENTUM / np.array(MOMENTS)))
+    equations, _ = heyoka_equations(MOMENTS, [], 0.0)
+    ta, compact_mode, _ = fastest_heyoka_integrator(equations, y0, 0.0, span, HEYOKA_TOLERANCE)
     grid = np.concatenate(([0.0], times))
 
     def run_heyoka():
         out = None
         for _ in range(N_STATES_HEYOKA):
             ta.time = 0.0
-            ta.state[:] = np.concatenate((IDENTITY, MOMENTUM))
+            ta.state[:] = y0
             out = ta.propagate_grid(grid)[-1]
         return out
 
     out = run_heyoka()
     error = rotation_angle(q_ref, out[1:, :4]).max()
-    wall = best_of(run_heyoka, repeats=3) / N_STATES_HEYOKA
-    rows.append((f"heyoka double, tol {HEYOKA_TOLERANCE:.1e}, 1 state × 1000 times", N_TIMES / wall, error))
+    mode = "compact" if compact_mode else "non-compact"
+    rows.append((f"heyoka double ({mode}), tol {HEYOKA_TOLERANCE:.1e}, 1 state × 1000 times",
+                 N_TIMES * N_STATES_HEYOKA, timed(run_heyoka, repeats=3), error))
 
-    # scipy DOP853, dense output on the same grid
-    y0 = np.concatenate((IDENTITY, MOMENTUM))
-    inverse = tuple(1.0 / np.array(MOMENTS))
+    # scipy DOP853 on the package's right-hand side in plain Python, dense output on the same grid
+    python_rhs = python_reference.make_rhs(make_model(MOMENTS))
 
     def run_scipy():
-        return solve_ivp(rhs, (0.0, span), y0, method="DOP853", t_eval=times, rtol=SCIPY_TOLERANCE,
-                         atol=SCIPY_TOLERANCE, args=inverse)
+        return solve_ivp(python_rhs, (0.0, span), y0, method="DOP853", t_eval=times, rtol=SCIPY_TOLERANCE,
+                         atol=SCIPY_TOLERANCE)
 
     sol = run_scipy()
     error = rotation_angle(q_ref, sol.y[:4].T).max()
-    wall = best_of(run_scipy, repeats=1)
-    rows.append((f"scipy DOP853, rtol=atol={SCIPY_TOLERANCE:.1e}, 1 state × 1000 times", N_TIMES / wall, error))
+    rows.append((f"scipy DOP853 (pure-Python RHS), rtol=atol={SCIPY_TOLERANCE:.1e}, 1 state × 1000 times",
+                 N_TIMES, timed(run_scipy, repeats=3), error))
 
-    exact_rate = rows[1][1]
+    rates = [count / timing.median for _, count, timing, _ in rows]
+    exact_rate = rates[1]
     lines = [
         "## Torque-free propagation (`benchmarks/bench_torque_free.py`)",
         "",
@@ -225,16 +204,17 @@ def main():
         "",
         f"Hairer–Lubich–Wanner body, {N_TIMES} output times over {SPAN_PERIODS:.0f} polhode periods "
         f"({span:.0f} time units) per state; a *state* is one attitude quaternion + body momentum at "
-        "one time. Error: largest attitude error on the grid against heyoka long double (tol 1e-19).",
+        "one time. Error: largest attitude error on the grid against heyoka long double (tol 1e-19). "
+        "Rates: median of the repeats (wall time), their min–max range beside it.",
         "",
-        "| method | states/s | vs exact (many states) | max attitude error (rad) |",
+        "| method | states/s (range) | vs exact (many states) | max attitude error (rad) |",
         "|---|---:|---:|---:|",
     ]
-    for name, rate, err in rows:
+    for (name, count, timing, err), rate in zip(rows, rates):
         err_text = "—" if math.isnan(err) else f"{err:.1e}"
-        lines.append(f"| {name} | {rate:.3g} | {rate / exact_rate:.3g}× | {err_text} |")
+        lines.append(f"| {name} | {rate_text(count, timing)} | {rate / exact_rate:.3g}× | {err_text} |")
     verdict = "met" if exact_rate >= GOAL_STATES_PER_SECOND else "missed"
-    one_time_rate = rows[2][1]
+    one_time_rate = rates[2]
     one_time_verdict = "met" if one_time_rate >= GOAL_STATES_PER_SECOND else "missed"
     lines += [
         "",
@@ -250,23 +230,9 @@ def main():
     ]
     markdown = "\n".join(lines)
     print(markdown)
-    write_section("bench_torque_free", markdown)
-    closed_form_section()
-
-
-def _heyoka_equations(hy):
-    qw, qx, qy, qz, mx, my, mz = hy.make_vars("qw", "qx", "qy", "qz", "mx", "my", "mz")
-    a, b, c = hy.par[0], hy.par[1], hy.par[2]
-    wx, wy, wz = a * mx, b * my, c * mz
-    return [
-        (qw, 0.5 * (-qx * wx - qy * wy - qz * wz)),
-        (qx, 0.5 * (qw * wx + qy * wz - qz * wy)),
-        (qy, 0.5 * (qw * wy - qx * wz + qz * wx)),
-        (qz, 0.5 * (qw * wz + qx * wy - qy * wx)),
-        (mx, my * wz - mz * wy),
-        (my, mz * wx - mx * wz),
-        (mz, mx * wy - my * wx),
-    ]
+    if write:
+        write_section("bench_torque_free", markdown)
+    closed_form_section(write)
 
 
 if __name__ == "__main__":

@@ -6,7 +6,8 @@ integrates the scene once and returns the states at ``scene.t_out``. The benchma
 callable. Adding a method (e.g. the canonical-element equations or a splitting scheme) is adding one
 entry to :data:`METHODS`.
 
-- ``spinorbit-dop853``: :func:`spinorbit.core.integrators.quaternion.integrate_quaternion`.
+- ``spinorbit-dop853``: :func:`spinorbit.core.integrate_quaternion` (the package's stable entry points
+  are imported from :mod:`spinorbit.core`, so the benchmarks survive moves inside it).
 - ``spinorbit DOP853, tabulated perturbers``: the same integrator with each Keplerian perturber
   replaced by cubic Hermite samples of its orbit, dense enough for 1e-15 relative position error
   (:func:`tabulated_model`): how an ephemeris-driven run looks, and it takes the Kepler solve (80 % of
@@ -20,16 +21,17 @@ entry to :data:`METHODS`.
   (paper eq. 11) with the same DOP853 tableau; same state layout in and out.
 - ``spinorbit Taylor (numba)``: :func:`spinorbit.core.integrators.taylor.integrate_taylor`, the adaptive
   Taylor method on the same equations (tolerance = its tol, heyoka's order and step rule).
-- ``scipy DOP853, pure-Python RHS``: ``solve_ivp(method="DOP853")`` with a right-hand side written in
-  plain Python/numpy (:func:`python_rhs`: Kepler solve by Newton, MacCullagh torque), the baseline the
-  issue's ≥100× goal names; scene (a) only and two tolerances (≈1–3 s per run).
+- ``scipy DOP853, pure-Python RHS``: ``solve_ivp(method="DOP853")`` with the package's right-hand side
+  transcribed to plain Python/numpy (:mod:`spinorbit.core.dynamics.python_reference`, held equal to the
+  compiled one by ``tests/test_python_reference.py``), the baseline the ≥100× goal names; scene (a)
+  only and two tolerances (≈1–3 s per run).
 - ``scipy-DOP853``: ``scipy.integrate.solve_ivp(method="DOP853")`` with the Python RHS
   :func:`spinorbit.core.dynamics.equations.scipy_rhs` (which calls the same compiled RHS).
-- ``heyoka``: heyoka's Taylor integrator on the same equations, rebuilt as heyoka expressions:
-  degree-2 (MacCullagh) torque N = 3μ/R⁵ r × (I r) of point masses; an elliptic perturber's position
-  from ``hy.kepE`` of the time; a hyperbolic one (no hyperbolic Kepler solver in heyoka) from the
-  two-body ODE of its relative position appended to the system. q is not renormalised (heyoka has no
-  step hook for it); the body-frame position divides by |q|² as spinorbit's RHS does.
+- ``heyoka``: heyoka's Taylor integrator on the same physics in the formulation cheapest for heyoka
+  (:func:`heyoka_equations`: degree-2 torque of point masses, no |q|² normalisation, constants
+  folded), in its compact mode or not, whichever is faster on the scene at that tolerance
+  (:func:`fastest_heyoka_integrator`; recorded in the info as ``compact_mode``). q is not
+  renormalised (heyoka has no step hook for it); the outputs are.
 """
 
 from __future__ import annotations
@@ -41,9 +43,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from spinorbit.core.dynamics import python_reference
 from spinorbit.core.dynamics.equations import scipy_rhs
-from spinorbit.core.integrators.quaternion import default_atol, integrate_quaternion
-from spinorbit.core.model.perturbers import kepler_state
+from spinorbit.core import integrate_elements, integrate_quaternion, integrate_splitting, integrate_taylor
+from spinorbit.core import make_model, sampled_source
+from spinorbit.core.integrators.quaternion import default_atol
+from spinorbit.core.model.perturbers import K_P, K_Q, kepler_state
 
 
 @dataclass
@@ -84,9 +89,6 @@ def tabulated_model(scene, rtol=TABULATION_RTOL):
     angular rate on the orbit, at pericentre; the bound is rough, so a factor 2 of margin is kept):
     h = 0.5 (384 rtol)^(1/4) / ω_max.
     """
-    from spinorbit.core.dynamics.equations import make_model
-    from spinorbit.core.model.perturbers import sampled_source
-
     t_lo = min(scene.t0, float(np.min(scene.t_out)))
     t_hi = max(scene.t0, float(np.max(scene.t_out)))
     sources = []
@@ -120,8 +122,6 @@ def prepare_spinorbit_tabulated(scene, tol):
 
 def prepare_splitting(scene, steps_per_rotation, scheme):
     """Fixed-step splitting with ``steps_per_rotation`` steps per rotation of the scene."""
-    from spinorbit.core.integrators.splitting import integrate_splitting
-
     span = abs(float(scene.t_out[-1]) - scene.t0)
     step = span / (scene.rotations * steps_per_rotation)
 
@@ -138,8 +138,8 @@ def splitting_method(scheme, label, color, marker):
                   SPLITTING_STEPS_PER_ROTATION, color, marker)
 
 
-#: Sweep of the splitting methods: steps per rotation (a rotation = the scene's spin period). 4 is
-#: already coarse (errors 1e-4 … 1e-2 rad); beyond 256 rounding dominates (≈ 1e-11 rad in scene a).
+#: Sweep of the splitting methods: steps per rotation (a rotation = the scene's spin period), from
+#: coarse to where rounding dominates.
 SPLITTING_STEPS_PER_ROTATION = (4, 8, 16, 32, 64, 128, 256)
 
 
@@ -156,72 +156,20 @@ def _prepare_call(integrate, scene, **kwargs):
 
 
 def prepare_spinorbit_elements(scene, tol):
-    from spinorbit.core.integrators.elements import integrate_elements
-
     return _prepare_call(integrate_elements, scene, rtol=tol)
 
 
 # --------------------------------------------------------------------------- Taylor
 
 def prepare_spinorbit_taylor(scene, tol):
-    from spinorbit.core.integrators.taylor import integrate_taylor
-
     return _prepare_call(integrate_taylor, scene, tol=tol)
 
 
 # --------------------------------------------------------------------------- scipy
 
-def python_rhs(scene):
-    """``fun(t, y)`` in plain Python/numpy for elliptic Kepler perturbers: no numba, no spinorbit kernel.
-
-    Kepler's equation by Newton's method from E = M + e sin M (|ΔE| < 1e-15), position
-    a(cos E − e) P + a√(1−e²) sin E Q, body frame r_b = M(q)ᵀ r / |q|², MacCullagh torque
-    N = 3μ/R⁵ r_b × (I r_b), then the quaternion kinematics and Euler's equations.
-    """
-    import math
-
-    moments = np.array(scene.moments, dtype=float)
-    A, B, C = moments
-    orbits = []
-    for p in scene.perturbers:
-        if p.e >= 1.0:
-            raise ValueError("python_rhs: elliptic perturbers only (scene a)")
-        params = p.source().params
-        n = math.sqrt((p.mu_orbit or p.mu) / p.a**3)
-        orbits.append((p.mu, p.a, p.e, math.sqrt(1 - p.e**2), p.mean_anomaly, p.epoch, n, params[11:14].copy(),
-                       params[14:17].copy()))
-
-    def fun(t, y):
-        q0, q1, q2, q3, wx, wy, wz = y
-        nx = ny = nz = 0.0
-        inv = 1.0 / (q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
-        for mu, a, e, root, m0, epoch, n, P, Q in orbits:
-            m = m0 + n * (t - epoch)
-            E = m + e * math.sin(m)
-            for _ in range(50):
-                dE = (E - e * math.sin(E) - m) / (1.0 - e * math.cos(E))
-                E -= dE
-                if abs(dE) < 1e-15:
-                    break
-            r = a * (math.cos(E) - e) * P + a * root * math.sin(E) * Q
-            rx, ry, rz = r
-            bx = inv * ((q0 * q0 + q1 * q1 - q2 * q2 - q3 * q3) * rx + 2 * (q1 * q2 + q0 * q3) * ry + 2 * (q1 * q3 - q0 * q2) * rz)
-            by = inv * (2 * (q1 * q2 - q0 * q3) * rx + (q0 * q0 - q1 * q1 + q2 * q2 - q3 * q3) * ry + 2 * (q2 * q3 + q0 * q1) * rz)
-            bz = inv * (2 * (q1 * q3 + q0 * q2) * rx + 2 * (q2 * q3 - q0 * q1) * ry + (q0 * q0 - q1 * q1 - q2 * q2 + q3 * q3) * rz)
-            k = 3.0 * mu * (bx * bx + by * by + bz * bz) ** -2.5
-            nx += k * (C - B) * by * bz
-            ny += k * (A - C) * bz * bx
-            nz += k * (B - A) * bx * by
-        return np.array([0.5 * (-q1 * wx - q2 * wy - q3 * wz), 0.5 * (q0 * wx + q2 * wz - q3 * wy),
-                         0.5 * (q0 * wy - q1 * wz + q3 * wx), 0.5 * (q0 * wz + q1 * wy - q2 * wx),
-                         ((B - C) * wy * wz + nx) / A, ((C - A) * wz * wx + ny) / B, ((A - B) * wx * wy + nz) / C])
-
-    return fun
-
-
 def prepare_scipy_python(scene, tol):
-    """scipy DOP853 with :func:`python_rhs` (the issue's ≥100× baseline)."""
-    return prepare_scipy(scene, tol, fun=python_rhs(scene))
+    """scipy DOP853 with the pure-Python transcription of the package's RHS (the ≥100× baseline)."""
+    return prepare_scipy(scene, tol, fun=python_reference.make_rhs(scene.model))
 
 
 def prepare_scipy(scene, tol, fun=None):
@@ -243,60 +191,134 @@ def prepare_scipy(scene, tol, fun=None):
 
 # --------------------------------------------------------------------------- heyoka
 
-def heyoka_system(scene, fp_type=float):
-    """heyoka (lhs, rhs) pairs and the initial state for the scene's quaternion equations."""
+def heyoka_equations(moments, perturbers, t0):
+    """The scene's equations of motion as heyoka expressions: the one place they are written for heyoka.
+
+    The physics of :func:`spinorbit.core.dynamics.equations.rhs` with degree-2 point-mass torques, in
+    the formulation cheapest for heyoka's Taylor decomposition:
+
+    - r_b = M(q)ᵀ r (no division by |q|²: heyoka does not leave the unit sphere at stages, only by
+      its tolerance over the run, and the division costs it extra series in every step);
+    - the torque of a point mass μ, N = (3μ/R⁵) r_b × (I r_b), as (3μ/R⁵)((C − B) y z, (A − C) z x,
+      (B − A) x y) with the constant factors folded, and Euler's equations divided through by the
+      moments, ω̇x = (B − C)/A ωy ωz + Nx/A (cyclic);
+    - an elliptic perturber's position from ``hy.kepE`` of the time; a hyperbolic one (heyoka has no
+      hyperbolic Kepler solver) from the two-body ODE of its relative position, appended to the
+      system and started from the exact Kepler state at t0.
+
+    Parameters
+    ----------
+    moments : (A, B, C)
+        Principal moments (the scene's units).
+    perturbers : sequence of ``scenes.KeplerPerturber``
+    t0 : float
+        Start time (the hyperbolic perturbers' initial states are taken there).
+
+    Returns
+    -------
+    eqs : list of (variable, expression)
+        State (q0, q1, q2, q3, ωx, ωy, ωz) first, then 6 variables per hyperbolic perturber.
+    extra_state : list of float
+        Initial values of the appended variables.
+    """
     import heyoka as hy
 
     q0, q1, q2, q3, wx, wy, wz = hy.make_vars("q0", "q1", "q2", "q3", "wx", "wy", "wz")
-    A, B, C = (float(m) for m in scene.moments)
-    nx = ny = nz = hy.expression(0.0)
-    extra_eqs = []
-    extra_state = []
-    inv = 1.0 / (q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
-    for k, p in enumerate(scene.perturbers):
+    A, B, C = (float(m) for m in moments)
+    torque_over_moment = [hy.expression(0.0)] * 3  # N/A, N/B, N/C
+    extra_eqs, extra_state = [], []
+    for k, p in enumerate(perturbers):
         params = p.source().params
         if p.e < 1.0:
             n = float(np.sqrt((p.mu_orbit or p.mu) / p.a**3))
             E = hy.kepE(p.e, p.mean_anomaly + n * (hy.time - p.epoch))
             px = p.a * (hy.cos(E) - p.e)
             py = p.a * float(np.sqrt(1 - p.e**2)) * hy.sin(E)
-            P, Q = params[11:14], params[14:17]
+            P, Q = params[K_P:K_P + 3], params[K_Q:K_Q + 3]
             rx, ry, rz = (float(P[i]) * px + float(Q[i]) * py for i in range(3))
         else:
-            # Two-body ODE of the relative position, started from the exact Kepler state at t0.
             x, y, z, vx, vy, vz = hy.make_vars(*(f"{s}{k}" for s in ("x", "y", "z", "vx", "vy", "vz")))
             mu_o = p.mu_orbit or p.mu
-            r3 = (x * x + y * y + z * z) ** 1.5
-            extra_eqs += [(x, vx), (y, vy), (z, vz), (vx, -mu_o * x / r3), (vy, -mu_o * y / r3), (vz, -mu_o * z / r3)]
-            extra_state += list(kepler_state(scene.t0, params))
+            inv_r3 = (x * x + y * y + z * z) ** -1.5
+            extra_eqs += [(x, vx), (y, vy), (z, vz), (vx, -mu_o * x * inv_r3), (vy, -mu_o * y * inv_r3),
+                          (vz, -mu_o * z * inv_r3)]
+            extra_state += list(kepler_state(t0, params))
             rx, ry, rz = x, y, z
-        # r_body = M(q)ᵀ r / |q|²
-        bx = inv * ((q0 * q0 + q1 * q1 - q2 * q2 - q3 * q3) * rx + 2 * (q1 * q2 + q0 * q3) * ry + 2 * (q1 * q3 - q0 * q2) * rz)
-        by = inv * (2 * (q1 * q2 - q0 * q3) * rx + (q0 * q0 - q1 * q1 + q2 * q2 - q3 * q3) * ry + 2 * (q2 * q3 + q0 * q1) * rz)
-        bz = inv * (2 * (q1 * q3 + q0 * q2) * rx + 2 * (q2 * q3 - q0 * q1) * ry + (q0 * q0 - q1 * q1 - q2 * q2 + q3 * q3) * rz)
-        rr = bx * bx + by * by + bz * bz
-        kfac = 3.0 * p.mu * rr ** (-2.5)
-        nx = nx + kfac * (by * (C * bz) - bz * (B * by))
-        ny = ny + kfac * (bz * (A * bx) - bx * (C * bz))
-        nz = nz + kfac * (bx * (B * by) - by * (A * bx))
+        # r_body = M(q)ᵀ r
+        bx = (q0 * q0 + q1 * q1 - q2 * q2 - q3 * q3) * rx + 2 * (q1 * q2 + q0 * q3) * ry + 2 * (q1 * q3 - q0 * q2) * rz
+        by = 2 * (q1 * q2 - q0 * q3) * rx + (q0 * q0 - q1 * q1 + q2 * q2 - q3 * q3) * ry + 2 * (q2 * q3 + q0 * q1) * rz
+        bz = 2 * (q1 * q3 + q0 * q2) * rx + 2 * (q2 * q3 - q0 * q1) * ry + (q0 * q0 - q1 * q1 - q2 * q2 + q3 * q3) * rz
+        inv_r5 = (bx * bx + by * by + bz * bz) ** -2.5
+        coefficients = (3.0 * p.mu * (C - B) / A, 3.0 * p.mu * (A - C) / B, 3.0 * p.mu * (B - A) / C)
+        products = (by * bz, bz * bx, bx * by)
+        torque_over_moment = [acc + c * prod * inv_r5 for acc, c, prod in zip(torque_over_moment, coefficients, products)]
+    nx, ny, nz = torque_over_moment
     eqs = [
         (q0, 0.5 * (-q1 * wx - q2 * wy - q3 * wz)),
         (q1, 0.5 * (q0 * wx + q2 * wz - q3 * wy)),
         (q2, 0.5 * (q0 * wy - q1 * wz + q3 * wx)),
         (q3, 0.5 * (q0 * wz + q1 * wy - q2 * wx)),
-        (wx, ((B - C) * wy * wz + nx) / A),
-        (wy, ((C - A) * wz * wx + ny) / B),
-        (wz, ((A - B) * wx * wy + nz) / C),
+        (wx, (B - C) / A * (wy * wz) + nx),
+        (wy, (C - A) / B * (wz * wx) + ny),
+        (wz, (A - B) / C * (wx * wy) + nz),
     ] + extra_eqs
-    state = list(np.asarray(scene.y0, float)) + extra_state
-    return eqs, np.array(state, dtype=fp_type)
+    return eqs, extra_state
 
 
-def make_heyoka_integrator(scene, tol, fp_type=float, compact_mode=False):
+def heyoka_system(scene, fp_type=float):
+    """heyoka (lhs, rhs) pairs and the initial state of the scene (:func:`heyoka_equations`)."""
+    eqs, extra_state = heyoka_equations(scene.moments, scene.perturbers, scene.t0)
+    return eqs, np.array(list(np.asarray(scene.y0, float)) + extra_state, dtype=fp_type)
+
+
+#: Steps over which the two heyoka modes are timed against each other: the cost per step is what the
+#: mode changes (same order, same steps), and 200 steps of the scenes take milliseconds.
+MODE_TRIAL_STEPS = 200
+MODE_TRIAL_REPEATS = 5
+_COMPACT_MODE_CHOICE = {}
+
+
+def fastest_heyoka_integrator(eqs, state, t0, t_end, tol):
+    """(integrator at t0, compact_mode, {mode: median trial CPU}): heyoka in its faster mode here.
+
+    Both modes are built and timed interleaved over MODE_TRIAL_STEPS steps from t0 towards t_end
+    (the cost per step is what the mode changes); cached per (equations, state, t0, t_end, tol), and a
+    copy of the faster integrator is returned, so each is compiled once.
+    """
+    import copy
+
+    import heyoka as hy
+
+    key = (str(eqs), np.asarray(state, float).tobytes(), t0, t_end, tol)
+    if key not in _COMPACT_MODE_CHOICE:
+        trials = {mode: hy.taylor_adaptive(eqs, state, tol=tol, compact_mode=mode, time=t0) for mode in (False, True)}
+        cpu = {mode: [] for mode in trials}
+        for _ in range(MODE_TRIAL_REPEATS):
+            for mode, ta in trials.items():
+                ta.state[:] = state
+                ta.time = t0
+                t = time.process_time()
+                ta.propagate_until(float(t_end), max_steps=MODE_TRIAL_STEPS)
+                cpu[mode].append(time.process_time() - t)
+        medians = {mode: float(np.median(v)) for mode, v in cpu.items()}
+        faster = min(medians, key=medians.get)
+        _COMPACT_MODE_CHOICE[key] = (trials[faster], faster, medians)
+    ta, faster, medians = _COMPACT_MODE_CHOICE[key]
+    ta = copy.deepcopy(ta)
+    ta.state[:] = state
+    ta.time = t0
+    return ta, faster, medians
+
+
+def make_heyoka_integrator(scene, tol, fp_type=float, compact_mode=None):
+    """heyoka's integrator of the scene (at its start) and its initial state; ``compact_mode=None``:
+    the faster mode on this scene (:func:`fastest_heyoka_integrator`, double precision)."""
     import heyoka as hy
 
     eqs, state = heyoka_system(scene, fp_type)
-    kwargs = {"tol": fp_type(tol), "compact_mode": compact_mode, "time": fp_type(scene.t0)}
+    if compact_mode is None and fp_type is float:
+        return fastest_heyoka_integrator(eqs, state, scene.t0, scene.t_out[-1], tol)[0], state
+    kwargs = {"tol": fp_type(tol), "compact_mode": bool(compact_mode), "time": fp_type(scene.t0)}
     if fp_type is not float:
         kwargs["fp_type"] = fp_type
     return hy.taylor_adaptive(eqs, state, **kwargs), state
@@ -304,7 +326,8 @@ def make_heyoka_integrator(scene, tol, fp_type=float, compact_mode=False):
 
 def prepare_heyoka(scene, tol):
     t = time.perf_counter()
-    ta, state = make_heyoka_integrator(scene, tol)
+    eqs, state = heyoka_system(scene)
+    ta, compact_mode, trial_cpu = fastest_heyoka_integrator(eqs, state, scene.t0, scene.t_out[-1], tol)
     compile_s = time.perf_counter() - t
     # heyoka's grid must start at the current time: prepend t0 and drop that row.
     grid = np.concatenate([[scene.t0], np.asarray(scene.t_out, float)])
@@ -317,7 +340,7 @@ def prepare_heyoka(scene, tol):
         res[:, :4] /= np.linalg.norm(res[:, :4], axis=1)[:, None]
         return res
 
-    return run, {"prepare_s": compile_s}
+    return run, {"prepare_s": compile_s, "compact_mode": compact_mode, "mode_trial_cpu": trial_cpu}
 
 
 def reference_solution(scene):

@@ -21,8 +21,8 @@ from scipy.optimize import brentq
 from scipy.special import ellipk
 
 from spinorbit.data.asteroids import aligning_quaternion as _quat_aligning  # one implementation, in the library
-from spinorbit.core.dynamics.equations import make_model
-from spinorbit.core.model.perturbers import kepler_source
+from spinorbit.core import kepler_source, make_model
+from spinorbit.core.dynamics import python_reference
 from spinorbit.core.math.rotations import matrix_to_quat
 
 GM_SUN = 2.9591220828559115e-4  # AU³/day² (IAU nominal, k²)
@@ -71,23 +71,21 @@ class Scene:
 def sam_periods(moments, G, d):
     """(P_ψ, P_φ) of the free SAM rigid body: P_ψ = 4K(m)/(G√((a−d)(b−c))) (period of the body-frame
     angular momentum, the Andoyer l), P_φ = 2π/⟨ġ⟩ with ġ = G(2T − cL²)/(G² − L²) averaged over one
-    P_ψ by quadrature along a direct integration of Euler's equations (rtol 1e-12)."""
+    P_ψ by quadrature along a direct integration of the torque-free equations of motion (the package's,
+    :mod:`spinorbit.core.dynamics.python_reference`; rtol 1e-12)."""
     A, B, C = moments
     a, b, c = 1 / A, 1 / B, 1 / C
     m = (a - b) * (d - c) / ((a - d) * (b - c))
     p_psi = 4 * ellipk(m) / (G * math.sqrt((a - d) * (b - c)))
     L = G * math.sqrt((b - d) / (b - c))
     Lb = np.array([0.0, math.sqrt(G * G - L * L), L])
-
-    def euler(t, Lv):
-        w = Lv / np.array(moments)
-        return np.cross(Lv, w)
-
-    sol = solve_ivp(euler, (0, p_psi), Lb, method="DOP853", rtol=1e-12, atol=1e-14 * G, dense_output=True)
+    y0 = np.concatenate([[1.0, 0.0, 0.0, 0.0], Lb / np.array(moments)])
+    sol = solve_ivp(python_reference.make_rhs(make_model(moments)), (0, p_psi), y0, method="DOP853", rtol=1e-12,
+                    atol=1e-14 * np.concatenate([np.ones(4), np.full(3, G / C)]), dense_output=True)
     two_t = d * G * G
 
     def g_dot(t):
-        lz = sol.sol(t)[2]
+        lz = C * sol.sol(t)[6]
         return G * (two_t - c * lz * lz) / (G * G - lz * lz)
 
     mean, _ = quad(g_dot, 0, p_psi, limit=200, epsabs=0, epsrel=1e-12)

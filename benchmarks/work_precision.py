@@ -5,8 +5,9 @@ is adding an entry to ``peers.METHODS``) and each tolerance:
 
 - error: the largest rotation angle (rad) between the method's attitude and the reference attitude
   over the scene's output times (10 times spread over the span, the last one at the end);
-- CPU: ``time.process_time`` of one integration, best of several repeats; compilation (heyoka's
-  LLVM, numba's first call / cache load) is done beforehand and reported separately.
+- CPU: ``time.process_time`` of one integration, the median of several repeats, with their minimum
+  and maximum beside it; compilation (heyoka's LLVM, numba's first call / cache load) is done
+  beforehand and reported separately.
 
 Reference: heyoka's Taylor integrator in x86 extended precision (long double, tol = ε ≈ 1.1e-19),
 checked against spinorbit's own integrator at rtol = 1e-14 landing on the output times: two
@@ -19,7 +20,8 @@ of spinorbit's Taylor method against heyoka's (steps, order, ns per step).
 
 spinorbit's Taylor method and heyoka are also timed head to head, interleaved run by run
 (:func:`head_to_head`), so that the ratio the issue's goal is about sees the same machine load on
-both sides.
+both sides. heyoka runs in its faster mode on each scene (compact or not, ``peers.fastest_heyoka_integrator``),
+which the report names.
 
 A method's sweep over tolerances stops once one point costs more than SLOW_POINT_S of CPU (the more
 accurate points would cost more still), so that the whole run takes a few minutes.
@@ -46,17 +48,14 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 import itertools
 
-from benchmarks._report import DOCS, machine_line, write_section
-from benchmarks.peers import METHODS, prepare_spinorbit, reference_solution
+from benchmarks._report import DOCS, interleaved_timings, machine_line, write_section
+from benchmarks.peers import METHODS, MODE_TRIAL_STEPS, prepare_spinorbit, reference_solution
 from benchmarks.scenes import all_scenes
 from spinorbit.runs.atomic import atomic_path
 from spinorbit.core.integrators.elements import integrate_elements_fixed_step
 from spinorbit.core.integrators.quaternion import integrate_fixed_step
-from spinorbit.core.integrators.splitting import integrate_splitting
-from spinorbit.core.integrators.taylor import (
-    integrate_taylor,
-    integrate_taylor_fixed_step,
-)
+from spinorbit.core import integrate_quaternion, integrate_splitting, integrate_taylor, make_model
+from spinorbit.core.integrators.taylor import integrate_taylor_fixed_step
 from spinorbit.core.math.rotations import rotation_angle_between_many
 
 #: Accuracy at which methods are compared (rad).
@@ -64,9 +63,8 @@ TARGET_ERROR = 1e-10
 #: Scene (c) (10⁴ rotations) cannot reach 1e-10 rad in double precision with any method here (the
 #: phase error of ~2e5 steps accumulates), so it is also compared at this looser accuracy (rad).
 TARGET_ERROR_LONG = 1e-6
-#: Repeat a timing until this much CPU time is spent (s) or MAX_REPEATS runs are done; keep the best.
-#: 25 repeats: the millisecond runs (heyoka, Taylor) are otherwise timed within ~20 ms, and one burst of
-#: load from the other jobs on this shared machine moved single points by 50 % (measured).
+#: Repeat a timing until this much CPU time is spent (s) or MAX_REPEATS runs are done; up to 25 so
+#: that the millisecond runs (heyoka, Taylor) get enough repeats for a median through bursts of load.
 TIMING_BUDGET_S = 1.0
 MAX_REPEATS = 25
 #: Tolerances of the interleaved Taylor-vs-heyoka timing (head_to_head): brackets 1e-10 and 1e-6 rad.
@@ -82,19 +80,9 @@ def attitude_error(ys, ref):
 
 
 def time_run(run):
-    """Best-of-N process time of run() (N ≥ 1, until TIMING_BUDGET_S or MAX_REPEATS) and its result."""
-    best = math.inf
-    spent = 0.0
-    result = None
-    for _ in range(MAX_REPEATS):
-        t = time.process_time()
-        result = run()
-        dt = time.process_time() - t
-        best = min(best, dt)
-        spent += dt
-        if spent > TIMING_BUDGET_S:
-            break
-    return best, result
+    """Process times of run() (≥ 1 repeats, until TIMING_BUDGET_S or MAX_REPEATS) as a Timing, and its result."""
+    (timing,), (result,) = interleaved_timings([run], MAX_REPEATS, time.process_time, TIMING_BUDGET_S)
+    return timing, result
 
 
 def cpu_at_error(points, target=TARGET_ERROR):
@@ -141,8 +129,7 @@ def rhs_cost_ns(model, y, t0, calls=200_000):
 
 def cost_breakdown(scene, tol=1e-12):
     """Where spinorbit's time goes at one tolerance: steps, RHS calls, RHS cost with/without torque."""
-    from spinorbit.core.dynamics.equations import make_model
-    from spinorbit.core.integrators.quaternion import default_atol, integrate_quaternion
+    from spinorbit.core.integrators.quaternion import default_atol
 
     y0 = np.asarray(scene.y0, float)
     atol = default_atol(y0, tol)
@@ -151,7 +138,8 @@ def cost_breakdown(scene, tol=1e-12):
         return integrate_quaternion(y0, scene.t0, scene.t_out, scene.model, rtol=tol, atol=atol, return_stats=True)
 
     run()
-    cpu, (_, stats) = time_run(run)
+    timing, (_, stats) = time_run(run)
+    cpu = timing.median
     with_torque = rhs_cost_ns(scene.model, y0, scene.t0)
     free = rhs_cost_ns(make_model(scene.moments), y0, scene.t0)
     per_call = cpu / stats["rhs_calls"] * 1e9
@@ -222,7 +210,8 @@ def taylor_cost_line(scene, tol=1e-10):
         return integrate_taylor(scene.y0, scene.t0, scene.t_out, scene.model, tol=tol, return_stats=True)
 
     ours()
-    cpu, (_, st) = time_run(ours)
+    timing, (_, st) = time_run(ours)
+    cpu = timing.median
     ta, state = make_heyoka_integrator(scene, tol)
 
     def theirs():
@@ -230,43 +219,50 @@ def taylor_cost_line(scene, tol=1e-10):
         ta.time = scene.t0
         return ta.propagate_until(float(scene.t_out[-1]))
 
-    cpu_h, res = time_run(theirs)
+    timing_h, res = time_run(theirs)
+    cpu_h = timing_h.median
     steps_h = int(res[3])
     return (f"Taylor cost at tol = {tol:.0e}: spinorbit {st['steps']} steps ({st['steps'] / scene.rotations:.1f} per "
             f"rotation), order {st['order']}, orbit series to order {st['mean_orbit_order']:.1f} on average (summed "
             f"over perturbers), {cpu / st['steps'] * 1e9:.0f} ns per step, {cpu * 1e3:.2f} ms; heyoka "
             f"{steps_h} steps ({steps_h / scene.rotations:.1f} per rotation), order {ta.order}, "
-            f"{cpu_h / steps_h * 1e9:.0f} ns per step, {cpu_h * 1e3:.2f} ms (propagate_until, no grid).")
+            f"{cpu_h / steps_h * 1e9:.0f} ns per step, {cpu_h * 1e3:.2f} ms (propagate_until, no grid; medians, "
+            f"ms with min–max: spinorbit {timing.text()}, heyoka {timing_h.text()}).")
 
 
 def head_to_head(scene, ref, tolerances):
     """spinorbit Taylor and heyoka timed *interleaved* (ours, theirs, ours, …) at each tolerance.
 
     The sweep times one method after the other, seconds apart; on a shared machine the load changes
-    in between (a --quick run once put the Taylor/heyoka ratio at 1.20 where the full run had 0.97).
-    Alternating the two and keeping each one's best makes both see the same load. Repeats: up to
-    MAX_REPEATS pairs or TIMING_BUDGET_S of CPU per method. Returns two lists of (error, cpu).
+    in between. Alternating the two makes both see the same load. Repeats: up to MAX_REPEATS pairs or
+    2 × TIMING_BUDGET_S of CPU. Returns two lists of (error, Timing).
     """
     from benchmarks.peers import prepare_heyoka, prepare_spinorbit_taylor
 
     ours_pts, theirs_pts = [], []
     for tol in tolerances:
         runs = [prepare_spinorbit_taylor(scene, tol)[0], prepare_heyoka(scene, tol)[0]]
-        best = [math.inf, math.inf]
-        spent = 0.0
-        outputs = [None, None]
-        for _ in range(MAX_REPEATS):
-            for i, run in enumerate(runs):
-                t = time.process_time()
-                outputs[i] = run()
-                dt = time.process_time() - t
-                best[i] = min(best[i], dt)
-                spent += dt
-            if spent > 2 * TIMING_BUDGET_S:
-                break
-        ours_pts.append((attitude_error(outputs[0], ref), best[0]))
-        theirs_pts.append((attitude_error(outputs[1], ref), best[1]))
+        (ours, theirs), outputs = interleaved_timings(runs, MAX_REPEATS, time.process_time, 2 * TIMING_BUDGET_S)
+        ours_pts.append((attitude_error(outputs[0], ref), ours))
+        theirs_pts.append((attitude_error(outputs[1], ref), theirs))
     return ours_pts, theirs_pts
+
+
+def _at_error(points, statistic, target):
+    """cpu_at_error of (error, Timing) points by one statistic of the timings ('median', 'min', 'max')."""
+    return cpu_at_error([(e, getattr(t, statistic)) for e, t in points], target)
+
+
+def heyoka_mode_line(infos):
+    """One sentence naming heyoka's mode at each tolerance and the trial that chose it."""
+    parts = []
+    for tol, info in sorted(infos.items(), reverse=True):
+        trial = info["mode_trial_cpu"]
+        parts.append(f"{tol:.0e}: {'compact' if info['compact_mode'] else 'non-compact'} "
+                     f"({trial[False] * 1e3:.2f} ms non-compact, {trial[True] * 1e3:.2f} ms compact)")
+    return (f"heyoka mode, the faster of the two by the median of interleaved {MODE_TRIAL_STEPS}-step trials, "
+            "per tolerance: "
+            + "; ".join(parts) + ".")
 
 
 def main(argv=None):
@@ -291,8 +287,9 @@ def main(argv=None):
     md = [machine_line(), ""]
     md.append(
         "Attitude error = largest rotation angle between the computed and the reference attitude over "
-        "10 output times spanning the run (rad). CPU = `time.process_time` of one integration, best of "
-        f"up to {MAX_REPEATS} repeats, one core, compilation excluded (reported separately). Reference: "
+        "10 output times spanning the run (rad). CPU = `time.process_time` of one integration, median of "
+        f"up to {MAX_REPEATS} repeats (their min–max in the tables), one core, compilation excluded "
+        "(reported separately); ratios and interpolations use the medians. Reference: "
         "heyoka Taylor in 80-bit extended precision at tol = 1.1e-19. spinorbit's tolerance is its rtol "
         "(atol = rtol × component scale); heyoka's is its tol; scipy gets the same rtol/atol as spinorbit."
     )
@@ -306,11 +303,12 @@ def main(argv=None):
         print(f"   reference {ref_s:.1f} s; spinorbit rtol=1e-14 vs reference: {agreement:.2e} rad", flush=True)
         results = {}
         compile_times = {}
+        heyoka_modes = {}
         methods = [m for m in METHODS if scene.name in m.scenes]
         for method in methods:
             tols = method.tolerances
             if method.name.startswith("scipy"):
-                # scipy's Python-level loop costs ~20 µs per RHS call: limit it on the long scenes.
+                # scipy's Python-level loop is slow: fewer tolerances on the long scenes.
                 if args.quick:
                     tols = tols[:1]
                 elif scene.name == "c":
@@ -319,11 +317,13 @@ def main(argv=None):
             for tol in tols:
                 run, info = method.prepare(scene, tol)
                 compile_times.setdefault(method.name, []).append(info["prepare_s"])
-                cpu, ys = time_run(run)
+                if "compact_mode" in info:
+                    heyoka_modes[tol] = info
+                timing, ys = time_run(run)
                 err = attitude_error(ys, ref)
-                pts.append((tol, err, cpu))
-                print(f"   {method.name:28s} tol={tol:.0e}  err={err:.2e} rad  cpu={cpu * 1e3:9.2f} ms", flush=True)
-                if cpu > SLOW_POINT_S:
+                pts.append((tol, err, timing))
+                print(f"   {method.name:28s} tol={tol:.0e}  err={err:.2e} rad  cpu={timing.text()} ms", flush=True)
+                if timing.median > SLOW_POINT_S:
                     break
             results[method.name] = pts
 
@@ -331,12 +331,13 @@ def main(argv=None):
         fig, ax = plt.subplots(figsize=(6.4, 4.6))
         for method in methods:
             pts = results[method.name]
-            ax.loglog([p[2] for p in pts], [p[1] for p in pts], marker=method.marker, color=method.color,
+            ax.loglog([p[2].median for p in pts], [p[1] for p in pts], marker=method.marker, color=method.color,
                       label=method.name)
-            for tol, err, cpu in pts:
-                ax.annotate(f"{tol:.0e}", (cpu, err), fontsize=6, textcoords="offset points", xytext=(3, 3))
+            for tol, err, timing in pts:
+                ax.annotate(f"{tol:.0e}", (timing.median, err), fontsize=6, textcoords="offset points",
+                            xytext=(3, 3))
         ax.axhline(TARGET_ERROR_LONG if scene.name == "c" else TARGET_ERROR, color="0.7", lw=0.8, ls="--")
-        ax.set_xlabel("CPU time per integration (s)")
+        ax.set_xlabel("CPU time per integration (s, median)")
         ax.set_ylabel("max attitude error (rad)")
         ax.set_title(f"({scene.name}) {scene.title}", fontsize=9)
         ax.grid(True, which="both", lw=0.3)
@@ -359,19 +360,23 @@ def main(argv=None):
         md.append("")
         md.append(f"![work-precision ({scene.name})](img/work_precision_{scene.name}.png)")
         md.append("")
-        md.append("| method | tolerance | max attitude error (rad) | CPU (ms) |")
-        md.append("|---|---|---|---|")
+        md.append("| method | tolerance | max attitude error (rad) | CPU median (ms) | min–max (ms) | runs |")
+        md.append("|---|---|---|---|---|---|")
         for method in methods:
-            for tol, err, cpu in results[method.name]:
-                md.append(f"| {method.name} | {tol:.0e} | {err:.2e} | {cpu * 1e3:.2f} |")
+            for tol, err, t in results[method.name]:
+                md.append(f"| {method.name} | {tol:.0e} | {err:.2e} | {t.median * 1e3:.2f} | "
+                          f"{t.min * 1e3:.2f}–{t.max * 1e3:.2f} | {len(t.samples)} |")
         md.append("")
         comp = ", ".join(f"{k}: {np.median(v):.2f} s" for k, v in compile_times.items())
         md.append(f"One-off preparation per tolerance (median; excluded from CPU): {comp}.")
         md.append("")
+        if heyoka_modes:
+            md.append(heyoka_mode_line(heyoka_modes))
+            md.append("")
         target = TARGET_ERROR_LONG if scene.name == "c" else TARGET_ERROR
         at = {}
         for method in methods:
-            at[method.name] = cpu_at_error([(e, c) for _, e, c in results[method.name]], target)
+            at[method.name] = cpu_at_error([(e, t.median) for _, e, t in results[method.name]], target)
         by_name = dict(at)
         taylor = by_name["spinorbit Taylor (numba)"]
         pure = by_name.get("scipy DOP853, pure-Python RHS", (None, "not run"))
@@ -393,7 +398,7 @@ def main(argv=None):
         ratios = [f"{a} / {b} = {x[0] / y[0]:{fmt}}" for a, x, b, y, fmt in pairs if x[0] and y[0]]
         md.append("")
         md.append(f"**Ratios at {target:.0e} rad:** " + ("; ".join(ratios) if ratios else "not measurable (see above)") + ".")
-        same_tol = [(tol, c_sp / c_so) for (tol, _, c_sp) in results["scipy DOP853 (Python RHS)"]
+        same_tol = [(tol, c_sp.median / c_so.median) for (tol, _, c_sp) in results["scipy DOP853 (Python RHS)"]
                     for (tol2, _, c_so) in results["spinorbit DOP853 (numba)"] if tol == tol2]
         if same_tol:
             md.append("")
@@ -405,16 +410,23 @@ def main(argv=None):
         md.append(breakdown)
         md.append("")
         h2h_ours, h2h_theirs = head_to_head(scene, ref, HEAD_TO_HEAD_TOLERANCES)
-        h2h = [cpu_at_error(h2h_ours, target), cpu_at_error(h2h_theirs, target)]
+        h2h = {stat: (_at_error(h2h_ours, stat, target), _at_error(h2h_theirs, stat, target))
+               for stat in ("median", "min", "max")}
         h2h_text = (f"**Head to head** (spinorbit Taylor and heyoka timed interleaved at tol "
-                    f"{', '.join(f'{t:.0e}' for t in HEAD_TO_HEAD_TOLERANCES)}; (error rad, CPU ms) ours: "
-                    + ", ".join(f"({e:.1e}, {c * 1e3:.2f})" for e, c in h2h_ours) + "; heyoka: "
-                    + ", ".join(f"({e:.1e}, {c * 1e3:.2f})" for e, c in h2h_theirs) + "): ")
-        if h2h[0][0] and h2h[1][0]:
-            h2h_text += (f"at {target:.0e} rad spinorbit Taylor {h2h[0][0] * 1e3:.2f} ms, heyoka "
-                         f"{h2h[1][0] * 1e3:.2f} ms, ratio **{h2h[0][0] / h2h[1][0]:.2f}**.")
+                    f"{', '.join(f'{t:.0e}' for t in HEAD_TO_HEAD_TOLERANCES)}; (error rad, median CPU ms "
+                    "[min–max]) ours: "
+                    + ", ".join(f"({e:.1e}, {t.median * 1e3:.2f} [{t.min * 1e3:.2f}–{t.max * 1e3:.2f}])"
+                                for e, t in h2h_ours) + "; heyoka: "
+                    + ", ".join(f"({e:.1e}, {t.median * 1e3:.2f} [{t.min * 1e3:.2f}–{t.max * 1e3:.2f}])"
+                                for e, t in h2h_theirs) + "): ")
+        (ours_med, _), (theirs_med, _) = h2h["median"]
+        if ours_med and theirs_med:
+            spread = [h2h[stat][0][0] / h2h[stat][1][0] for stat in ("min", "max") if h2h[stat][0][0] and h2h[stat][1][0]]
+            h2h_text += (f"at {target:.0e} rad spinorbit Taylor {ours_med * 1e3:.2f} ms, heyoka "
+                         f"{theirs_med * 1e3:.2f} ms (medians), ratio **{ours_med / theirs_med:.2f}**")
+            h2h_text += (f" (by the minima {spread[0]:.2f}, by the maxima {spread[1]:.2f})." if len(spread) == 2 else ".")
         else:
-            h2h_text += f"ratio not measurable ({h2h[0][1]}; {h2h[1][1]})."
+            h2h_text += f"ratio not measurable ({h2h['median'][0][1]}; {h2h['median'][1][1]})."
         print("   " + h2h_text, flush=True)
         md.append(h2h_text)
         md.append("")

@@ -2,7 +2,9 @@
 
 :mod:`.equations` holds Euler's equations, the torque sum from one force function U, the energy and
 angular-momentum diagnostics, and the model-array layout; every integrator and every benchmark peer
-evaluates the dynamics through it.
+evaluates the dynamics through it. :mod:`.python_reference` is its pure-Python transcription, for the
+baselines that must not use compiled code (scipy with a plain-Python right-hand side); a test holds
+the two equal.
 """
 
 from spinorbit import old_paths

@@ -57,8 +57,6 @@ KNOWN_PRIVATE_CROSSINGS = [
     "spinorbit.core.integrators.handover: from spinorbit.core.integrators.elements import _STATUS_MESSAGES",
 ]
 KNOWN_LONG = [
-    "spinorbit.core.free_motion.flow",
-    "spinorbit.core.math.elliptic",
     "spinorbit.coupling.rebound.adapter",
     "spinorbit.scene.scene",
 ]

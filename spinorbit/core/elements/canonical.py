@@ -54,9 +54,11 @@ import math
 
 import numpy as np
 
-from spinorbit.core.jit import jit
 from spinorbit.core.elements.andoyer import node_frame
-from spinorbit.core.math.elliptic import parameter_constants, pn_constants, pn_k, ellipf_k, sncndn_k
+from spinorbit.core.jit import jit
+from spinorbit.core.math.elliptic_integrals import ellipf_k, pn_constants, pn_k
+from spinorbit.core.math.elliptic_periods import parameter_constants
+from spinorbit.core.math.jacobi import sncndn_k
 
 # Body-frame flips: the working frame is the body frame turned by π about one principal axis.
 FLIP_NONE, FLIP_A, FLIP_B, FLIP_C = 0, 1, 2, 3

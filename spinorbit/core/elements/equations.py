@@ -43,7 +43,7 @@ import math
 
 import numpy as np
 
-from spinorbit.core.jit import jit
+from spinorbit.core.dynamics.equations import force_function_and_torque_xyz
 from spinorbit.core.elements.canonical import (
     FLIP_B,
     FLIP_NONE,
@@ -59,9 +59,10 @@ from spinorbit.core.elements.canonical import (
     state_from_elements,
     state_from_elements_motion,
 )
-from spinorbit.core.math.elliptic import MK_K_HI, MK_K_LO, NK_COMPLETE
-from spinorbit.core.dynamics.equations import force_function_and_torque_xyz
 from spinorbit.core.elements.jacobian import andoyer_jacobian_motion
+from spinorbit.core.jit import jit
+from spinorbit.core.math.elliptic_integrals import NK_COMPLETE
+from spinorbit.core.math.elliptic_periods import MK_K_HI, MK_K_LO
 from spinorbit.core.math.rotations import matrix_to_quat
 
 TWO_PI = 2.0 * math.pi

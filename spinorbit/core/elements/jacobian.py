@@ -54,7 +54,6 @@ import math
 
 import numpy as np
 
-from spinorbit.core.jit import jit
 from spinorbit.core.elements.canonical import (
     MO_ARG_PER_S,
     MO_D,
@@ -70,7 +69,9 @@ from spinorbit.core.elements.canonical import (
     elliptic_constants,
     motion_from_elements,
 )
-from spinorbit.core.math.elliptic import (
+from spinorbit.core.jit import jit
+from spinorbit.core.math.carlson import rd, rf, rj
+from spinorbit.core.math.elliptic_periods import (
     MK_HEAD,
     MK_K_HI,
     MK_K_LO,
@@ -78,15 +79,13 @@ from spinorbit.core.math.elliptic import (
     MK_MUC,
     MK_SQRT_MUC,
     MK_TAIL,
-    rd,
-    rf,
-    rj,
+    reduce_by_period,
 )
 
-# The reduced-argument kernels of the elliptic module are used directly so that sn, cn, dn and the
-# associate integrals below come from one reduction u = 2jK + r (|r| ≤ K), not from two that could
-# disagree by one half period at the boundary.
-from spinorbit.core.math.elliptic import reduce_by_period, sncndn_reduced
+# The reduced-argument kernel is used directly so that sn, cn, dn and the associate integrals below
+# come from one reduction u = 2jK + r (|r| ≤ K), not from two that could disagree by one half period
+# at the boundary.
+from spinorbit.core.math.jacobi import sncndn_reduced
 
 # Row / column indices of the Jacobian.
 ROW_L, ROW_G, ROW_H, ROW_SMALL_L, ROW_SMALL_G, ROW_SMALL_H = range(6)

@@ -65,6 +65,9 @@ FLIP_NONE, FLIP_A, FLIP_B, FLIP_C = 0, 1, 2, 3
 
 MODE_SAM, MODE_LAM, MODE_UNIFORM = 1, -1, 0
 
+# Offsets of the canonical elements (S, Z, H, s, z, h) in a (6,) state array (paper eq. 4 order).
+EL_S, EL_Z, EL_H, EL_SMALL_S, EL_SMALL_Z, EL_SMALL_H = range(6)
+
 # Indices into the "motion constants" tuple (one torque-free motion; see motion_constants).
 (
     MO_MODE,  # MODE_SAM (separatrix included) / MODE_LAM / MODE_UNIFORM
@@ -452,7 +455,7 @@ def state_from_elements(elements, flip, ic):
     ``elements`` = (S, Z, H, s, z, h) of the working frame with S ≥ 0; ``flip`` turns the result back
     into the body frame. Returns (attitude (3, 3), momentum (3,)).
     """
-    mo = motion_from_elements(elements[0], elements[1], ic)
+    mo = motion_from_elements(elements[EL_S], elements[EL_Z], ic)
     mk, pk = elliptic_constants(mo)
     return state_from_elements_motion(elements, flip, mo, mk, pk)
 
@@ -464,7 +467,8 @@ def state_from_elements_motion(elements, flip, mo, mk, pk):
     For callers that need them anyway (the element integrator's RHS also builds the Jacobian from
     them): computing them costs about as much as the rest of the backward map.
     """
-    big_z, big_h, s, z, h = elements[1], elements[2], elements[3], elements[4], elements[5]
+    big_z, big_h, s = elements[EL_Z], elements[EL_H], elements[EL_SMALL_S]
+    z, h = elements[EL_SMALL_Z], elements[EL_SMALL_H]
     arg = s * mo[MO_ARG_PER_S]
     mx, my, mz, sin_l, cos_l = body_from_argument(arg, mo, mk)
     g = z + mo[MO_G_PER_S] * s + mo[MO_PN_COEFF] * pn_k(arg, mk, pk)

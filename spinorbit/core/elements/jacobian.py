@@ -55,6 +55,9 @@ import math
 import numpy as np
 
 from spinorbit.core.elements.canonical import (
+    EL_S,
+    EL_SMALL_S,
+    EL_Z,
     MO_ARG_PER_S,
     MO_D,
     MO_G,
@@ -89,7 +92,7 @@ from spinorbit.core.math.jacobi import sncndn_reduced
 
 # Row / column indices of the Jacobian.
 ROW_L, ROW_G, ROW_H, ROW_SMALL_L, ROW_SMALL_G, ROW_SMALL_H = range(6)
-COL_S, COL_Z, COL_H, COL_SMALL_S, COL_SMALL_Z, COL_SMALL_H = range(6)
+COL_S, COL_Z, COL_H, COL_SMALL_S, COL_SMALL_Z, COL_SMALL_H = range(6)  # the EL_* order of the elements
 
 ANDOYER_NAMES = ("L", "G", "H", "l", "g", "h")
 ELEMENT_NAMES = ("S", "Z", "H", "s", "z", "h")
@@ -310,7 +313,7 @@ def andoyer_jacobian(elements, ic):
     evaluated in (u, m), the LAM parts in (v, μ) = (√m u, 1/m) (module docstring). The 23 zero
     components are exactly zero.
     """
-    big_s, big_z = elements[0], elements[1]
+    big_s, big_z = elements[EL_S], elements[EL_Z]
     mo = motion_from_elements(abs(big_s), big_z, ic)
     mk, _ = elliptic_constants(mo)
     return andoyer_jacobian_motion(elements, ic, mo, mk)
@@ -320,7 +323,7 @@ def andoyer_jacobian(elements, ic):
 def andoyer_jacobian_motion(elements, ic, mo, mk):
     """:func:`andoyer_jacobian` with the motion constants of (|S|, Z) and their parameter constants
     (``motion_from_elements``, ``elliptic_constants``) supplied by a caller that has them already."""
-    big_s, big_z, s = elements[0], elements[1], elements[3]
+    big_s, big_z, s = elements[EL_S], elements[EL_Z], elements[EL_SMALL_S]
     sense = 1.0
     if big_s < 0.0:
         sense = -1.0

@@ -269,20 +269,21 @@ def flow_constants(quaternion, momentum, big_a, big_b, big_c):
         elliptic kernels.
     """
     ic = inertia_constants(big_a, big_b, big_c)
-    mo, flip = motion_from_momentum(momentum[0], momentum[1], momentum[2], ic)
+    m0x, m0y, m0z = momentum[0], momentum[1], momentum[2]
+    mo, flip = motion_from_momentum(m0x, m0y, m0z, ic)
     flow = np.zeros(FLOW_SIZE)
     mode = int(mo[MO_MODE])
     flow[FL_MODE] = mode
     flow[FL_FLIP] = flip
     fx, fy, fz = flip_signs(flip)
     flow[FL_FLIP_X], flow[FL_FLIP_Y], flow[FL_FLIP_Z] = fx, fy, fz
-    flow[FL_M0_X], flow[FL_M0_Y], flow[FL_M0_Z] = momentum[0], momentum[1], momentum[2]
+    flow[FL_M0_X], flow[FL_M0_Y], flow[FL_M0_Z] = m0x, m0y, m0z
     if mode == MODE_UNIFORM:
         # Permanent rotation: ω = I⁻¹M ∥ M, q(t) = q0 ⊗ (cos(|ω|t/2), k sin(|ω|t/2)), k = ω/|ω|.
         # |ω|/2 in double-double, so the half angle does not drift either.
-        oxh, oxl = dd_div(momentum[0], 0.0, big_a, 0.0)
-        oyh, oyl = dd_div(momentum[1], 0.0, big_b, 0.0)
-        ozh, ozl = dd_div(momentum[2], 0.0, big_c, 0.0)
+        oxh, oxl = dd_div(m0x, 0.0, big_a, 0.0)
+        oyh, oyl = dd_div(m0y, 0.0, big_b, 0.0)
+        ozh, ozl = dd_div(m0z, 0.0, big_c, 0.0)
         xxh, xxl = dd_mul(oxh, oxl, oxh, oxl)
         yyh, yyl = dd_mul(oyh, oyl, oyh, oyl)
         zzh, zzl = dd_mul(ozh, ozl, ozh, ozl)
@@ -296,7 +297,7 @@ def flow_constants(quaternion, momentum, big_a, big_b, big_c):
         flow[FL_QN_Y], flow[FL_QN_Z] = quaternion[2], quaternion[3]
         mk, pk = elliptic_constants(mo)  # unused by a uniform rotation; returned for one signature
         return flow, mo, mk, pk
-    mx, my, mz = fx * momentum[0], fy * momentum[1], fz * momentum[2]
+    mx, my, mz = fx * m0x, fy * m0y, fz * m0z
     (nuh, nul, perh, perl, cgh, cgl, wh, wl, kah, kal, param, param_c, char_n, ok) = (
         phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c)
     )

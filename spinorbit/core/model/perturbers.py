@@ -215,11 +215,9 @@ def kepler_perifocal(t, a, e, m0, t0, n, root):
     return abs_a * (e - ch), abs_a * root * sh, -abs_a * sh * rate, abs_a * root * ch * rate
 
 
-# inline="always": functions on the RHS hot path that receive arrays are inlined at numba-IR level,
-# so no array crosses a call boundary (each crossing costs reference-count updates, which measured
-# ~120 ns per RHS call, 30× the arithmetic of a torque-free RHS).
 # inline="always": functions on the RHS hot path are inlined at numba-IR level so that the model array
-# does not cross a call boundary per evaluation (each crossing costs atomic reference-count updates).
+# does not cross a call boundary per evaluation (each crossing costs atomic reference-count updates,
+# more than the arithmetic of a torque-free RHS).
 @jit(inline="always")
 def kepler_position_xyz(t, arr, off):
     """Inertial position (x, y, z) of the KIND_KEPLER parameter row ``arr[off:off+PARAM_SIZE]``.

@@ -347,6 +347,22 @@ def kappa_pn(kah, kal, rh, rl, s, c, d, pk):
     double-double: for nearly symmetric bodies (A ≈ B) κ is large while pn(r) ≈ r, and κ · pn(r)
     rounded as a whole would cost ε·κ·r rad. R_C form (n ≤ −1): pn(r) is far from r (≈ r/(1 − n)),
     so splitting r off would cancel; κ · pn(r) is formed from the whole value.
+
+    Parameters
+    ----------
+    kah, kal : float
+        κ = (a − c) G / ν (``FL_KAPPA_*``) as a double-double, rad per unit of pn.
+    rh, rl : float
+        The reduced argument r (dimensionless, |r| ≤ K) as a double-double.
+    s, c, d : float
+        sn, cn, dn of r (:func:`spinorbit.core.math.jacobi.sncndn_reduced`).
+    pk : tuple
+        :func:`spinorbit.core.math.elliptic_integrals.pn_constants` of the motion.
+
+    Returns
+    -------
+    hi, lo : float
+        κ · pn(r) (rad), the r-dependent part of g in paper eqs. (8) and (12).
     """
     if pk[NK_METHOD] == METHOD_LARGE_NEGATIVE:
         return dd_mul(kah, kal, pi_principal(s, c * c, d * d, rh, pk), 0.0)

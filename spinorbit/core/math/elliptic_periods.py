@@ -127,13 +127,37 @@ def ellipk(m, mc):
 
 @jit
 def reduce_by_period(u, head, tail):
-    """j = rint(u / P), r = u − j P with P = head + tail; j*head exact, u − j*head exact (Sterbenz)."""
+    """j = rint(u / P), r = u − j P with P = head + tail; j*head exact, u − j*head exact (Sterbenz).
+
+    Parameters
+    ----------
+    u : float
+        Argument of the elliptic functions (dimensionless).
+    head, tail : float
+        The half period P = 2K(μ)/√m split as ``mk[MK_HEAD]``, ``mk[MK_TAIL]`` (24-bit head).
+
+    Returns
+    -------
+    j, r : float
+        The whole number of half periods and the remainder, |r| ≤ P/2 up to rounding.
+    """
     j = np.rint(u / (head + tail))
     return j, (u - j * head) - j * tail
 
 
 @jit
 def reduce_by_pi(phi):
-    """j = rint(φ/π), r = φ − jπ with π in three parts (Cody–Waite; note §6.1)."""
+    """j = rint(φ/π), r = φ − jπ with π in three parts (Cody–Waite; note §6.1).
+
+    Parameters
+    ----------
+    phi : float
+        Amplitude φ of F or Π (rad).
+
+    Returns
+    -------
+    j, r : float
+        Whole turns of π and the remainder r ∈ [−π/2, π/2] (rad), exact for |j| < 2^29.
+    """
     j = np.rint(phi / PI_HI)
     return j, ((phi - j * PI_HEAD) - j * PI_MID) - j * PI_LO

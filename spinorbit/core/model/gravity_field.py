@@ -91,7 +91,18 @@ def unnormalize_stokes(c_bar, s_bar):
 
 
 def normalize_stokes(c, s):
-    """Inverse of :func:`unnormalize_stokes`: unnormalised → fully normalised."""
+    """Inverse of :func:`unnormalize_stokes`: unnormalised → fully normalised (Kaula 1966).
+
+    Parameters
+    ----------
+    c, s : array_like, shape (n+1, n+1)
+        Unnormalised coefficients C_nm, S_nm indexed [degree, order] (dimensionless).
+
+    Returns
+    -------
+    c_bar, s_bar : ndarray
+        Fully normalised coefficients (4π convention), same shape.
+    """
     return _rescale_stokes(c, s, normalised=False)
 
 

@@ -19,6 +19,14 @@ RDJ_STOP = (0.25 * EPSILON) ** (-1.0 / 6.0)  # ≈ 513, for R_D and R_J
 
 
 @jit
+def _duplicate(x, y, z):
+    """One step of the duplication theorem (DLMF 19.26.18): (√x, √y, √z, λ, x′, y′, z′), w′ = (w + λ)/4."""
+    sx, sy, sz = math.sqrt(x), math.sqrt(y), math.sqrt(z)
+    lam = sx * sy + sx * sz + sy * sz
+    return sx, sy, sz, lam, 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam)
+
+
+@jit
 def rf(x, y, z):
     """Carlson's R_F(x, y, z) = ½∫₀^∞ dt / √((t+x)(t+y)(t+z)) (DLMF 19.16.1).
 
@@ -29,11 +37,7 @@ def rf(x, y, z):
     q = RF_STOP * max(abs(a0 - x), abs(a0 - y), abs(a0 - z))
     a = a0
     while q >= abs(a):
-        sx, sy, sz = math.sqrt(x), math.sqrt(y), math.sqrt(z)
-        lam = sx * sy + sx * sz + sy * sz
-        x = 0.25 * (x + lam)
-        y = 0.25 * (y + lam)
-        z = 0.25 * (z + lam)
+        _, _, _, _, x, y, z = _duplicate(x, y, z)
         a = (x + y + z) / 3.0
         q *= 0.25
     dx = (a - x) / a
@@ -96,13 +100,10 @@ def rd(x, y, z):
     power4 = 1.0
     total = 0.0
     while q >= abs(a):
-        sx, sy, sz = math.sqrt(x), math.sqrt(y), math.sqrt(z)
-        lam = sx * sy + sx * sz + sy * sz
+        _, _, sz, lam, x_next, y_next, z_next = _duplicate(x, y, z)
         total += power4 / (sz * (z + lam))
         power4 *= 0.25
-        x = 0.25 * (x + lam)
-        y = 0.25 * (y + lam)
-        z = 0.25 * (z + lam)
+        x, y, z = x_next, y_next, z_next
         a = (x + y + 3.0 * z) / 5.0
         q *= 0.25
     dx = (a - x) / a
@@ -132,16 +133,12 @@ def rj(x, y, z, p):
     power4 = 1.0
     total = 0.0
     while q >= abs(a):
-        sx, sy, sz = math.sqrt(x), math.sqrt(y), math.sqrt(z)
-        lam = sx * sy + sx * sz + sy * sz
+        sx, sy, sz, lam, x, y, z = _duplicate(x, y, z)
         alpha = p * (sx + sy + sz) + sx * sy * sz
         alpha *= alpha
         beta = p * (p + lam) * (p + lam)
         total += power4 * rc(alpha, beta)
         power4 *= 0.25
-        x = 0.25 * (x + lam)
-        y = 0.25 * (y + lam)
-        z = 0.25 * (z + lam)
         p = 0.25 * (p + lam)
         a = (x + y + z + 2.0 * p) / 5.0
         q *= 0.25

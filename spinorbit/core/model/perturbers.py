@@ -318,15 +318,8 @@ def hermite_state(t, times, xv):
     if not (times[0] <= t <= times[n - 1]):
         out[:] = np.nan
         return out
-    # Binary search for the interval [times[i], times[i+1]] containing t.
-    lo = 0
-    hi = n - 1
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if times[mid] <= t:
-            lo = mid
-        else:
-            hi = mid
+    lo = find_interval(t, times, 0, n)  # [times[lo], times[lo + 1]] contains t
+    hi = lo + 1
     h = times[hi] - times[lo]
     s = (t - times[lo]) / h
     s2 = s * s

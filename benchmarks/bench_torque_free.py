@@ -39,13 +39,8 @@ from peers import fastest_heyoka_integrator, heyoka_equations  # noqa: E402
 from spinorbit.core import make_model  # noqa: E402
 from spinorbit.core.dynamics import python_reference  # noqa: E402
 
-from spinorbit.core.free_motion.flow import (  # noqa: E402
-    FL_PERIOD_HI,
-    FL_RATE_HI,
-    flow_constants,
-    torque_free_states,
-    torque_free_states_many,
-)
+from spinorbit.core.free_motion.flow import torque_free_states, torque_free_states_many  # noqa: E402
+from spinorbit.core.free_motion.flow_constants import FL_PERIOD_HI, FL_RATE_HI, flow_constants  # noqa: E402
 
 GOAL_STATES_PER_SECOND = 2.0e6  # goal for the exact solution on one core
 MOMENTS = (2.0 / 3.0, 1.0, 2.0)

@@ -118,68 +118,62 @@ def _result(shape, *outputs):
 
 
 # --------------------------------------------------------------------------------------------------
-# Compiled loops: the per-m (and per-n) constants are recomputed only when the parameter changes,
-# so a scalar m broadcast against many u costs one AGM.
+# One compiled loop for every function: the per-m (and per-n) constants are recomputed only when the
+# parameter changes, so a scalar m broadcast against many u costs one AGM.
 # --------------------------------------------------------------------------------------------------
 
+# Which kernel the loop applies (the branch is the same for every element of one call).
+KIND_SNCNDN, KIND_AM, KIND_K, KIND_F, KIND_PI, KIND_PN = range(6)
+
 
 @jit
-def _ellipj_loop(u, m, mc, sn, cn, dn):
+def _characteristic_constants(kind, n, m, mc):
+    """The constants of n for Π or pn; the other kinds take none (a tuple of the same type)."""
+    if kind == KIND_PI:
+        return _kernels.characteristic_constants(n, m, mc)
+    if kind == KIND_PN:
+        return _kernels.pn_constants(n, m, mc)
+    return (0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+@jit
+def _evaluate_loop(kind, x, n, m, mc, out0, out1, out2):
+    """out0[i] (and out1, out2 for sn, cn, dn) = the kernel ``kind`` at (x[i], n[i] | m[i], mc[i])."""
     mk = _kernels.parameter_constants(m[0], mc[0])
-    for i in range(u.size):
-        if i > 0 and not (m[i] == m[i - 1] and mc[i] == mc[i - 1]):
-            mk = _kernels.parameter_constants(m[i], mc[i])
-        sn[i], cn[i], dn[i] = _kernels.sncndn_k(u[i], mk)
+    nk = _characteristic_constants(kind, n[0], m[0], mc[0])
+    for i in range(x.size):
+        if i > 0:
+            same_m = m[i] == m[i - 1] and mc[i] == mc[i - 1]
+            if not same_m:
+                mk = _kernels.parameter_constants(m[i], mc[i])
+            if not (same_m and n[i] == n[i - 1]):
+                nk = _characteristic_constants(kind, n[i], m[i], mc[i])
+        if kind == KIND_SNCNDN:
+            out0[i], out1[i], out2[i] = _kernels.sncndn_k(x[i], mk)
+        elif kind == KIND_AM:
+            out0[i] = _kernels.am_k(x[i], mk)
+        elif kind == KIND_K:
+            out0[i] = _kernels.ellipk(m[i], mc[i])
+        elif kind == KIND_F:
+            out0[i] = _kernels.ellipf_k(x[i], mk)
+        elif kind == KIND_PI:
+            out0[i] = _kernels.ellippi_k(x[i], mk, nk)
+        else:
+            out0[i] = _kernels.pn_k(x[i], mk, nk)
 
 
-@jit
-def _am_loop(u, m, mc, out):
-    mk = _kernels.parameter_constants(m[0], mc[0])
-    for i in range(u.size):
-        if i > 0 and not (m[i] == m[i - 1] and mc[i] == mc[i - 1]):
-            mk = _kernels.parameter_constants(m[i], mc[i])
-        out[i] = _kernels.am_k(u[i], mk)
-
-
-@jit
-def _ellipk_loop(m, mc, out):
-    for i in range(m.size):
-        out[i] = _kernels.ellipk(m[i], mc[i])
-
-
-@jit
-def _ellipf_loop(phi, m, mc, out):
-    mk = _kernels.parameter_constants(m[0], mc[0])
-    for i in range(phi.size):
-        if i > 0 and not (m[i] == m[i - 1] and mc[i] == mc[i - 1]):
-            mk = _kernels.parameter_constants(m[i], mc[i])
-        out[i] = _kernels.ellipf_k(phi[i], mk)
-
-
-@jit
-def _ellippi_loop(n, phi, m, mc, out):
-    mk = _kernels.parameter_constants(m[0], mc[0])
-    nk = _kernels.characteristic_constants(n[0], m[0], mc[0])
-    for i in range(phi.size):
-        same_m = m[i] == m[i - 1] and mc[i] == mc[i - 1]
-        if i > 0 and not same_m:
-            mk = _kernels.parameter_constants(m[i], mc[i])
-        if i > 0 and not (same_m and n[i] == n[i - 1]):
-            nk = _kernels.characteristic_constants(n[i], m[i], mc[i])
-        out[i] = _kernels.ellippi_k(phi[i], mk, nk)
-
-
-@jit
-def _pn_loop(u, n, m, mc, out):
-    mk = _kernels.parameter_constants(m[0], mc[0])
-    pk = _kernels.pn_constants(n[0], m[0], mc[0])
-    for i in range(u.size):
-        same_m = m[i] == m[i - 1] and mc[i] == mc[i - 1]
-        if i > 0 and not same_m:
-            mk = _kernels.parameter_constants(m[i], mc[i])
-        if i > 0 and not (same_m and n[i] == n[i - 1]):
-            pk = _kernels.pn_constants(n[i], m[i], mc[i])
-        out[i] = _kernels.pn_k(u[i], mk, pk)
+def _evaluate(function_name, kind, arrays, n_outputs=1):
+    """Broadcast the validated ``arrays`` (x, and n where the kernel has one, then m, mc), run the loop."""
+    shape, flat = _broadcast(function_name, **arrays)
+    m, mc = flat["m"], flat["mc"]
+    x = flat.get("u", flat.get("phi", m))
+    n = flat.get("n", m)  # kernels without a characteristic never read it
+    outputs = [np.empty(m.size) for _ in range(n_outputs)]
+    if m.size:
+        out0 = outputs[0]
+        _evaluate_loop(kind, x, n, m, mc, out0, outputs[1] if n_outputs > 1 else out0,
+                       outputs[2] if n_outputs > 2 else out0)
+    return _result(shape, *outputs)
 
 
 # --------------------------------------------------------------------------------------------------
@@ -218,11 +212,7 @@ def ellipj(u, m, *, mc=None):
     """
     u = _as_float_array("u", u)
     m, mc = _parameter("ellipj", m, mc)
-    shape, flat = _broadcast("ellipj", u=u, m=m, mc=mc)
-    sn, cn, dn = (np.empty(flat["u"].size) for _ in range(3))
-    if sn.size:
-        _ellipj_loop(flat["u"], flat["m"], flat["mc"], sn, cn, dn)
-    return _result(shape, sn, cn, dn)
+    return _evaluate("ellipj", KIND_SNCNDN, dict(u=u, m=m, mc=mc), n_outputs=3)
 
 
 def am(u, m, *, mc=None):
@@ -250,11 +240,7 @@ def am(u, m, *, mc=None):
     """
     u = _as_float_array("u", u)
     m, mc = _parameter("am", m, mc)
-    shape, flat = _broadcast("am", u=u, m=m, mc=mc)
-    out = np.empty(flat["u"].size)
-    if out.size:
-        _am_loop(flat["u"], flat["m"], flat["mc"], out)
-    return _result(shape, out)
+    return _evaluate("am", KIND_AM, dict(u=u, m=m, mc=mc))
 
 
 def ellipk(m, *, mc=None):
@@ -280,11 +266,7 @@ def ellipk(m, *, mc=None):
         If m < 0, mc is inconsistent with m, or the shapes do not broadcast.
     """
     m, mc = _parameter("ellipk", m, mc)
-    shape, flat = _broadcast("ellipk", m=m, mc=mc)
-    out = np.empty(flat["m"].size)
-    if out.size:
-        _ellipk_loop(flat["m"], flat["mc"], out)
-    return _result(shape, out)
+    return _evaluate("ellipk", KIND_K, dict(m=m, mc=mc))
 
 
 def ellipf(phi, m, *, mc=None):
@@ -312,11 +294,7 @@ def ellipf(phi, m, *, mc=None):
     """
     phi = _as_float_array("phi", phi)
     m, mc = _parameter("ellipf", m, mc)
-    shape, flat = _broadcast("ellipf", phi=phi, m=m, mc=mc)
-    out = np.empty(flat["phi"].size)
-    if out.size:
-        _ellipf_loop(flat["phi"], flat["m"], flat["mc"], out)
-    return _result(shape, out)
+    return _evaluate("ellipf", KIND_F, dict(phi=phi, m=m, mc=mc))
 
 
 def ellippi(n, phi, m, *, mc=None):
@@ -351,11 +329,7 @@ def ellippi(n, phi, m, *, mc=None):
     phi = _as_float_array("phi", phi)
     m, mc = _parameter("ellippi", m, mc)
     n = _characteristic("ellippi", n, m)
-    shape, flat = _broadcast("ellippi", n=n, phi=phi, m=m, mc=mc)
-    out = np.empty(flat["phi"].size)
-    if out.size:
-        _ellippi_loop(flat["n"], flat["phi"], flat["m"], flat["mc"], out)
-    return _result(shape, out)
+    return _evaluate("ellippi", KIND_PI, dict(n=n, phi=phi, m=m, mc=mc))
 
 
 def pn(u, n, m, *, mc=None):
@@ -390,8 +364,4 @@ def pn(u, n, m, *, mc=None):
     u = _as_float_array("u", u)
     m, mc = _parameter("pn", m, mc)
     n = _characteristic("pn", n, m)
-    shape, flat = _broadcast("pn", u=u, n=n, m=m, mc=mc)
-    out = np.empty(flat["u"].size)
-    if out.size:
-        _pn_loop(flat["u"], flat["n"], flat["m"], flat["mc"], out)
-    return _result(shape, out)
+    return _evaluate("pn", KIND_PN, dict(u=u, n=n, m=m, mc=mc))

@@ -14,7 +14,7 @@ from __future__ import annotations
 import mpmath as mp
 import numpy as np
 
-from spinorbit.core.free_motion import flow as tf
+from spinorbit.core.free_motion import flow_constants as tf
 from spinorbit.core.elements.canonical import (
     FLIP_A,
     FLIP_B,

@@ -56,8 +56,6 @@ KNOWN_PRIVATE_CROSSINGS = [
     "spinorbit.core.integrators.handover: from spinorbit.core.integrators.elements import _STATUS_MESSAGES",
 ]
 KNOWN_LONG = [
-    "spinorbit.core.free_motion.flow",
-    "spinorbit.core.math.elliptic",
 ]
 
 

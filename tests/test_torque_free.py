@@ -15,16 +15,8 @@ import pytest
 from _heyoka_reference import propagate, rotation_angle
 from _mp_reference import exact_states
 from spinorbit.core.elements.canonical import MODE_LAM, MODE_SAM, MODE_UNIFORM
-from spinorbit.core.free_motion.flow import (
-    FL_MODE,
-    FL_PERIOD_HI,
-    FL_RATE_HI,
-    complete_k_pi_dd,
-    flow_constants,
-    torque_free_attitudes,
-    torque_free_states,
-    torque_free_states_many,
-)
+from spinorbit.core.free_motion.flow import torque_free_attitudes, torque_free_states, torque_free_states_many
+from spinorbit.core.free_motion.flow_constants import FL_MODE, FL_PERIOD_HI, FL_RATE_HI, complete_k_pi_dd, flow_constants
 from spinorbit.core.math.rotations import quat_to_attitude
 
 # Goal of the long-span work: attitude error after 1e4 rotation periods (rad). Measured against

@@ -54,14 +54,19 @@ import math
 
 import numpy as np
 
-from spinorbit.core.jit import jit
 from spinorbit.core.elements.andoyer import node_frame
-from spinorbit.core.math.elliptic import parameter_constants, pn_constants, pn_k, ellipf_k, sncndn_k
+from spinorbit.core.jit import jit
+from spinorbit.core.math.elliptic_integrals import ellipf_k, pn_constants, pn_k
+from spinorbit.core.math.elliptic_periods import parameter_constants
+from spinorbit.core.math.jacobi import sncndn_k
 
 # Body-frame flips: the working frame is the body frame turned by π about one principal axis.
 FLIP_NONE, FLIP_A, FLIP_B, FLIP_C = 0, 1, 2, 3
 
 MODE_SAM, MODE_LAM, MODE_UNIFORM = 1, -1, 0
+
+# Offsets of the canonical elements (S, Z, H, s, z, h) in a (6,) state array (paper eq. 4 order).
+EL_S, EL_Z, EL_H, EL_SMALL_S, EL_SMALL_Z, EL_SMALL_H = range(6)
 
 # Indices into the "motion constants" tuple (one torque-free motion; see motion_constants).
 (
@@ -208,18 +213,10 @@ def motion_from_elements(big_s, big_z, ic):
     a_d = max(a * (big_z - big_s) * (big_z + big_s) / z2, 0.0)
     d = a * big_s * big_s / z2
     d_c = max(d - c, 0.0)
-    # Symmetric bodies: one d for all three differences: the smaller gap is kept as formed above and the other two are
-    # taken from it, (d − c, b − d) = ((a − c) − (a − d), (a − d) − (a − b)) or (a − d, b − d) =
-    # ((a − c) − (d − c), (b − c) − (d − c)), so that d − c + a − d = a − c and m, 1 − m (μ, 1 − μ)
-    # are built from the same numbers (each rounds no worse than the one-ulp sensitivity 2ε d of S).
-    # Formed independently they belong to d's an ulp apart: for A = B (m = 0) b − fl(d) against the
-    # accurate a − d gave 1 − m = 0.9987 at a − d = 7e-14 d, hence sn² + cn² = 1 + 4e-9, an attitude
-    # 4e-9 from orthonormal and |M| = G (1 + 2e-9); for a body of A = 614, B = C = 615, |M|² missed G²
-    # by ε d/(a − c) = 1.7e-13 (both found by tests/stress/test_fuzz.py).
-    # Triaxial bodies keep b − d = b − fl(d): near the separatrix (d → b) that is the difference 1 − m
-    # rests on, and deriving it from the other gaps measured worse there (the hand-over's separatrix
-    # case at 1 − m ≈ 1e-3 went from < 7× to 10.6× DOP853's error, tests/stress/test_handover.py);
-    # for them |M| = G to ε d/(a − c) is harmless, attitude_from_parts normalising by the computed |M|.
+    # Symmetric bodies: the smaller gap is kept as formed above and the other two are taken from it,
+    # so that m and 1 − m (μ, 1 − μ) belong to one d; formed independently they belong to d's an ulp
+    # apart and the motion leaves sn² + cn² = 1. Triaxial bodies keep b − d = b − fl(d), the
+    # difference 1 − m rests on near the separatrix. Why, with the cases: docs/theory.md, item 7.
     if a_b == 0.0 or b_c == 0.0:
         if a_d < d_c:
             d_c = max(a_c - a_d, 0.0)
@@ -438,8 +435,8 @@ def elements_from_state(attitude, momentum, ic):
     flipped = np.array([mx, my, mz])
     big_h, _, _, h, g = node_angles(working, flipped, sin_l, cos_l)
     z = g - mo[MO_G_PER_S] * s - mo[MO_PN_COEFF] * pn_k(arg, mk, pk)
-    out[0], out[1], out[2] = mo[MO_S], mo[MO_G], big_h
-    out[3], out[4], out[5] = s, reduce_angle(z), h
+    out[EL_S], out[EL_Z], out[EL_H] = mo[MO_S], mo[MO_G], big_h
+    out[EL_SMALL_S], out[EL_SMALL_Z], out[EL_SMALL_H] = s, reduce_angle(z), h
     return out, flip, mode
 
 
@@ -450,7 +447,7 @@ def state_from_elements(elements, flip, ic):
     ``elements`` = (S, Z, H, s, z, h) of the working frame with S ≥ 0; ``flip`` turns the result back
     into the body frame. Returns (attitude (3, 3), momentum (3,)).
     """
-    mo = motion_from_elements(elements[0], elements[1], ic)
+    mo = motion_from_elements(elements[EL_S], elements[EL_Z], ic)
     mk, pk = elliptic_constants(mo)
     return state_from_elements_motion(elements, flip, mo, mk, pk)
 
@@ -462,7 +459,8 @@ def state_from_elements_motion(elements, flip, mo, mk, pk):
     For callers that need them anyway (the element integrator's RHS also builds the Jacobian from
     them): computing them costs about as much as the rest of the backward map.
     """
-    big_z, big_h, s, z, h = elements[1], elements[2], elements[3], elements[4], elements[5]
+    big_z, big_h, s = elements[EL_Z], elements[EL_H], elements[EL_SMALL_S]
+    z, h = elements[EL_SMALL_Z], elements[EL_SMALL_H]
     arg = s * mo[MO_ARG_PER_S]
     mx, my, mz, sin_l, cos_l = body_from_argument(arg, mo, mk)
     g = z + mo[MO_G_PER_S] * s + mo[MO_PN_COEFF] * pn_k(arg, mk, pk)

@@ -43,8 +43,14 @@ import math
 
 import numpy as np
 
-from spinorbit.core.jit import jit
+from spinorbit.core.dynamics.equations import force_function_and_torque_xyz
 from spinorbit.core.elements.canonical import (
+    EL_H,
+    EL_S,
+    EL_SMALL_H,
+    EL_SMALL_S,
+    EL_SMALL_Z,
+    EL_Z,
     FLIP_B,
     FLIP_NONE,
     MO_ARG_PER_S,
@@ -59,9 +65,10 @@ from spinorbit.core.elements.canonical import (
     state_from_elements,
     state_from_elements_motion,
 )
-from spinorbit.core.math.elliptic import MK_K_HI, MK_K_LO, NK_COMPLETE
-from spinorbit.core.dynamics.equations import force_function_and_torque_xyz
-from spinorbit.core.elements.jacobian import andoyer_jacobian_motion
+from spinorbit.core.elements.jacobian import andoyer_jacobian_motion, canonical_gradient
+from spinorbit.core.jit import jit
+from spinorbit.core.math.elliptic_integrals import NK_COMPLETE
+from spinorbit.core.math.elliptic_periods import MK_K_HI, MK_K_LO
 from spinorbit.core.math.rotations import matrix_to_quat
 
 TWO_PI = 2.0 * math.pi
@@ -78,9 +85,9 @@ def working_elements(elements):
     (``FLIP_B``) and the working elements are (−S, Z, H, −s, z, h) (:mod:`spinorbit.core.elements.canonical`).
     """
     work = elements.copy()
-    if elements[0] < 0.0:
-        work[0] = -elements[0]
-        work[3] = -elements[3]
+    if elements[EL_S] < 0.0:
+        work[EL_S] = -elements[EL_S]
+        work[EL_SMALL_S] = -elements[EL_SMALL_S]
         return work, FLIP_B
     return work, FLIP_NONE
 
@@ -152,7 +159,7 @@ def singularity_distances(elements, attitude, momentum, ic):
     symmetric body (:func:`singularity_distances_of_motion`). A permanent rotation returns a separatrix distance of 0.
     """
     work, _ = working_elements(elements)
-    return singularity_distances_of_motion(motion_from_elements(work[0], work[1], ic), attitude, momentum, ic)
+    return singularity_distances_of_motion(motion_from_elements(work[EL_S], work[EL_Z], ic), attitude, momentum, ic)
 
 
 @jit
@@ -210,26 +217,20 @@ def elements_rhs_into(t, elements, model, frame, ic, dy):
     """
     # The motion and elliptic constants of (S, Z) once, for both the backward map and the Jacobian.
     work, flip = working_elements(elements)
-    mo = motion_from_elements(work[0], work[1], ic)
+    mo = motion_from_elements(work[EL_S], work[EL_Z], ic)
     mk, pk = elliptic_constants(mo)
     attitude, momentum = state_from_elements_motion(work, flip, mo, mk, pk)
     q = inertial_quaternion(attitude, frame)
     _, nx, ny, nz = force_function_and_torque_xyz(t, q[0], q[1], q[2], q[3], model)
     du_andoyer = andoyer_gradient_from_torque(attitude, momentum, nx, ny, nz)
-    jac = andoyer_jacobian_motion(elements, ic, mo, mk)
-    du = np.zeros(6)
-    for j in range(6):
-        acc = 0.0
-        for i in range(6):
-            acc += jac[i, j] * du_andoyer[i]
-        du[j] = acc
+    du = canonical_gradient(du_andoyer, andoyer_jacobian_motion(elements, ic, mo, mk))
     a, _b, _c, _a_b, _b_c, _a_c = ic  # inertia_constants: (a, b, c, a − b, b − c, a − c)
-    dy[0] = du[3]
-    dy[1] = du[4]
-    dy[2] = du[5]
-    dy[3] = a * elements[0] - du[0]
-    dy[4] = -du[1]
-    dy[5] = -du[2]
+    dy[EL_S] = du[EL_SMALL_S]
+    dy[EL_Z] = du[EL_SMALL_Z]
+    dy[EL_H] = du[EL_SMALL_H]
+    dy[EL_SMALL_S] = a * elements[EL_S] - du[EL_S]
+    dy[EL_SMALL_Z] = -du[EL_Z]
+    dy[EL_SMALL_H] = -du[EL_H]
     return singularity_distances_of_motion(mo, attitude, momentum, ic)
 
 
@@ -256,19 +257,19 @@ def reduce_phase(elements, ic):
     Returns the number of periods removed (0: nothing done).
     """
     work, _ = working_elements(elements)
-    mo = motion_from_elements(work[0], work[1], ic)
+    mo = motion_from_elements(work[EL_S], work[EL_Z], ic)
     if mo[MO_MODE] == MODE_UNIFORM or not (mo[MO_PARAM_C] > 0.0):
         return 0.0
     mk, pk = elliptic_constants(mo)
     four_k = 4.0 * (mk[MK_K_HI] + mk[MK_K_LO])
-    arg = work[3] * mo[MO_ARG_PER_S]
+    arg = work[EL_SMALL_S] * mo[MO_ARG_PER_S]
     periods = np.rint(arg / four_k)
     if periods == 0.0:
         return 0.0
     period_s = four_k / mo[MO_ARG_PER_S]
     advance_g = mo[MO_G_PER_S] * period_s + mo[MO_PN_COEFF] * 4.0 * pk[NK_COMPLETE]
-    shifted = work[3] - periods * period_s
-    elements[3] = -shifted if elements[0] < 0.0 else shifted
-    z = elements[4] + periods * advance_g
-    elements[4] = z - TWO_PI * np.rint(z / TWO_PI)  # z is an angle: keep it in [−π, π] as well
+    shifted = work[EL_SMALL_S] - periods * period_s
+    elements[EL_SMALL_S] = -shifted if elements[EL_S] < 0.0 else shifted
+    z = elements[EL_SMALL_Z] + periods * advance_g
+    elements[EL_SMALL_Z] = z - TWO_PI * np.rint(z / TWO_PI)  # z is an angle: keep it in [−π, π] as well
     return periods

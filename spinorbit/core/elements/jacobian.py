@@ -54,8 +54,10 @@ import math
 
 import numpy as np
 
-from spinorbit.core.jit import jit
 from spinorbit.core.elements.canonical import (
+    EL_S,
+    EL_SMALL_S,
+    EL_Z,
     MO_ARG_PER_S,
     MO_D,
     MO_G,
@@ -70,7 +72,9 @@ from spinorbit.core.elements.canonical import (
     elliptic_constants,
     motion_from_elements,
 )
-from spinorbit.core.math.elliptic import (
+from spinorbit.core.jit import jit
+from spinorbit.core.math.carlson import rd, rf, rj
+from spinorbit.core.math.elliptic_periods import (
     MK_HEAD,
     MK_K_HI,
     MK_K_LO,
@@ -78,19 +82,17 @@ from spinorbit.core.math.elliptic import (
     MK_MUC,
     MK_SQRT_MUC,
     MK_TAIL,
-    rd,
-    rf,
-    rj,
+    reduce_by_period,
 )
 
-# The reduced-argument kernels of the elliptic module are used directly so that sn, cn, dn and the
-# associate integrals below come from one reduction u = 2jK + r (|r| ≤ K), not from two that could
-# disagree by one half period at the boundary.
-from spinorbit.core.math.elliptic import reduce_by_period, sncndn_reduced
+# The reduced-argument kernel is used directly so that sn, cn, dn and the associate integrals below
+# come from one reduction u = 2jK + r (|r| ≤ K), not from two that could disagree by one half period
+# at the boundary.
+from spinorbit.core.math.jacobi import sncndn_reduced
 
 # Row / column indices of the Jacobian.
 ROW_L, ROW_G, ROW_H, ROW_SMALL_L, ROW_SMALL_G, ROW_SMALL_H = range(6)
-COL_S, COL_Z, COL_H, COL_SMALL_S, COL_SMALL_Z, COL_SMALL_H = range(6)
+COL_S, COL_Z, COL_H, COL_SMALL_S, COL_SMALL_Z, COL_SMALL_H = range(6)  # the EL_* order of the elements
 
 ANDOYER_NAMES = ("L", "G", "H", "l", "g", "h")
 ELEMENT_NAMES = ("S", "Z", "H", "s", "z", "h")
@@ -311,7 +313,7 @@ def andoyer_jacobian(elements, ic):
     evaluated in (u, m), the LAM parts in (v, μ) = (√m u, 1/m) (module docstring). The 23 zero
     components are exactly zero.
     """
-    big_s, big_z = elements[0], elements[1]
+    big_s, big_z = elements[EL_S], elements[EL_Z]
     mo = motion_from_elements(abs(big_s), big_z, ic)
     mk, _ = elliptic_constants(mo)
     return andoyer_jacobian_motion(elements, ic, mo, mk)
@@ -321,7 +323,7 @@ def andoyer_jacobian(elements, ic):
 def andoyer_jacobian_motion(elements, ic, mo, mk):
     """:func:`andoyer_jacobian` with the motion constants of (|S|, Z) and their parameter constants
     (``motion_from_elements``, ``elliptic_constants``) supplied by a caller that has them already."""
-    big_s, big_z, s = elements[0], elements[1], elements[3]
+    big_s, big_z, s = elements[EL_S], elements[EL_Z], elements[EL_SMALL_S]
     sense = 1.0
     if big_s < 0.0:
         sense = -1.0

@@ -50,6 +50,24 @@ def _check_moments(big_a, big_b, big_c):
         )
 
 
+def _validated(names, values):
+    """Broadcast six variables and the moments A, B, C; check they are finite and the moments ordered."""
+    names = names + ("A", "B", "C")
+    shape, flat = _broadcast(names, values)
+    _check_finite(names, flat)
+    _check_moments(*flat[6:])
+    return shape, flat
+
+
+def _evaluate(kernel, flat, shape, direction):
+    """Run one compiled map over the flat inputs; raise for singular states; shape the six outputs."""
+    out = np.empty((6, flat[0].size))
+    status = np.empty(flat[0].size, dtype=np.int64)
+    kernel(*flat, out, status)
+    _raise_for_status(status, shape, direction)
+    return _finish(out, shape)
+
+
 def _raise_for_status(status, shape, direction):
     if np.all(status == _canonical.STATUS_OK):
         return
@@ -103,21 +121,15 @@ def andoyer_to_canonical(L, G, H, l, g, h, A, B, C):
         Permanent rotations (no finite elements) and the two separatrix arcs that need an explicit
         branch (see ``spinorbit.core.elements.canonical``).
     """
-    shape, flat = _broadcast(_ANDOYER_NAMES + ("A", "B", "C"), (L, G, H, l, g, h, A, B, C))
-    _check_finite(_ANDOYER_NAMES + ("A", "B", "C"), flat)
+    shape, flat = _validated(_ANDOYER_NAMES, (L, G, H, l, g, h, A, B, C))
     big_l, big_g, big_h = flat[0], flat[1], flat[2]
-    _check_moments(*flat[6:])
     if np.any(big_g <= 0):
         raise ValueError("G (the angular momentum's magnitude) must be positive; got G ≤ 0. A body at rest has no elements.")
     slack = 1e-14 * big_g
     for name, value in (("L", big_l), ("H", big_h)):
         if np.any(np.abs(value) > big_g + slack):
             raise ValueError(f"|{name}| must not exceed G (it is a component of the angular momentum); got |{name}| > G.")
-    out = np.empty((6, big_l.size))
-    status = np.empty(big_l.size, dtype=np.int64)
-    _canonical.canonical_from_andoyer_many(*flat, out, status)
-    _raise_for_status(status, shape, "Andoyer → canonical")
-    return _finish(out, shape)
+    return _evaluate(_canonical.canonical_from_andoyer_many, flat, shape, "Andoyer → canonical")
 
 
 def canonical_to_andoyer(S, Z, H, s, z, h, A, B, C):
@@ -138,10 +150,8 @@ def canonical_to_andoyer(S, Z, H, s, z, h, A, B, C):
     L, G, H, l, g, h : float or ndarray
         Andoyer variables, angles reduced to (−π, π].
     """
-    shape, flat = _broadcast(_CANONICAL_NAMES + ("A", "B", "C"), (S, Z, H, s, z, h, A, B, C))
-    _check_finite(_CANONICAL_NAMES + ("A", "B", "C"), flat)
+    shape, flat = _validated(_CANONICAL_NAMES, (S, Z, H, s, z, h, A, B, C))
     big_s, big_z, big_h = flat[0], flat[1], flat[2]
-    _check_moments(*flat[6:])
     if np.any(big_z <= 0):
         raise ValueError("Z (= G, the angular momentum's magnitude) must be positive; got Z ≤ 0.")
     slack = 1e-14 * big_z
@@ -155,8 +165,4 @@ def canonical_to_andoyer(S, Z, H, s, z, h, A, B, C):
         )
     if np.any(np.abs(big_h) > big_z + slack):
         raise ValueError("|H| must not exceed Z (H is a component of the angular momentum); got |H| > Z.")
-    out = np.empty((6, big_s.size))
-    status = np.empty(big_s.size, dtype=np.int64)
-    _canonical.andoyer_from_canonical_many(*flat, out, status)
-    _raise_for_status(status, shape, "canonical → Andoyer")
-    return _finish(out, shape)
+    return _evaluate(_canonical.andoyer_from_canonical_many, flat, shape, "canonical → Andoyer")

@@ -41,6 +41,11 @@ Bodies with two exactly equal moments (and spheres) do not come here: the loops 
 the regular precession in closed form (:mod:`.regular_precession`, trig only, the same double-double
 phase treatment), unless ``closed_forms=False``.
 
+Where it lives: the constants of one motion are set up once per state by
+:func:`.flow_constants.flow_constants` (module :mod:`.flow_constants`, which owns the ``FL_*``
+layout); this module evaluates them at each time (:func:`evaluate_flow`) and runs the loops over
+states and times.
+
 Output convention: quaternions scalar first, body → inertial (``docs/conventions.md``), and body
 angular momenta, in the user's principal-axis body frame.
 """
@@ -49,362 +54,86 @@ import math
 
 import numpy as np
 
-from spinorbit.core.jit import jit
-from spinorbit.core.elements.andoyer import node_frame
 from spinorbit.core.elements.canonical import (
     FLIP_A,
     FLIP_B,
     FLIP_C,
     MO_G,
-    MO_MODE,
-    MO_PARAM_C,
-    MODE_SAM,
     MODE_UNIFORM,
-    amplitude_from_momentum,
-    body_from_argument,
     body_from_sncndn,
-    elliptic_constants,
-    flip_attitude,
-    flip_signs,
-    inertia_constants,
-    motion_from_momentum,
-    node_angles,
 )
+from spinorbit.core.free_motion.flow_constants import (
+    FL_ARG0,
+    FL_AXIS_X,
+    FL_AXIS_Y,
+    FL_AXIS_Z,
+    FL_FLIP,
+    FL_FLIP_X,
+    FL_FLIP_Y,
+    FL_FLIP_Z,
+    FL_G_ADVANCE_HI,
+    FL_G_ADVANCE_LO,
+    FL_G_CONST_HI,
+    FL_G_CONST_LO,
+    FL_G_RATE_HI,
+    FL_G_RATE_LO,
+    FL_KAPPA_HI,
+    FL_KAPPA_LO,
+    FL_M0_X,
+    FL_M0_Y,
+    FL_M0_Z,
+    FL_MODE,
+    FL_PERIOD_HI,
+    FL_PERIOD_LO,
+    FL_PERIODIC,
+    FL_QN_W,
+    FL_QN_X,
+    FL_QN_Y,
+    FL_QN_Z,
+    FL_RATE_HI,
+    FL_RATE_LO,
+    FLOW_SIZE,
+    flow_constants,
+    kappa_pn,
+)
+from spinorbit.core.free_motion.regular_precession import (
+    NO_SYMMETRY_AXIS,
+    evaluate_precession,
+    precession_constants,
+    symmetry_axis,
+)
+from spinorbit.core.jit import jit
 from spinorbit.core.math.ddouble import (
     TWO_PI_HI,
     TWO_PI_LO,
     dd_add,
-    dd_difference_ratio as _dd_difference_ratio,
-    dd_div,
     dd_mul,
     dd_remainder,
     dd_remainder_dd,
-    dd_scale as _dd_scale,
-    dd_sqrt,
-    two_prod,
+    dd_scale,
 )
-from spinorbit.core.math.elliptic import (
+from spinorbit.core.math.elliptic_integrals import pn_k
+from spinorbit.core.math.elliptic_periods import (
     MK_K_HI,
     MK_K_LO,
     MK_M,
     MK_MC,
     MK_SQRT_MUC,
-    METHOD_LARGE_NEGATIVE,
-    NK_METHOD,
-    PI_HI,
-    PI_LO,
-    pi_principal,
-    sncndn_reduced,
-    ellipf_k,
-    parameter_constants,
-    pn_constants,
-    pn_k,
-    sncndn_k,
 )
-from spinorbit.core.free_motion.regular_precession import NO_SYMMETRY_AXIS, evaluate_precession, precession_constants, symmetry_axis
-from spinorbit.core.math.rotations import attitude_to_quat, matrix_to_quat, qmul_parts as _qmul, quat_to_attitude
+from spinorbit.core.math.jacobi import sncndn_k, sncndn_reduced
+from spinorbit.core.math.rotations import attitude_to_quat, qmul_parts, quat_to_attitude
 
-# The double-double AGM for K and Π stops when both the AGM gap and the last term of the Π series
-# are below this fraction of the result: the double-double unit roundoff is 2^-106 ≈ 1.2e-32.
-AGM_TOLERANCE = 1e-33
-# f = −n up to 1e30 needs ≈ 50 halvings of p_k before the quadratic phase; 200 is never reached.
-AGM_MAX_STEPS = 200
+# The FL_* layout and the set-up belong to .flow_constants; they are named here too because the
+# callers of the flow (the splitting integrator, tests, benchmarks) read the constants it returns.
+__all__ = [
+    "FLOW_SIZE", "FL_ARG0", "FL_AXIS_X", "FL_AXIS_Y", "FL_AXIS_Z", "FL_FLIP", "FL_FLIP_X", "FL_FLIP_Y",
+    "FL_FLIP_Z", "FL_G_ADVANCE_HI", "FL_G_ADVANCE_LO", "FL_G_CONST_HI", "FL_G_CONST_LO", "FL_G_RATE_HI",
+    "FL_G_RATE_LO", "FL_KAPPA_HI", "FL_KAPPA_LO", "FL_M0_X", "FL_M0_Y", "FL_M0_Z", "FL_MODE",
+    "FL_PERIODIC", "FL_PERIOD_HI", "FL_PERIOD_LO", "FL_QN_W", "FL_QN_X", "FL_QN_Y", "FL_QN_Z",
+    "FL_RATE_HI", "FL_RATE_LO", "evaluate_flow", "flow_constants", "propagate_many_into",
+    "torque_free_attitudes", "torque_free_states", "torque_free_states_many", "uniform_rotation",
+]
 
-# Indices into the per-state flow constants (see flow_constants). The MO_* motion constants, the
-# elliptic constants and these describe one torque-free motion completely.
-(
-    FL_MODE,  # MODE_SAM / MODE_LAM / MODE_UNIFORM (separatrix: MODE_SAM with FL_PERIODIC == 0)
-    FL_PERIODIC,  # 1 if the argument is reduced by the double-double half period 2K, 0 at m = 1
-    FL_RATE_HI,  # ν = d(arg)/dt (uniform rotation: |ω|/2, the rate of the half angle)
-    FL_RATE_LO,
-    FL_ARG0,  # arg at t = 0 (a double: its rounding is a constant offset, not a drift)
-    FL_PERIOD_HI,  # 2K(p), the half period of the argument
-    FL_PERIOD_LO,
-    FL_G_RATE_HI,  # c G, secular rate of g (rad per time unit)
-    FL_G_RATE_LO,
-    FL_G_ADVANCE_HI,  # 2 κ Π(n|p): advance of g per half period of the argument, beyond c G t
-    FL_G_ADVANCE_LO,
-    FL_G_CONST_HI,  # g0 − κ pn(arg0)
-    FL_G_CONST_LO,
-    FL_QN_W,  # quaternion of the node frame (R1(I) R3(h))ᵀ; uniform rotation: the initial attitude
-    FL_QN_X,
-    FL_QN_Y,
-    FL_QN_Z,
-    FL_AXIS_X,  # uniform rotation: unit spin axis ω/|ω| in the body frame
-    FL_AXIS_Y,
-    FL_AXIS_Z,
-    FL_FLIP_X,  # diagonal of the body-frame flip
-    FL_FLIP_Y,
-    FL_FLIP_Z,
-    FL_FLIP,  # FLIP_* code
-    FL_M0_X,  # body momentum at t = 0 (constant in a uniform rotation)
-    FL_M0_Y,
-    FL_M0_Z,
-    FL_KAPPA_HI,  # κ = (a−c) G / ν, the coefficient of pn in g (rad per unit of pn)
-    FL_KAPPA_LO,
-) = range(29)
-FLOW_SIZE = 29
-
-
-# --------------------------------------------------------------------------------------------------
-# Double-double constants of one motion
-# --------------------------------------------------------------------------------------------------
-
-
-@jit
-def complete_k_pi_dd(f_hi, f_lo, mc_hi, mc_lo):
-    """K(p) and Π(n | p) for n = −f ≤ 0, 0 ≤ p < 1, as double-doubles (DLMF 19.8.5, 19.8.6–8).
-
-    Parameters
-    ----------
-    f_hi, f_lo : float
-        f = −n ≥ 0 as a double-double (dimensionless; up to 1e30 checked).
-    mc_hi, mc_lo : float
-        Complementary parameter p_c = 1 − p > 0 as a double-double.
-
-    Returns
-    -------
-    k_hi, k_lo, pi_hi, pi_lo : float
-        K(p) = π / (2 M(1, √p_c)) and Π(n | p) = ∫₀^{π/2} dθ / ((1 − n sin²θ) √(1 − p sin²θ)).
-
-    Notes
-    -----
-    DLMF 19.8.6 reads Π = K/2 · (2 + n/(1 − n) Σ_{k≥0} Q_k), with p_0² = 1 − n, Q_0 = 1,
-    ε_k = (p_k² − a_k g_k)/(p_k² + a_k g_k), Q_{k+1} = Q_k ε_k / 2, p_{k+1} = (p_k² + a_k g_k)/(2 p_k).
-    For n → −∞ the bracket cancels catastrophically (Σ Q → 2, Π → 0). Written with
-    T = 1 − Σ_{k≥1} Q_k = Σ_{k≥1} 2^{-k} D_k, D_k = 1 − Π_{i<k} ε_i, the result is
-    Π = K/2 · (2 + f T)/(1 + f), and D_{k+1} = D_k + δ_k (1 − D_k) with δ_k = 1 − ε_k = 2 a_k g_k /
-    (p_k² + a_k g_k) sums positive terms only (ε_k ≥ 0 for n ≤ 0). Once ε_k = 0 all later D are 1,
-    so the tail of T is the last weight 2^{-k}. Checked against mpmath (50 digits) for p_c from 1e-20
-    to 1 and f from 0 to 1e30: relative error ≤ 3e-31 (``tests/test_torque_free.py``).
-    """
-    ah, al = 1.0, 0.0
-    gh, gl = dd_sqrt(mc_hi, mc_lo)
-    oneh, onel = dd_add(1.0, 0.0, f_hi, f_lo)
-    ph, pl = dd_sqrt(oneh, onel)
-    prod_h, prod_l = 1.0, 0.0  # Π_{i<k} ε_i = 1 − D_k, kept as a product (no cancellation)
-    dh, dl = 0.0, 0.0  # D_k
-    th, tl = 0.0, 0.0  # partial sum of T
-    weight = 1.0
-    for _ in range(AGM_MAX_STEPS):
-        agh, agl = dd_mul(ah, al, gh, gl)
-        p2h, p2l = dd_mul(ph, pl, ph, pl)
-        denh, denl = dd_add(p2h, p2l, agh, agl)
-        nh, nl = dd_add(p2h, p2l, -agh, -agl)
-        eh, el = dd_div(nh, nl, denh, denl)
-        delh, dell = dd_div(2.0 * agh, 2.0 * agl, denh, denl)
-        xh, xl = dd_mul(delh, dell, prod_h, prod_l)
-        dh, dl = dd_add(dh, dl, xh, xl)
-        prod_h, prod_l = dd_mul(prod_h, prod_l, eh, el)
-        weight *= 0.5
-        th, tl = dd_add(th, tl, weight * dh, weight * dl)
-        ph, pl = dd_div(denh, denl, 2.0 * ph, 2.0 * pl)
-        sh, sl = dd_add(ah, al, gh, gl)
-        ah, al = 0.5 * sh, 0.5 * sl
-        gh, gl = dd_sqrt(agh, agl)
-        if abs(prod_h) * weight <= AGM_TOLERANCE * abs(th) and abs(ah - gh) <= AGM_TOLERANCE * ah:
-            break
-    th, tl = dd_add(th, tl, weight, 0.0)
-    kh, kl = dd_div(PI_HI, PI_LO, 2.0 * ah, 2.0 * al)
-    fth, ftl = dd_mul(f_hi, f_lo, th, tl)
-    numh, numl = dd_add(2.0, 0.0, fth, ftl)
-    rh, rl = dd_div(numh, numl, oneh, onel)
-    pih, pil = dd_mul(kh, kl, 0.5 * rh, 0.5 * rl)
-    return kh, kl, pih, pil
-
-
-@jit
-def _dd_lin(ah, al, xh, xl, bh, bl, yh, yl):
-    """a·x + b·y for double-doubles."""
-    uh, ul = dd_mul(ah, al, xh, xl)
-    vh, vl = dd_mul(bh, bl, yh, yl)
-    return dd_add(uh, ul, vh, vl)
-
-
-@jit
-def phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c):
-    """Secular constants of a SAM/LAM motion as double-doubles from the exact double inputs.
-
-    Parameters
-    ----------
-    mode : int
-        MODE_SAM or MODE_LAM (from :func:`.canonical.motion_from_momentum`).
-    mx, my, mz : float
-        Body angular momentum (any flip: only squares enter).
-    big_a, big_b, big_c : float
-        Principal moments A ≤ B ≤ C.
-
-    Returns
-    -------
-    tuple of 14 floats
-        (ν_hi, ν_lo, P_hi, P_lo, cG_hi, cG_lo, W_hi, W_lo, κ_hi, κ_lo, p, p_c, n, ok): the argument
-        rate ν (argument per time unit), the half period P = 2K(p) of the argument, the secular rate
-        c G of g (rad per time unit), the advance W = 2 κ Π(n|p) of g per half period (rad), the pn
-        coefficient κ (rad), and the parameter, complementary parameter and characteristic rounded
-        once from their double-double values (for the double kernels: near the separatrix p_c from
-        doubles would lose ε/p_c); ok = 0 when the double-double p_c is not positive (the
-        separatrix), 1 otherwise.
-
-    Notes
-    -----
-    With P_a = (a−b) M_y² + (a−c) M_z² = (a−d) G², Q = (a−c) M_x² + (b−c) M_y² = (d−c) G² and
-    R = (b−c) M_z² − (a−b) M_x² = (b−d) G² (``canonical`` module docstring, eqs. 5, 7, 8):
-    SAM ν² = P_a (b−c), p = (a−b) Q / (P_a (b−c)), p_c = (a−c) R / (P_a (b−c)), n = −(a−b)/(b−c);
-    LAM ν² = Q (a−b), p = P_a (b−c) / ((a−b) Q), p_c = −(a−c) R / ((a−b) Q), n = −P_a / Q;
-    κ = (a−c) G / ν in both modes.
-    """
-    abh, abl = _dd_difference_ratio(big_a, big_b)
-    bch, bcl = _dd_difference_ratio(big_b, big_c)
-    ach, acl = _dd_difference_ratio(big_a, big_c)
-    x2h, x2l = two_prod(mx, mx)
-    y2h, y2l = two_prod(my, my)
-    z2h, z2l = two_prod(mz, mz)
-    pah, pal = _dd_lin(abh, abl, y2h, y2l, ach, acl, z2h, z2l)
-    qh, ql = _dd_lin(ach, acl, x2h, x2l, bch, bcl, y2h, y2l)
-    rh, rl = _dd_lin(bch, bcl, z2h, z2l, -abh, -abl, x2h, x2l)
-    g2h, g2l = dd_add(x2h, x2l, y2h, y2l)
-    g2h, g2l = dd_add(g2h, g2l, z2h, z2l)
-    gh, gl = dd_sqrt(g2h, g2l)
-    if mode == MODE_SAM:
-        denh, denl = dd_mul(pah, pal, bch, bcl)
-        nu2h, nu2l = denh, denl
-        ah_, al_ = dd_mul(ach, acl, rh, rl)
-        fh, fl = dd_div(abh, abl, bch, bcl)
-        numh, numl = dd_mul(abh, abl, qh, ql)
-    else:
-        denh, denl = dd_mul(abh, abl, qh, ql)
-        nu2h, nu2l = denh, denl
-        ah_, al_ = dd_mul(-ach, -acl, rh, rl)
-        fh, fl = dd_div(pah, pal, qh, ql)
-        numh, numl = dd_mul(pah, pal, bch, bcl)
-    pch, pcl = dd_div(ah_, al_, denh, denl)
-    param = dd_div(numh, numl, denh, denl)[0]
-    nuh, nul = dd_sqrt(nu2h, nu2l)
-    ch, cl = dd_div(1.0, 0.0, big_c, 0.0)
-    cgh, cgl = dd_mul(ch, cl, gh, gl)
-    # κ = (a−c) G / ν
-    kah, kal = dd_mul(ach, acl, gh, gl)
-    kah, kal = dd_div(kah, kal, nuh, nul)
-    if not pch > 0.0:
-        return nuh, nul, math.inf, 0.0, cgh, cgl, 0.0, 0.0, kah, kal, param, pch, -fh, 0.0
-    kh, kl, pih, pil = complete_k_pi_dd(fh, fl, pch, pcl)
-    wh, wl = dd_mul(kah, kal, 2.0 * pih, 2.0 * pil)
-    return nuh, nul, 2.0 * kh, 2.0 * kl, cgh, cgl, wh, wl, kah, kal, param, pch, -fh, 1.0
-
-
-# --------------------------------------------------------------------------------------------------
-# Per-state setup
-# --------------------------------------------------------------------------------------------------
-
-
-@jit
-def flow_constants(quaternion, momentum, big_a, big_b, big_c):
-    """Everything the per-time evaluation needs for one state (computed once per state).
-
-    Parameters
-    ----------
-    quaternion : (4,) ndarray
-        Attitude at t = 0, scalar first, body → inertial (unit norm).
-    momentum : (3,) ndarray
-        Body angular momentum at t = 0 (principal axes A ≤ B ≤ C; any consistent unit).
-    big_a, big_b, big_c : float
-        Principal moments A ≤ B ≤ C (same mass·length² unit as implied by the momentum).
-
-    Returns
-    -------
-    flow : (FLOW_SIZE,) ndarray
-        The ``FL_*`` constants.
-    mo, mk, pk : tuples
-        Motion constants (:func:`.canonical.motion_constants`), parameter and pn constants of the
-        elliptic kernels.
-    """
-    ic = inertia_constants(big_a, big_b, big_c)
-    mo, flip = motion_from_momentum(momentum[0], momentum[1], momentum[2], ic)
-    flow = np.zeros(FLOW_SIZE)
-    mode = int(mo[MO_MODE])
-    flow[FL_MODE] = mode
-    flow[FL_FLIP] = flip
-    fx, fy, fz = flip_signs(flip)
-    flow[FL_FLIP_X], flow[FL_FLIP_Y], flow[FL_FLIP_Z] = fx, fy, fz
-    flow[FL_M0_X], flow[FL_M0_Y], flow[FL_M0_Z] = momentum[0], momentum[1], momentum[2]
-    if mode == MODE_UNIFORM:
-        # Permanent rotation: ω = I⁻¹M ∥ M, q(t) = q0 ⊗ (cos(|ω|t/2), k sin(|ω|t/2)), k = ω/|ω|.
-        # |ω|/2 in double-double, so the half angle does not drift either.
-        oxh, oxl = dd_div(momentum[0], 0.0, big_a, 0.0)
-        oyh, oyl = dd_div(momentum[1], 0.0, big_b, 0.0)
-        ozh, ozl = dd_div(momentum[2], 0.0, big_c, 0.0)
-        xxh, xxl = dd_mul(oxh, oxl, oxh, oxl)
-        yyh, yyl = dd_mul(oyh, oyl, oyh, oyl)
-        zzh, zzl = dd_mul(ozh, ozl, ozh, ozl)
-        sqh, sql = dd_add(xxh, xxl, yyh, yyl)
-        sqh, sql = dd_add(sqh, sql, zzh, zzl)
-        rh, rl = dd_sqrt(sqh, sql)
-        flow[FL_RATE_HI], flow[FL_RATE_LO] = 0.5 * rh, 0.5 * rl
-        if rh > 0.0:
-            flow[FL_AXIS_X], flow[FL_AXIS_Y], flow[FL_AXIS_Z] = oxh / rh, oyh / rh, ozh / rh
-        flow[FL_QN_W], flow[FL_QN_X] = quaternion[0], quaternion[1]
-        flow[FL_QN_Y], flow[FL_QN_Z] = quaternion[2], quaternion[3]
-        mk, pk = elliptic_constants(mo)  # unused by a uniform rotation; returned for one signature
-        return flow, mo, mk, pk
-    mx, my, mz = fx * momentum[0], fy * momentum[1], fz * momentum[2]
-    (nuh, nul, perh, perl, cgh, cgl, wh, wl, kah, kal, param, param_c, char_n, ok) = (
-        phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c)
-    )
-    if ok > 0.0 and mo[MO_PARAM_C] > 0.0:
-        # kernel constants from the once-rounded double-double p, p_c, n (not from ratios of rounded
-        # differences: near the separatrix those lose ε/p_c in p_c)
-        mk = parameter_constants(param, param_c)
-        pk = pn_constants(char_n, param, param_c)
-        periodic = True
-    else:  # the separatrix: the kernels' closed forms, from the motion constants
-        mk, pk = elliptic_constants(mo)
-        periodic = False
-    working = flip_attitude(quat_to_attitude(quaternion), flip)
-    arg0 = ellipf_k(amplitude_from_momentum(mx, my, mz, mo, ic), mk)
-    _, _, _, sin_l, cos_l = body_from_argument(arg0, mo, mk)
-    _, cos_i, sin_i, h, g0 = node_angles(working, np.array([mx, my, mz]), sin_l, cos_l)
-    qn = matrix_to_quat(node_frame(cos_i, sin_i, h).T.copy())
-    flow[FL_QN_W], flow[FL_QN_X], flow[FL_QN_Y], flow[FL_QN_Z] = qn[0], qn[1], qn[2], qn[3]
-    flow[FL_ARG0] = arg0
-    flow[FL_PERIODIC] = 1.0 if periodic else 0.0
-    flow[FL_RATE_HI], flow[FL_RATE_LO] = nuh, nul
-    flow[FL_PERIOD_HI], flow[FL_PERIOD_LO] = perh, perl
-    flow[FL_G_RATE_HI], flow[FL_G_RATE_LO] = cgh, cgl
-    flow[FL_G_ADVANCE_HI], flow[FL_G_ADVANCE_LO] = wh, wl
-    flow[FL_KAPPA_HI], flow[FL_KAPPA_LO] = kah, kal
-    # g0 − κ pn(arg0), with pn(arg0) = 2Π j0 + pn(r0) split as at every later time, so that the
-    # large parts cancel exactly at t = 0 (κ pn is huge for nearly symmetric bodies)
-    if periodic:
-        j0, r0h, r0l = dd_remainder_dd(arg0, 0.0, perh, perl)
-        s, c, d = sncndn_reduced(r0h, mk[MK_M], mk[MK_MC], mk[MK_SQRT_MUC], mk[MK_K_HI], mk[MK_K_LO])
-        ph, pl = _kappa_pn(kah, kal, r0h, r0l, s, c, d, pk)
-        jwh, jwl = _dd_scale(wh, wl, j0)
-        ph, pl = dd_add(ph, pl, jwh, jwl)
-    else:
-        ph, pl = dd_mul(kah, kal, pn_k(arg0, mk, pk), 0.0)
-    ch, cl = dd_add(g0, 0.0, -ph, -pl)
-    flow[FL_G_CONST_HI], flow[FL_G_CONST_LO] = ch, cl
-    return flow, mo, mk, pk
-
-
-# --------------------------------------------------------------------------------------------------
-# Per-time evaluation
-# --------------------------------------------------------------------------------------------------
-
-
-@jit
-def _kappa_pn(kah, kal, rh, rl, s, c, d, pk):
-    """κ · pn(r) as a double-double for |r| ≤ K, from sn, cn, dn of r and r as a double-double.
-
-    Carlson form (|n| < 1): pn(r) = r + (n/3) s³ R_J (F(am r) = r), and κ r is formed in
-    double-double: for nearly symmetric bodies (A ≈ B) κ is large while pn(r) ≈ r, and κ · pn(r)
-    rounded as a whole would cost ε·κ·r rad. R_C form (n ≤ −1): pn(r) is far from r (≈ r/(1 − n)),
-    so splitting r off would cancel; κ · pn(r) is formed from the whole value.
-    """
-    if pk[NK_METHOD] == METHOD_LARGE_NEGATIVE:
-        return dd_mul(kah, kal, pi_principal(s, c * c, d * d, rh, pk), 0.0)
-    xh, xl = dd_add(rh, rl, pi_principal(s, c * c, d * d, 0.0, pk), 0.0)
-    return dd_mul(kah, kal, xh, xl)
 
 
 @jit
@@ -434,26 +163,26 @@ def evaluate_flow(t, flow, mo, mk, pk, q_out, m_out):
     """
     mode = flow[FL_MODE]
     if mode == MODE_UNIFORM:
-        th, tl = _dd_scale(flow[FL_RATE_HI], flow[FL_RATE_LO], t)
+        th, tl = dd_scale(flow[FL_RATE_HI], flow[FL_RATE_LO], t)
         _, half = dd_remainder(th, tl, TWO_PI_HI, TWO_PI_LO)
         ch, sh = math.cos(half), math.sin(half)
-        q = _qmul(flow[FL_QN_W], flow[FL_QN_X], flow[FL_QN_Y], flow[FL_QN_Z],
-                  ch, sh * flow[FL_AXIS_X], sh * flow[FL_AXIS_Y], sh * flow[FL_AXIS_Z])
+        q = qmul_parts(flow[FL_QN_W], flow[FL_QN_X], flow[FL_QN_Y], flow[FL_QN_Z],
+                       ch, sh * flow[FL_AXIS_X], sh * flow[FL_AXIS_Y], sh * flow[FL_AXIS_Z])
         q_out[0], q_out[1], q_out[2], q_out[3] = q
         m_out[0], m_out[1], m_out[2] = flow[FL_M0_X], flow[FL_M0_Y], flow[FL_M0_Z]
         return
     # arg(t) = arg0 + ν t in double-double
-    ah, al = _dd_scale(flow[FL_RATE_HI], flow[FL_RATE_LO], t)
+    ah, al = dd_scale(flow[FL_RATE_HI], flow[FL_RATE_LO], t)
     ah, al = dd_add(ah, al, flow[FL_ARG0], 0.0)
-    gh, gl = _dd_scale(flow[FL_G_RATE_HI], flow[FL_G_RATE_LO], t)
+    gh, gl = dd_scale(flow[FL_G_RATE_HI], flow[FL_G_RATE_LO], t)
     gh, gl = dd_add(gh, gl, flow[FL_G_CONST_HI], flow[FL_G_CONST_LO])
     if flow[FL_PERIODIC] > 0.0:
         j, rh, rl = dd_remainder_dd(ah, al, flow[FL_PERIOD_HI], flow[FL_PERIOD_LO])
         s, c, d = sncndn_reduced(rh, mk[MK_M], mk[MK_MC], mk[MK_SQRT_MUC], mk[MK_K_HI], mk[MK_K_LO])
-        ph, pl = _kappa_pn(flow[FL_KAPPA_HI], flow[FL_KAPPA_LO], rh, rl, s, c, d, pk)
+        ph, pl = kappa_pn(flow[FL_KAPPA_HI], flow[FL_KAPPA_LO], rh, rl, s, c, d, pk)
         gh, gl = dd_add(gh, gl, ph, pl)
         if j != 0.0:
-            wh, wl = _dd_scale(flow[FL_G_ADVANCE_HI], flow[FL_G_ADVANCE_LO], j)
+            wh, wl = dd_scale(flow[FL_G_ADVANCE_HI], flow[FL_G_ADVANCE_LO], j)
             gh, gl = dd_add(gh, gl, wh, wl)
             if abs(j) % 2.0 == 1.0:  # sn, cn change sign every half period; dn does not
                 s, c = -s, -c
@@ -478,8 +207,8 @@ def evaluate_flow(t, flow, mo, mk, pk, q_out, m_out):
     # q_z(g) ⊗ q_x(J) ⊗ q_z(l): the 3-1-3 quaternion of Wᵀ R3(g)ᵀ with W = R3(l) R1(J)
     cp, sp = cg * cl - sg * sl, sg * cl + cg * sl  # (g + l)/2
     cm, sm = cg * cl + sg * sl, sg * cl - cg * sl  # (g − l)/2
-    q = _qmul(flow[FL_QN_W], flow[FL_QN_X], flow[FL_QN_Y], flow[FL_QN_Z],
-              cj * cp, sj * cm, sj * sm, cj * sp)
+    q = qmul_parts(flow[FL_QN_W], flow[FL_QN_X], flow[FL_QN_Y], flow[FL_QN_Z],
+                   cj * cp, sj * cm, sj * sm, cj * sp)
     flip = flow[FL_FLIP]
     if flip == FLIP_A:  # right factor (0, 1, 0, 0): the π turn about A back to the body frame
         q = (-q[1], q[0], q[3], -q[2])

@@ -11,7 +11,6 @@ torqued one.
 
 import math
 
-from spinorbit.core.jit import jit
 from spinorbit.core.elements.canonical import (
     MO_ARG_PER_S,
     MO_G,
@@ -27,7 +26,9 @@ from spinorbit.core.elements.canonical import (
     inertia_constants,
     motion_from_momentum,
 )
-from spinorbit.core.math.elliptic import NK_COMPLETE, characteristic_constants, ellipk
+from spinorbit.core.jit import jit
+from spinorbit.core.math.elliptic_integrals import NK_COMPLETE, characteristic_constants
+from spinorbit.core.math.elliptic_periods import ellipk
 
 #: Mode code of a motion on the separatrix (SAM formulas at 1 − m = 0 exactly), next to
 #: ``canonical.MODE_SAM``, ``MODE_LAM`` and ``MODE_UNIFORM`` (permanent rotation).

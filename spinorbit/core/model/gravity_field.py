@@ -87,30 +87,39 @@ def unnormalize_stokes(c_bar, s_bar):
     c, s : ndarray
         Unnormalised coefficients, same shape.
     """
-    c_bar = np.asarray(c_bar, dtype=float)
-    s_bar = np.asarray(s_bar, dtype=float)
-    c = np.zeros_like(c_bar)
-    s = np.zeros_like(s_bar)
-    for n in range(c_bar.shape[0]):
-        for m in range(n + 1):
-            factor = normalization_factor(n, m)
-            c[n, m] = factor * c_bar[n, m]
-            s[n, m] = factor * s_bar[n, m]
-    return c, s
+    return _rescale_stokes(c_bar, s_bar, normalised=True)
 
 
 def normalize_stokes(c, s):
-    """Inverse of :func:`unnormalize_stokes`: unnormalised → fully normalised."""
-    c = np.asarray(c, dtype=float)
-    s = np.asarray(s, dtype=float)
-    c_bar = np.zeros_like(c)
-    s_bar = np.zeros_like(s)
-    for n in range(c.shape[0]):
+    """Inverse of :func:`unnormalize_stokes`: unnormalised → fully normalised (Kaula 1966).
+
+    Parameters
+    ----------
+    c, s : array_like, shape (n+1, n+1)
+        Unnormalised coefficients C_nm, S_nm indexed [degree, order] (dimensionless).
+
+    Returns
+    -------
+    c_bar, s_bar : ndarray
+        Fully normalised coefficients (4π convention), same shape.
+    """
+    return _rescale_stokes(c, s, normalised=False)
+
+
+def _rescale_stokes(c_in, s_in, normalised):
+    """Multiply (``normalised``: input fully normalised) or divide by N_nm degree by degree."""
+    c_in = np.asarray(c_in, dtype=float)
+    s_in = np.asarray(s_in, dtype=float)
+    c_out = np.zeros_like(c_in)
+    s_out = np.zeros_like(s_in)
+    for n in range(c_in.shape[0]):
         for m in range(n + 1):
             factor = normalization_factor(n, m)
-            c_bar[n, m] = c[n, m] / factor
-            s_bar[n, m] = s[n, m] / factor
-    return c_bar, s_bar
+            if normalised:
+                c_out[n, m], s_out[n, m] = factor * c_in[n, m], factor * s_in[n, m]
+            else:
+                c_out[n, m], s_out[n, m] = c_in[n, m] / factor, s_in[n, m] / factor
+    return c_out, s_out
 
 
 def make_body(moments, mass=0.0, reference_radius=1.0, stokes_c=None, stokes_s=None, normalized=False):

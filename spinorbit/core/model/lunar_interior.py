@@ -48,6 +48,8 @@ INTERIOR_SIZE = 16
 INTERIOR_MARKER = -271828.0
 #: State of the mantle-and-core model: quaternion (4), mantle ω (3), core ω_c on the mantle axes (3).
 INTERIOR_STATE_SIZE = 10
+# Offsets of a symmetric 3×3 matrix (inertia, ΔI, a Hessian) stored as its 6 unique entries.
+SYM_XX, SYM_YY, SYM_ZZ, SYM_XY, SYM_XZ, SYM_YZ = range(6)
 
 
 def make_interior_block(earth_row, gravitational_constant, love_number, time_delay, radius, mean_motion,
@@ -154,39 +156,41 @@ def distortion(block, rx, ry, rz, vx, vy, vz, mu_earth, wx, wy, wz, ax, ay, az, 
     wa = wx * ax + wy * ay + wz * az
     bxx, byy, bzz = rx * rx - third, ry * ry - third, rz * rz - third
     bxy, bxz, byz = rx * ry, rx * rz, ry * rz
-    out[0] = tide * bxx + spin * (wx * wx - (ww - n2) / 3.0)
-    out[1] = tide * byy + spin * (wy * wy - (ww - n2) / 3.0)
-    out[2] = tide * bzz + spin * (wz * wz - (ww + 2.0 * n2) / 3.0)
-    out[3] = tide * bxy + spin * wx * wy
-    out[4] = tide * bxz + spin * wx * wz
-    out[5] = tide * byz + spin * wy * wz
+    out[SYM_XX] = tide * bxx + spin * (wx * wx - (ww - n2) / 3.0)
+    out[SYM_YY] = tide * byy + spin * (wy * wy - (ww - n2) / 3.0)
+    out[SYM_ZZ] = tide * bzz + spin * (wz * wz - (ww + 2.0 * n2) / 3.0)
+    out[SYM_XY] = tide * bxy + spin * wx * wy
+    out[SYM_XZ] = tide * bxz + spin * wx * wz
+    out[SYM_YZ] = tide * byz + spin * wy * wz
     dthird = 2.0 * rv / 3.0
-    rate[0] = tide * (dtide * bxx + 2.0 * rx * vx - dthird) + spin * (2.0 * wx * ax - 2.0 * wa / 3.0)
-    rate[1] = tide * (dtide * byy + 2.0 * ry * vy - dthird) + spin * (2.0 * wy * ay - 2.0 * wa / 3.0)
-    rate[2] = tide * (dtide * bzz + 2.0 * rz * vz - dthird) + spin * (2.0 * wz * az - 2.0 * wa / 3.0)
-    rate[3] = tide * (dtide * bxy + rx * vy + vx * ry) + spin * (wx * ay + ax * wy)
-    rate[4] = tide * (dtide * bxz + rx * vz + vx * rz) + spin * (wx * az + ax * wz)
-    rate[5] = tide * (dtide * byz + ry * vz + vy * rz) + spin * (wy * az + ay * wz)
+    rate[SYM_XX] = tide * (dtide * bxx + 2.0 * rx * vx - dthird) + spin * (2.0 * wx * ax - 2.0 * wa / 3.0)
+    rate[SYM_YY] = tide * (dtide * byy + 2.0 * ry * vy - dthird) + spin * (2.0 * wy * ay - 2.0 * wa / 3.0)
+    rate[SYM_ZZ] = tide * (dtide * bzz + 2.0 * rz * vz - dthird) + spin * (2.0 * wz * az - 2.0 * wa / 3.0)
+    rate[SYM_XY] = tide * (dtide * bxy + rx * vy + vx * ry) + spin * (wx * ay + ax * wy)
+    rate[SYM_XZ] = tide * (dtide * bxz + rx * vz + vx * rz) + spin * (wx * az + ax * wz)
+    rate[SYM_YZ] = tide * (dtide * byz + ry * vz + vy * rz) + spin * (wy * az + ay * wz)
 
 
 @jit(inline="always")
 def symmetric_times(m, x, y, z):
     """M v for a symmetric M given as (xx, yy, zz, xy, xz, yz)."""
-    return (m[0] * x + m[3] * y + m[4] * z,
-            m[3] * x + m[1] * y + m[5] * z,
-            m[4] * x + m[5] * y + m[2] * z)
+    mxx, myy, mzz, mxy, mxz, myz = m[SYM_XX], m[SYM_YY], m[SYM_ZZ], m[SYM_XY], m[SYM_XZ], m[SYM_YZ]
+    return (mxx * x + mxy * y + mxz * z,
+            mxy * x + myy * y + myz * z,
+            mxz * x + myz * y + mzz * z)
 
 
 @jit(inline="always")
 def symmetric_solve(m, bx, by, bz):
     """M⁻¹ b for a symmetric positive-definite 3×3 M given as (xx, yy, zz, xy, xz, yz) (Cramer)."""
-    c00 = m[1] * m[2] - m[5] * m[5]
-    c01 = m[4] * m[5] - m[3] * m[2]
-    c02 = m[3] * m[5] - m[4] * m[1]
-    c11 = m[0] * m[2] - m[4] * m[4]
-    c12 = m[3] * m[4] - m[0] * m[5]
-    c22 = m[0] * m[1] - m[3] * m[3]
-    inv_det = 1.0 / (m[0] * c00 + m[3] * c01 + m[4] * c02)
+    mxx, myy, mzz, mxy, mxz, myz = m[SYM_XX], m[SYM_YY], m[SYM_ZZ], m[SYM_XY], m[SYM_XZ], m[SYM_YZ]
+    c00 = myy * mzz - myz * myz
+    c01 = mxz * myz - mxy * mzz
+    c02 = mxy * myz - mxz * myy
+    c11 = mxx * mzz - mxz * mxz
+    c12 = mxy * mxz - mxx * myz
+    c22 = mxx * myy - mxy * mxy
+    inv_det = 1.0 / (mxx * c00 + mxy * c01 + mxz * c02)
     return ((c00 * bx + c01 * by + c02 * bz) * inv_det,
             (c01 * bx + c11 * by + c12 * bz) * inv_det,
             (c02 * bx + c12 * by + c22 * bz) * inv_det)
@@ -218,7 +222,7 @@ def j2_hessian(block, mu_earth, sx, sy, sz, px, py, pz, h):
     c = sx * px + sy * py + sz * pz
     s = (sx, sy, sz)
     p = (px, py, pz)
-    pairs = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
+    pairs = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))  # (row, column) of each SYM_* offset
     for n in range(6):
         i, j = pairs[n]
         delta = 1.0 if i == j else 0.0
@@ -233,8 +237,8 @@ def figure_figure_torque(m, h):
     """N_i = −ε_ijk (M H)_jk for symmetric M and H (6-entry forms): the torque of a field with
     Hessian H on a body of inertia M."""
     # (MH)_jk = Σ_l M_jl H_lk with the 6-entry layout (xx, yy, zz, xy, xz, yz).
-    mxx, myy, mzz, mxy, mxz, myz = m[0], m[1], m[2], m[3], m[4], m[5]
-    hxx, hyy, hzz, hxy, hxz, hyz = h[0], h[1], h[2], h[3], h[4], h[5]
+    mxx, myy, mzz, mxy, mxz, myz = m[SYM_XX], m[SYM_YY], m[SYM_ZZ], m[SYM_XY], m[SYM_XZ], m[SYM_YZ]
+    hxx, hyy, hzz, hxy, hxz, hyz = h[SYM_XX], h[SYM_YY], h[SYM_ZZ], h[SYM_XY], h[SYM_XZ], h[SYM_YZ]
     mh_yz = mxy * hxz + myy * hyz + myz * hzz
     mh_zy = mxz * hxy + myz * hyy + mzz * hyz
     mh_zx = mxz * hxx + myz * hxy + mzz * hxz

@@ -50,17 +50,26 @@ KEPLER_MAX_ITERATIONS = 200
 
 
 @jit
-def _x_minus_sin(x):
-    """x − sin x without cancellation for small |x| (series to x¹⁵, error < ε for |x| < 0.5)."""
-    if abs(x) >= 0.5:
-        return x - math.sin(x)
+def _odd_series_tail(x, sign):
+    """Σ_{k≥1} sign^(k+1) x^(2k+1)/(2k+1)!: x − sin x (sign = −1) or sinh x − x (sign = +1).
+
+    The series to x¹⁵ is below ε relative for |x| < 0.5, where the direct difference would cancel.
+    """
     x2 = x * x
     term = x * x2 / 6.0
     total = term
     for k in range(2, 8):
-        term *= -x2 / ((2 * k) * (2 * k + 1))
+        term *= sign * x2 / ((2 * k) * (2 * k + 1))
         total += term
     return total
+
+
+@jit
+def _x_minus_sin(x):
+    """x − sin x without cancellation for small |x| (series to x¹⁵, error < ε for |x| < 0.5)."""
+    if abs(x) >= 0.5:
+        return x - math.sin(x)
+    return _odd_series_tail(x, -1.0)
 
 
 @jit
@@ -68,19 +77,41 @@ def _sinh_minus_x(x):
     """sinh x − x without cancellation for small |x| (series, error < ε for |x| < 0.5)."""
     if abs(x) >= 0.5:
         return math.sinh(x) - x
-    x2 = x * x
-    term = x * x2 / 6.0
-    total = term
-    for k in range(2, 8):
-        term *= x2 / ((2 * k) * (2 * k + 1))
-        total += term
-    return total
+    return _odd_series_tail(x, 1.0)
 
 
 #: Halley correction below which the iteration stops and sin E, cos E are updated by their Taylor
 #: series to second order instead of being recomputed: Halley converges cubically, so the root's
 #: remaining error is ~ this³ = 1e-18, and the neglected third-order trig term is ~ this³/6.
 KEPLER_FINAL_STEP = 1e-6
+
+# What one safeguarded Halley step of a Kepler solver leaves to do.
+STEP_CONTINUE, STEP_FINAL, STEP_CONVERGED = 0, 1, 2
+
+
+@jit(inline="always")
+def _bracketed_halley(x, f, fp, fpp, lo, hi):
+    """One Halley step for the root of a monotone increasing f, kept inside the bracket [lo, hi].
+
+    Returns (lo, hi, x_new, dx, what): the bracket shrunk by the sign of f, the next iterate (Halley's
+    x − dx, or the bisection when it leaves the bracket) and what the solver does next:
+    ``STEP_FINAL`` (|dx| < KEPLER_FINAL_STEP inside the bracket: the caller applies x − dx to the
+    trig functions by their Taylor series), ``STEP_CONVERGED`` (the bracket is a few ulps wide) or
+    ``STEP_CONTINUE``. fp only steers the iteration; its rounding does not limit the root.
+    """
+    if f > 0.0:
+        hi = x
+    else:
+        lo = x
+    dx = f / (fp - 0.5 * f * fpp / fp) if fp > 0.0 else np.inf
+    if abs(dx) <= KEPLER_FINAL_STEP * max(1.0, abs(x)) and lo <= x - dx <= hi:
+        return lo, hi, x - dx, dx, STEP_FINAL
+    x_new = x - dx
+    if not (lo <= x_new <= hi):
+        x_new = 0.5 * (lo + hi)
+    if hi - lo <= KEPLER_TOLERANCE * max(1.0, abs(x_new)):
+        return lo, hi, x_new, dx, STEP_CONVERGED
+    return lo, hi, x_new, dx, STEP_CONTINUE
 
 
 @jit
@@ -111,24 +142,13 @@ def solve_kepler_elliptic_sincos(mean_anomaly, e):
             f = (1.0 - e) * x + e * _x_minus_sin(x) - m
         else:
             f = x - e * sx - m
-        if f > 0.0:
-            hi = x
-        else:
-            lo = x
-        fp = 1.0 - e * cx  # only steers the iteration; its rounding does not limit the root
-        fpp = e * sx
-        dx = f / (fp - 0.5 * f * fpp / fp) if fp > 0.0 else np.inf  # Halley
-        if abs(dx) <= KEPLER_FINAL_STEP * max(1.0, abs(x)) and lo <= x - dx <= hi:
-            x_new = x - dx
+        lo, hi, x_new, dx, what = _bracketed_halley(x, f, 1.0 - e * cx, e * sx, lo, hi)
+        if what == STEP_FINAL:
             half_dx2 = 0.5 * dx * dx
             return x_new + turns * two_pi, sx - cx * dx - sx * half_dx2, cx + sx * dx - cx * half_dx2
-        x_new = x - dx
-        if not (lo <= x_new <= hi):
-            x_new = 0.5 * (lo + hi)
-        if hi - lo <= KEPLER_TOLERANCE * max(1.0, abs(x_new)):
-            x = x_new
-            break
         x = x_new
+        if what == STEP_CONVERGED:
+            break
         sx = math.sin(x)
         cx = math.cos(x)
     return x + turns * two_pi, math.sin(x), math.cos(x)
@@ -164,24 +184,13 @@ def solve_kepler_hyperbolic_sinhcosh(mean_anomaly, e):
             f = (e - 1.0) * x + e * _sinh_minus_x(x) - m
         else:
             f = e * sh - x - m
-        if f > 0.0:
-            hi = x
-        else:
-            lo = x
-        fp = e * ch - 1.0  # only steers the iteration; its rounding does not limit the root
-        fpp = e * sh
-        dx = f / (fp - 0.5 * f * fpp / fp) if fp > 0.0 else np.inf  # Halley
-        if abs(dx) <= KEPLER_FINAL_STEP * max(1.0, abs(x)) and lo <= x - dx <= hi:
-            x_new = x - dx
+        lo, hi, x_new, dx, what = _bracketed_halley(x, f, e * ch - 1.0, e * sh, lo, hi)
+        if what == STEP_FINAL:
             half_dx2 = 0.5 * dx * dx
             return sgn * x_new, sgn * (sh - ch * dx + sh * half_dx2), ch - sh * dx + ch * half_dx2
-        x_new = x - dx
-        if not (lo <= x_new <= hi):
-            x_new = 0.5 * (lo + hi)
-        if hi - lo <= KEPLER_TOLERANCE * max(1.0, abs(x_new)):
-            x = x_new
-            break
         x = x_new
+        if what == STEP_CONVERGED:
+            break
         sh = math.sinh(x)
         ch = math.cosh(x)
     return sgn * x, sgn * math.sinh(x), math.cosh(x)
@@ -206,11 +215,9 @@ def kepler_perifocal(t, a, e, m0, t0, n, root):
     return abs_a * (e - ch), abs_a * root * sh, -abs_a * sh * rate, abs_a * root * ch * rate
 
 
-# inline="always": functions on the RHS hot path that receive arrays are inlined at numba-IR level,
-# so no array crosses a call boundary (each crossing costs reference-count updates, which measured
-# ~120 ns per RHS call, 30× the arithmetic of a torque-free RHS).
 # inline="always": functions on the RHS hot path are inlined at numba-IR level so that the model array
-# does not cross a call boundary per evaluation (each crossing costs atomic reference-count updates).
+# does not cross a call boundary per evaluation (each crossing costs atomic reference-count updates,
+# more than the arithmetic of a torque-free RHS).
 @jit(inline="always")
 def kepler_position_xyz(t, arr, off):
     """Inertial position (x, y, z) of the KIND_KEPLER parameter row ``arr[off:off+PARAM_SIZE]``.
@@ -311,15 +318,8 @@ def hermite_state(t, times, xv):
     if not (times[0] <= t <= times[n - 1]):
         out[:] = np.nan
         return out
-    # Binary search for the interval [times[i], times[i+1]] containing t.
-    lo = 0
-    hi = n - 1
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if times[mid] <= t:
-            lo = mid
-        else:
-            hi = mid
+    lo = find_interval(t, times, 0, n)  # [times[lo], times[lo + 1]] contains t
+    hi = lo + 1
     h = times[hi] - times[lo]
     s = (t - times[lo]) / h
     s2 = s * s

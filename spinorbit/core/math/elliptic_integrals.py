@@ -1,0 +1,246 @@
+"""Elliptic integrals F(φ|m), Π(φ, n|m) and Fukushima's pn(u, n|m), for every parameter m ≥ 0.
+
+Numba scalar kernels (dimensionless), written in Carlson's symmetric integrals (:mod:`.carlson`).
+The hot-loop forms take the constants of :func:`.elliptic_periods.parameter_constants` and of the
+characteristic (``characteristic_constants`` for Π, ``pn_constants`` for pn: the ``NK_*`` layout);
+φ is reduced by π and u by the half period, so the secular part is exact multiples of the complete
+integrals. pn (paper eq. 9) is Π evaluated at the sn, cn, dn of the reduced argument, no
+trigonometric call. Domain, NaN cases and formulas: ``docs/elliptic.md`` (notes §6.2–6.7).
+"""
+
+import math
+
+from spinorbit.core.jit import jit
+from spinorbit.core.math.carlson import rc_from_difference, rd, rf, rj
+from spinorbit.core.math.elliptic_periods import (
+    HALF_PI,
+    MK_HEAD,
+    MK_K_HI,
+    MK_K_LO,
+    MK_MC,
+    MK_MU,
+    MK_MUC,
+    MK_SQRT_M,
+    MK_SQRT_MUC,
+    MK_TAIL,
+    parameter_constants,
+    reduce_by_period,
+    reduce_by_pi,
+)
+from spinorbit.core.math.jacobi import sncndn_reduced
+
+# Methods for the characteristic n (see characteristic_constants).
+METHOD_GENERAL = 0  # Π = F + (n/3) s³ R_J(c², Δ², 1, p), n < 1 and not the cases below (note §6.3)
+METHOD_LARGE_NEGATIVE = 1  # n = −f with f ≥ 1: R_C form (note §6.4), no cancellation for f → ∞
+METHOD_EQUAL_TO_M = 2  # n = m: R_J(c², Δ², 1, Δ²) = R_D(c², 1, Δ²), exact as m → 1 (note §6.5)
+METHOD_DIVERGENT = 3  # pn(u, m | m) for m > 1: 1/(1 − m sn²) is non-integrable; result NaN
+
+# Indices into the characteristic-constants tuple (characteristic_constants, pn_constants).
+NK_METHOD, NK_N, NK_F, NK_G, NK_COMPLETE = range(5)
+NK_SIZE = 5
+
+
+@jit
+def _carlson_f(s, c2, delta2):
+    """F over the principal range: s R_F(c², Δ², 1) (DLMF 19.25.5)."""
+    return s * rf(c2, delta2, 1.0)
+
+
+@jit
+def characteristic_constants(n, m, mc):
+    """Constants of the characteristic n for Π(φ, n | m): (method, n, f, g, Π(n|m)).
+
+    method (``METHOD_*``) picks the formula: n == m → R_D form; n = −f with f ≥ 1 → R_C form with
+    g = m/f (note §6.4; never used at f = 0); otherwise the plain Carlson form. Π(n|m) is the
+    complete integral for 0 ≤ m < 1 (used for the reduction φ = jπ + r), NaN for m ≥ 1 where no
+    reduction happens (F, Π are only real on |φ| ≤ π/2 there).
+    """
+    f = -n
+    g = 0.0
+    if n == m:
+        method = METHOD_EQUAL_TO_M
+    elif f >= 1.0:
+        method = METHOD_LARGE_NEGATIVE
+        g = m / f
+    else:
+        method = METHOD_GENERAL
+    complete = math.nan
+    if mc > 0.0:
+        k = rf(0.0, mc, 1.0)
+        if method == METHOD_EQUAL_TO_M:
+            complete = k + (m / 3.0) * rd(0.0, 1.0, mc)
+        elif method == METHOD_LARGE_NEGATIVE:
+            complete = (g / 3.0) * rj(0.0, mc, 1.0, 1.0 + g) + HALF_PI / math.sqrt(
+                (1.0 + f) * (1.0 + g)
+            )
+        elif n == 0.0:
+            complete = k
+        else:
+            complete = k + (n / 3.0) * rj(0.0, mc, 1.0, 1.0 - n)
+    return (float(method), n, f, g, complete)
+
+
+@jit
+def pi_principal(s, c2, delta2, f_part, nk):
+    """Π over a principal range from s, c², Δ² (Δ² = 1 − m s² = c² + mc s²).
+
+    ``f_part`` is the F value already known to the caller (s R_F(c², Δ², 1) for φ, or r for pn,
+    since F(am r) = r), or NaN to have it computed here; the R_C method does not need it.
+    """
+    method = nk[NK_METHOD]
+    n = nk[NK_N]
+    s2 = s * s
+    if method == METHOD_LARGE_NEGATIVE:
+        f = nk[NK_F]
+        g = nk[NK_G]
+        m_term = g * f  # ≈ m
+        one_g = 1.0 + g * s2
+        x = c2 * delta2
+        # y − x = s²(1 + m + f + g) exactly, because f·g = m (note §6.4)
+        y_minus_x = s2 * (1.0 + m_term + f + g)
+        rc_term = rc_from_difference(x, x + y_minus_x, y_minus_x)
+        result = s * rc_term
+        if g != 0.0:
+            result += g * (s * s2 / 3.0) * rj(c2, delta2, 1.0, one_g)
+        return result
+    if f_part != f_part:
+        f_part = _carlson_f(s, c2, delta2)
+    if n == 0.0:
+        return f_part
+    if method == METHOD_EQUAL_TO_M:
+        return f_part + (n / 3.0) * s * s2 * rd(c2, 1.0, delta2)
+    if n > 0.0:
+        p = c2 + (1.0 - n) * s2
+    else:
+        p = 1.0 - n * s2
+    return f_part + (n / 3.0) * s * s2 * rj(c2, delta2, 1.0, p)
+
+
+@jit
+def ellipf_k(phi, mk):
+    """Incomplete integral of the first kind F(φ|m) = ∫₀^φ dθ/√(1 − m sin²θ) (DLMF 19.2.4).
+
+    m < 1: φ = jπ + r, F = 2jK + s R_F(c², c² + mc s², 1) (note §6.1, §6.3). m = 1: atanh(sin φ)
+    via the same Carlson form for |φ| < π/2, ±inf beyond. m > 1: Carlson form unchanged where
+    m sin²φ ≤ 1 and |φ| ≤ π/2 (note §6.2), NaN elsewhere.
+    """
+    mc = mk[MK_MC]
+    if mc > 0.0:
+        j, r = reduce_by_pi(phi)
+        s = math.sin(r)
+        c = math.cos(r)
+        f_r = _carlson_f(s, c * c, c * c + mc * s * s)
+        return 2.0 * j * mk[MK_K_HI] + (2.0 * j * mk[MK_K_LO] + f_r)
+    if abs(phi) > HALF_PI:
+        return math.copysign(math.inf, phi) if mc == 0.0 else math.nan
+    s = math.sin(phi)
+    c = math.cos(phi)
+    delta2 = c * c + mc * s * s
+    if delta2 < 0.0:
+        return math.nan
+    return _carlson_f(s, c * c, delta2)
+
+
+@jit
+def ellippi_k(phi, mk, nk):
+    """Π(φ, n | m) = ∫₀^φ dθ / ((1 − n sin²θ)√(1 − m sin²θ)) with precomputed constants.
+
+    ``nk = characteristic_constants(n, m, mc)``. m < 1: φ = jπ + r, Π = 2jΠ(n|m) + Π(r) for
+    n < 1. m = 1: |φ| < π/2 only (±inf beyond). m > 1: defined where m sin²φ ≤ 1, |φ| ≤ π/2
+    (NaN elsewhere). n ≥ 1 other than n = m ≤ 1: only |φ| < π/2 with 1 − n sin²φ > 0 is returned.
+    """
+    mc = mk[MK_MC]
+    n = nk[NK_N]
+    if mc > 0.0 and n < 1.0:
+        j, r = reduce_by_pi(phi)
+        s = math.sin(r)
+        c = math.cos(r)
+        c2 = c * c
+        pi_r = pi_principal(s, c2, c2 + mc * s * s, math.nan, nk)
+        return 2.0 * j * nk[NK_COMPLETE] + pi_r
+    if abs(phi) > HALF_PI:
+        return math.copysign(math.inf, phi) if mc == 0.0 else math.nan
+    s = math.sin(phi)
+    c = math.cos(phi)
+    c2 = c * c
+    delta2 = c2 + mc * s * s
+    if delta2 < 0.0 or (n > 1.0 and n * s * s >= 1.0):
+        return math.nan
+    return pi_principal(s, c2, delta2, math.nan, nk)
+
+
+@jit
+def ellipf(phi, m, mc):
+    """F(φ | m) (computes the constants; use ellipf_k in loops)."""
+    return ellipf_k(phi, parameter_constants(m, mc))
+
+
+@jit
+def ellippi(n, phi, m, mc):
+    """Π(φ, n | m) (computes the constants; use ellippi_k in loops)."""
+    return ellippi_k(phi, parameter_constants(m, mc), characteristic_constants(n, m, mc))
+
+
+# --------------------------------------------------------------------------------------------------
+# pn(u, n | m) = ∫₀ᵘ du′ / (1 − n sn²(u′|m))  (paper eq. 9, secular for every m)
+# --------------------------------------------------------------------------------------------------
+
+
+@jit
+def pn_constants(n, m, mc):
+    """Characteristic constants for pn, in the layout of characteristic_constants.
+
+    m ≤ 1: those of Π(·, n | m). m > 1: those of Π(·, n/m | 1/m) (note §6.2:
+    pn(u, n|m) = pn(√m u, n/m | 1/m)/√m); n = m > 1 gives METHOD_DIVERGENT (NaN results).
+    """
+    if mc >= 0.0:
+        return characteristic_constants(n, m, mc)
+    if n == m:
+        return (float(METHOD_DIVERGENT), 1.0, -1.0, 0.0, math.nan)
+    mu = 1.0 / m
+    muc = -mc / m
+    return characteristic_constants(n / m, mu, muc)
+
+
+@jit
+def _pn_separatrix(u, n):
+    """pn(u, n | 1) in closed form (integrate 1/(1 − n tanh²u); note §6.7 with atanh(tanh u) = u)."""
+    if n == 1.0:
+        return 0.5 * u + 0.25 * math.sinh(2.0 * u)  # ∫ cosh²
+    if n <= 0.0:
+        f = -n
+        rf_ = math.sqrt(f)
+        return (u + rf_ * math.atan(rf_ * math.tanh(u))) / (1.0 + f)
+    rn = math.sqrt(n)
+    return (u - rn * math.atanh(rn * math.tanh(u))) / (1.0 - n)
+
+
+@jit
+def pn_k(u, mk, pk):
+    """pn(u, n | m) with ``mk = parameter_constants(m, mc)``, ``pk = pn_constants(n, m, mc)``.
+
+    m < 1 (note §6.6): u = 2jK + r, pn = 2jΠ(n|m) + Π(am r, n|m), where Π(am r) comes from
+    s, c, d = sn, cn, dn(r) with Δ² = d² and F(am r) = r (no trigonometric call).
+    m > 1: the same at (√m r, n/m | 1/m), divided by √m (note §6.2). m = 1: closed forms.
+    """
+    mc = mk[MK_MC]
+    method = pk[NK_METHOD]
+    if method == METHOD_DIVERGENT:
+        return math.nan
+    if mc == 0.0:
+        return _pn_separatrix(u, pk[NK_N])
+    j, r = reduce_by_period(u, mk[MK_HEAD], mk[MK_TAIL])
+    sqrt_m = mk[MK_SQRT_M]
+    v = sqrt_m * r if mc < 0.0 else r
+    s, c, d = sncndn_reduced(v, mk[MK_MU], mk[MK_MUC], mk[MK_SQRT_MUC], mk[MK_K_HI], mk[MK_K_LO])
+    pi_r = pi_principal(s, c * c, d * d, v, pk)
+    result = 2.0 * j * pk[NK_COMPLETE] + pi_r if j != 0.0 else pi_r
+    if mc < 0.0:
+        result /= sqrt_m
+    return result
+
+
+@jit
+def pn(u, n, m, mc):
+    """pn(u, n | m) (computes the constants; use pn_k in loops)."""
+    return pn_k(u, parameter_constants(m, mc), pn_constants(n, m, mc))

@@ -36,19 +36,19 @@ from spinorbit.core.elements.equations import singularity_distances_of_motion
 from spinorbit.core.errors import SingularElementsError
 from spinorbit.core.model.gravity_field import BODY_A, BODY_B, BODY_C
 from spinorbit.core.integrators.elements import (
-    _SINGULAR,
-    _STATUS_MESSAGES,
     MIN_ASPHERICITY_PER_RTOL,
     MIN_SEPARATRIX_DISTANCE,
     MIN_SIN_I,
     MIN_SIN_J,
     MIN_SIN_J_A,
     MIN_SIN_P,
+    SINGULAR_SETS,
     STATUS_SUCCESS,
     reference_frame_for,
     run_elements,
 )
-from spinorbit.core.integrators.quaternion import DEFAULT_MAX_STEPS, STAT_STATUS, IntegrationError, integrate_quaternion
+from spinorbit.core.integrators.dop853 import DEFAULT_MAX_STEPS, STAT_STATUS, STATUS_MESSAGES, IntegrationError
+from spinorbit.core.integrators.quaternion import integrate_quaternion
 from spinorbit.core.dynamics.validation import validate_output_times
 from spinorbit.core.math.rotations import quat_to_attitude
 
@@ -205,9 +205,9 @@ def _elements_stretch(y, t, t_out, i_out, model, rtol, max_steps, ys):
     i_out += n_done
     if status == STATUS_SUCCESS:
         return i_out, t_stop, y_stop, None
-    if status in _SINGULAR:
-        return i_out, t_stop, y_stop, _SINGULAR[status][0]
-    raise IntegrationError(f"elements stretch from t = {t!r} stopped: {_STATUS_MESSAGES[status]}.")
+    if status in SINGULAR_SETS:
+        return i_out, t_stop, y_stop, SINGULAR_SETS[status][0]
+    raise IntegrationError(f"elements stretch from t = {t!r} stopped: {STATUS_MESSAGES[status]}.")
 
 
 def _quaternion_probe(y, t, t_out, i_out, model, rtol, max_steps, direction, check_interval, ys):

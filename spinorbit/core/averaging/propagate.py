@@ -31,10 +31,7 @@ import math
 
 import numpy as np
 
-from spinorbit.core.integrators.dop853_tableau import N_STAGES
-from spinorbit.core.integrators.dop853_tableau import A as _A_FULL
-from spinorbit.core.integrators.dop853_tableau import B as _B_FULL
-from spinorbit.core.integrators.dop853_tableau import C as _C_FULL
+from spinorbit.core.integrators.dop853 import dop853_scratch, dop853_step, landing_step
 from spinorbit.core.jit import jit
 from spinorbit.core.averaging.mean_equations import (
     MC_A,
@@ -58,7 +55,15 @@ from spinorbit.core.dynamics.equations import MODEL_PERTURBERS
 from spinorbit.core.dynamics.validation import validate_sampled_span, validate_state
 from spinorbit.core.elements.equations import attitude_and_momentum, inertial_quaternion, reduce_phase
 from spinorbit.core.model.gravity_field import BODY_NMAX
-from spinorbit.core.integrators.elements import elements_of_state, reference_frame_for
+from spinorbit.core.integrators.elements import (
+    ACTION_S,
+    ACTION_Z,
+    ANGLE_S,
+    ANGLE_Z,
+    ELEMENT_SIZE,
+    elements_of_state,
+    reference_frame_for,
+)
 from spinorbit.core.integrators.quaternion import integrate_quaternion
 from spinorbit.core.dynamics.validation import validate_output_times
 from spinorbit.core.model.perturbers import (
@@ -90,10 +95,6 @@ STEPS_PER_ANOMALY_TURN = 8.0
 #: near-radial approach (a flyby) the rate n grows like 1/r², which the n-limit alone would step over.
 RADIAL_STEP_FRACTION = 0.1
 
-_A = np.ascontiguousarray(_A_FULL[:N_STAGES, :N_STAGES])
-_B = np.ascontiguousarray(_B_FULL)
-_C = np.ascontiguousarray(_C_FULL[:N_STAGES])
-
 #: Default validity thresholds (module docstring). 5: the first-order theory's neglected terms are
 #: ~ (n/Ω)²; Toutatis' slowest combination ω_s − ω_g is ~9× its perihelion rate, so 5 keeps it.
 MIN_FREQUENCY_RATIO = 5.0
@@ -111,6 +112,11 @@ _WHY = {INVALID_RESONANCE: "resonance / fast perturber (a fast frequency is clos
         INVALID_SEPARATRIX: "near the separatrix"}
 
 
+# Layout of the array of :func:`free_motion_numbers`.
+FREE_OMEGA_MIN, FREE_ASYMMETRY, FREE_SEPARATRIX, FREE_PERIOD, FREE_ADVANCE_G = range(5)
+FREE_SIZE = 5
+
+
 @jit
 def free_motion_numbers(elements, ic):
     """(Ω_min, (C − A)/C, 1 − m, P, Δg) of the free motion of the elements' (S, Z): the slowest fast
@@ -124,10 +130,18 @@ def free_motion_numbers(elements, ic):
             if j == 0 and k <= 0:
                 continue
             omega_min = min(omega_min, abs(j * omega_s + k * omega_g))
-    mo = motion_from_elements(abs(elements[0]), elements[1], ic)
+    big_s, big_z = elements[ACTION_S], elements[ACTION_Z]
+    mo = motion_from_elements(abs(big_s), big_z, ic)
     sep = 0.0 if mo[MO_MODE] == MODE_UNIFORM else mo[MO_PARAM_C]
-    period, nu, _ = torus_frequencies(elements[0], elements[1], ic)
-    return np.array([omega_min, ic[5] / ic[0], sep, period, nu * period])  # (a − c)/a = 1 − A/C
+    period, nu, _ = torus_frequencies(big_s, big_z, ic)
+    a, _, _, _, _, a_minus_c = ic
+    free = np.empty(FREE_SIZE)
+    free[FREE_OMEGA_MIN] = omega_min
+    free[FREE_ASYMMETRY] = a_minus_c / a  # (a − c)/a = 1 − A/C = (C − A)/C
+    free[FREE_SEPARATRIX] = sep
+    free[FREE_PERIOD] = period
+    free[FREE_ADVANCE_G] = nu * period
+    return free
 
 
 @jit
@@ -139,14 +153,14 @@ def perturber_numbers(t, model):
     radial_time = np.inf
     for p in range(int(model[MODEL_PERTURBERS])):
         row = MODEL_PERTURBERS + 1 + p * PERTURBER_ROW
-        xv = perturber_state(t, model, row)
-        r2 = xv[0] ** 2 + xv[1] ** 2 + xv[2] ** 2
-        cx = xv[1] * xv[5] - xv[2] * xv[4]
-        cy = xv[2] * xv[3] - xv[0] * xv[5]
-        cz = xv[0] * xv[4] - xv[1] * xv[3]
+        x, y, z, vx, vy, vz = perturber_state(t, model, row)
+        r2 = x * x + y * y + z * z
+        cx = y * vz - z * vy
+        cy = z * vx - x * vz
+        cz = x * vy - y * vx
         rate_max = max(rate_max, math.sqrt(cx * cx + cy * cy + cz * cz) / r2)
         strength += 3.0 * model[row + 1] / r2 ** 1.5
-        r_dot = abs(xv[0] * xv[3] + xv[1] * xv[4] + xv[2] * xv[5])  # r·v = r ṙ
+        r_dot = abs(x * vx + y * vy + z * vz)  # r·v = r ṙ
         bound = model[row] == KIND_KEPLER and model[row + 2 + K_E] < 1.0
         if r_dot > 0.0 and not bound:  # elliptic orbits: the angular-rate limit is enough
             radial_time = min(radial_time, r2 / r_dot)
@@ -157,8 +171,9 @@ def perturber_numbers(t, model):
 def validity_numbers(t, model, free):
     """(Ω_min/n_max, ε, 1 − m) at time t; ``free`` from :func:`free_motion_numbers`."""
     rate_max, strength, _ = perturber_numbers(t, model)
-    ratio = free[0] / rate_max if rate_max > 0.0 else np.inf
-    return ratio, strength * free[1] / (free[0] * free[0]), free[2]
+    omega_min = free[FREE_OMEGA_MIN]
+    ratio = omega_min / rate_max if rate_max > 0.0 else np.inf
+    return ratio, strength * free[FREE_ASYMMETRY] / (omega_min * omega_min), free[FREE_SEPARATRIX]
 
 
 @jit
@@ -170,20 +185,23 @@ def validity_code(t, model, free, thresholds):
 
 @jit
 def _validity_from_numbers(rate_max, strength, free, thresholds):
-    ratio = free[0] / rate_max if rate_max > 0.0 else np.inf
-    eps = strength * free[1] / (free[0] * free[0])
-    sep = free[2]
-    if not (sep >= thresholds[2]):
+    omega_min = free[FREE_OMEGA_MIN]
+    ratio = omega_min / rate_max if rate_max > 0.0 else np.inf
+    eps = strength * free[FREE_ASYMMETRY] / (omega_min * omega_min)
+    min_ratio, max_eps, min_separatrix = thresholds
+    if not (free[FREE_SEPARATRIX] >= min_separatrix):
         return INVALID_SEPARATRIX
-    if not (ratio >= thresholds[0]):
+    if not (ratio >= min_ratio):
         return INVALID_RESONANCE
-    if not (eps <= thresholds[1]):
+    if not (eps <= max_eps):
         return INVALID_PERTURBATION
     return VALID
 
 
 @jit(inline="always")
-def _rhs(t, y, mc, model, frame, ic, kind, dy):
+def _rhs(t, y, params, dy):
+    """The mean equations in the engine's form; params = (mc, model, frame, ic, RHS_* kind)."""
+    mc, model, frame, ic, kind = params
     if kind == RHS_DEGREE2_ANOMALY:
         degree2_mean_rhs_anomaly(t, y, mc, model, frame, dy)
     elif kind == RHS_QUADRATURE:
@@ -193,69 +211,31 @@ def _rhs(t, y, mc, model, frame, ic, kind, dy):
 
 
 @jit
-def _rk8_step(t, y, h, mc, model, frame, ic, kind, k, tmp, y_new):
-    n = y.shape[0]
-    for s in range(N_STAGES):
-        for i in range(n):
-            tmp[i] = y[i]
-        for j in range(s):
-            a = _A[s, j] * h
-            if a != 0.0:
-                for i in range(n):
-                    tmp[i] += a * k[j, i]
-        _rhs(t + _C[s] * h, tmp, mc, model, frame, ic, kind, k[s])
-    for i in range(n):
-        y_new[i] = y[i]
-    for j in range(N_STAGES):
-        b = _B[j] * h
-        if b != 0.0:
-            for i in range(n):
-                y_new[i] += b * k[j, i]
-
-
-@jit
 def _shift_phase(y, period, advance_g):
     """:func:`spinorbit.core.elements.equations.reduce_phase` with the period P and advance Δg of the
     (constant) mean S, Z supplied: whole periods out of the working s, Δg each into z."""
-    sign = 1.0 if y[0] >= 0.0 else -1.0
-    periods = np.rint(sign * y[3] / period)
+    sign = 1.0 if y[ACTION_S] >= 0.0 else -1.0
+    periods = np.rint(sign * y[ANGLE_S] / period)
     if periods != 0.0:
-        y[3] -= sign * periods * period
-        z = y[4] + periods * advance_g
-        y[4] = z - 2.0 * math.pi * np.rint(z / (2.0 * math.pi))
-
-
-@jit
-def _rk8_scratch():
-    """Stage derivatives, stage state and new state of :func:`_rk8_step` (allocated once per run)."""
-    return np.empty((N_STAGES, 6)), np.empty(6), np.empty(6)
+        y[ANGLE_S] -= sign * periods * period
+        z = y[ANGLE_Z] + periods * advance_g
+        y[ANGLE_Z] = z - 2.0 * math.pi * np.rint(z / (2.0 * math.pi))
 
 
 @jit(inline="always")
 def _accept_step(y, y_new, free):
     """y ← y_new, whole periods of s moved into z (``free`` from :func:`free_motion_numbers`)."""
-    for c in range(6):
+    for c in range(ELEMENT_SIZE):
         y[c] = y_new[c]
-    _shift_phase(y, free[3], free[4])
+    _shift_phase(y, free[FREE_PERIOD], free[FREE_ADVANCE_G])
 
 
 @jit
 def _write_output(row, y, ic):
     """One output row: y in one representation (|κ s| ≤ 2K, :func:`reduce_phase`)."""
-    for c in range(6):
+    for c in range(ELEMENT_SIZE):
         row[c] = y[c]
     reduce_phase(row, ic)
-
-
-@jit(inline="always")
-def _landing_step(h, remaining):
-    """Step h shortened to land on an output ``remaining`` away: in one step if within 1 % of a
-    full step, else never leaving a sliver shorter than half a step."""
-    if remaining <= 1.01 * h:
-        return remaining
-    if remaining < 1.5 * h:
-        return 0.5 * remaining
-    return h
 
 
 @jit
@@ -273,7 +253,7 @@ def mean_elements_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, model, fr
     """
     y = el0.copy()
     t = t0
-    k, tmp, y_new = _rk8_scratch()
+    k, tmp, y_new = dop853_scratch(ELEMENT_SIZE)
     steps = 0
     for i in range(t_out.shape[0]):
         target = t_out[i]
@@ -287,8 +267,8 @@ def mean_elements_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, model, fr
             if rate > 0.0 and steps_per_turn > 0.0:
                 h = min(h, 2.0 * math.pi / (steps_per_turn * rate), RADIAL_STEP_FRACTION * radial_time)
             remaining = abs(target - t)
-            h = _landing_step(h, remaining)
-            _rk8_step(t, y, direction * h, mc, model, frame, ic, kind, k, tmp, y_new)
+            h = landing_step(h, remaining)
+            dop853_step(_rhs, (mc, model, frame, ic, kind), t, y, direction * h, k, tmp, y_new)
             t = target if h == remaining else t + direction * h
             _accept_step(y, y_new, free)
             steps += 1
@@ -348,8 +328,8 @@ def mean_elements_anomaly_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, m
     y = el0.copy()
     t = t0
     f = true_anomaly_of_time(t0, model, par)
-    free_rate = mc[MC_A] * el0[0]  # ds/dt of the free motion
-    k, tmp, y_new = _rk8_scratch()
+    free_rate = mc[MC_A] * el0[ACTION_S]  # ds/dt of the free motion
+    k, tmp, y_new = dop853_scratch(ELEMENT_SIZE)
     steps = 0
     for i in range(t_out.shape[0]):
         target = t_out[i]
@@ -363,14 +343,14 @@ def mean_elements_anomaly_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, m
                 return i, t, y, code, steps
             h = min(2.0 * math.pi / steps_per_turn, max_step / dt_df)
             remaining = abs(f_target - f)
-            h = _landing_step(h, remaining)
-            _rk8_step(f, y, direction * h, mc, model, frame, ic, RHS_DEGREE2_ANOMALY, k, tmp, y_new)
+            h = landing_step(h, remaining)
+            dop853_step(_rhs, (mc, model, frame, ic, RHS_DEGREE2_ANOMALY), f, y, direction * h, k, tmp, y_new)
             if h == remaining:
                 f, t_new = f_target, target
             else:
                 f += direction * h
                 t_new = time_of_true_anomaly(f, model, par)
-            y_new[3] += free_rate * (t_new - t)
+            y_new[ANGLE_S] += free_rate * (t_new - t)
             t = t_new
             _accept_step(y, y_new, free)
             steps += 1
@@ -549,7 +529,7 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
     done = 0
     steps = 0
     while done < t_out.size:
-        mc = mean_constants(mean[0], mean[1], ic, moments)
+        mc = mean_constants(mean[ACTION_S], mean[ACTION_Z], ic, moments)
         if anomaly:
             written, t_stop, y_stop, code, n_steps = mean_elements_anomaly_kernel(
                 mean, t, t_out[done:], float(max_step), steps_per_turn, mc, model, frame, ic, thresholds,

@@ -67,6 +67,8 @@ from spinorbit.core.math.rotations import quat_to_attitude, rot1
 from spinorbit.core.model.gravity_field import BODY_A, BODY_B, BODY_C
 
 ELEMENT_SIZE = 6
+#: Layout of a signed element vector: the actions (S, Z, H), then their angles (s, z, h).
+ACTION_S, ACTION_Z, ACTION_H, ANGLE_S, ANGLE_Z, ANGLE_H = range(ELEMENT_SIZE)
 
 #: Stop before the separatrix: below this 1 − m (SAM) or 1 − μ (LAM) the elliptic period grows like
 #: log(1/(1 − m)) and the Jacobian's d-derivatives like 1/(1 − m) (∂m/∂d), so the steps shrink and

@@ -23,8 +23,10 @@ Validity (checked at every step, :func:`validity_code`); averaging is refused wh
 
 There the run hands over to :func:`spinorbit.core.integrators.quaternion.integrate_quaternion`
 (osculating state from the mean one), continues in chunks of ``handover_chunk`` until the check
-passes again, and hands back (mean elements from the osculating ones). A hand-over that starts at
-the initial time continues from the given osculating state itself, not from a reconstruction.
+passes again, and hands back (mean elements from the osculating ones), through the package's one
+hand-over mechanism (:func:`spinorbit.core.integrators.handover.alternate_stretches`, which also
+serves the canonical elements ↔ quaternion hand-over). A hand-over that starts at the initial time
+continues from the given osculating state itself, not from a reconstruction.
 """
 
 import math
@@ -64,7 +66,7 @@ from spinorbit.core.integrators.elements import (
     elements_of_state,
     reference_frame_for,
 )
-from spinorbit.core.integrators.quaternion import integrate_quaternion
+from spinorbit.core.integrators.handover import alternate_stretches, quaternion_chunk
 from spinorbit.core.dynamics.validation import validate_output_times
 from spinorbit.core.model.perturbers import (
     K_E,
@@ -521,14 +523,16 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
     if handover_chunk is None:
         handover_chunk = 2.0 * math.pi / min(abs(omega_s), abs(omega_g))
     direction = 1.0 if t_out[-1] > t0 else -1.0
-    out_mean = np.full((t_out.size, 6), np.nan)
+    out_mean = np.full((t_out.size, ELEMENT_SIZE), np.nan)
     out_state = np.full((t_out.size, 7), np.nan) if osculating else None
     segments = []
-    t = t0
-    exact = y0  # the last osculating state known without short-period reconstruction, at time t
-    done = 0
     steps = 0
-    while done < t_out.size:
+    reason = ""  # why the current full segment started
+
+    def averaged_stretch(t, state, done):
+        """Mean elements from t until averaging is invalid; state = (exact osculating state at t or None, mean)."""
+        nonlocal steps, reason
+        exact, mean = state
         mc = mean_constants(mean[ACTION_S], mean[ACTION_Z], ic, moments)
         if anomaly:
             written, t_stop, y_stop, code, n_steps = mean_elements_anomaly_kernel(
@@ -546,36 +550,35 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
         segments.append((t, float(t_stop) if code != VALID else float(t_out[-1]), "averaged", ""))
         done += written
         if code == VALID:
-            break
+            return done, float(t_out[-1]), state, None
         if not hand_over:
             raise ValueError(f"averaging is invalid at t = {t_stop!r}: {_WHY[code]}; allow hand_over=True "
                              "or integrate this stretch with integrate_quaternion.")
-        # Full integration in chunks until the averaged theory is valid again.
         if float(t_stop) == t:
             y = exact  # invalid where the segment starts: continue from the exact state
         else:
             t = float(t_stop)
             y = state_of_elements(mean_to_osculating(t, y_stop, model, frame, ic), frame, moments)
         reason = _WHY[code]
-        while True:
-            t_next = t + direction * handover_chunk
-            pending = t_out[done:]
-            inside = pending[(pending - t_next) * direction < 0]
-            grid = np.concatenate([inside, [t_next]])
-            ys = integrate_quaternion(y, t, grid, model, rtol=rtol)
-            for i, yi in enumerate(ys[:-1]):
-                el = elements_of_state(yi, model, frame)
-                out_mean[done + i] = osculating_to_mean(float(inside[i]), el, model, frame, ic)
-                if osculating:
-                    out_state[done + i] = yi
-            done += inside.size
-            segments.append((t, float(t_next) if done < t_out.size else float(t_out[-1]), "full", reason))
-            t, y = float(t_next), ys[-1]
-            if done >= t_out.size:
-                break
-            el = elements_of_state(y, model, frame)
-            if validity_code(t, model, free_motion_numbers(el, ic), thresholds) == VALID:
-                mean = osculating_to_mean(t, el, model, frame, ic)
-                exact = y
-                break
+        return done, t, (y, None), reason
+
+    def full_chunk(t, state, done):
+        """The full integration over one chunk; hands back with the mean elements where averaging is valid."""
+        y, _ = state
+        n, ys, t_end, y_end = quaternion_chunk(y, t, t_out, done, handover_chunk, direction, model, rtol)
+        for i in range(n):
+            el = elements_of_state(ys[i], model, frame)
+            out_mean[done + i] = osculating_to_mean(float(t_out[done + i]), el, model, frame, ic)
+            if osculating:
+                out_state[done + i] = ys[i]
+        done += n
+        segments.append((t, float(t_end), "full", reason))
+        if done < t_out.size:
+            el = elements_of_state(y_end, model, frame)
+            if validity_code(t_end, model, free_motion_numbers(el, ic), thresholds) == VALID:
+                return done, float(t_end), (y_end, osculating_to_mean(t_end, el, model, frame, ic)), "valid again"
+        return done, float(t_end), (y_end, None), None
+
+    # Full integration in chunks where the averaged theory fails, until it is valid again.
+    alternate_stretches(t0, (y0, mean), t_out.size, (averaged_stretch, full_chunk), ("averaged", "full"))
     return AveragedResult(t_out, out_mean, out_state, segments, frame, steps)

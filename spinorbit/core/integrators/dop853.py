@@ -101,7 +101,8 @@ class IntegrationError(RuntimeError):
 
 @jit(inline="always")
 def stage_input(y, h, k, s, out):
-    """out = y + h Σ_{j<s} A[s, j] k_j, the state at which stage s is evaluated.
+    """out = y + h Σ_{j<s} A[s, j] k_j, the state at which stage s is evaluated (s = 12: the 8th-order
+    solution, A[12, :12] being B).
 
     The sum runs over j outside, components inside (contiguous rows of k) and skips the tableau's
     zeros (a third of the entries below the diagonal).
@@ -119,21 +120,6 @@ def stage_input(y, h, k, s, out):
 
 
 @jit(inline="always")
-def eighth_order_solution(y, h, k, y_new):
-    """y_new = y + h Σ_j B_j k_j over the 12 stages."""
-    n = y.shape[0]
-    for i in range(n):
-        y_new[i] = 0.0
-    for j in range(N_STAGES):
-        b = B[j] * h
-        if b != 0.0:
-            for i in range(n):
-                y_new[i] += b * k[j, i]
-    for i in range(n):
-        y_new[i] += y[i]
-
-
-@jit(inline="always")
 def dop853_stages(rhs, params, t, y, h, k, tmp, y_new):
     """Stages 1..11 from (t, y) with k[0] = f(t, y) set by the caller; the 8th-order result into y_new.
 
@@ -143,7 +129,7 @@ def dop853_stages(rhs, params, t, y, h, k, tmp, y_new):
     for s in range(1, N_STAGES):
         stage_input(y, h, k, s, tmp)
         rhs(t + C[s] * h, tmp, params, k[s])
-    eighth_order_solution(y, h, k, y_new)
+    stage_input(y, h, k, N_STAGES, y_new)  # row 12 of A is B: the 8th-order solution
 
 
 @jit(inline="always")

@@ -39,20 +39,17 @@ from spinorbit.core.dynamics.equations import STATE_SIZE, rhs_into
 from spinorbit.core.dynamics.validation import validate_output_times, validate_sampled_span, validate_state
 from spinorbit.core.integrators.dop853 import (
     DEFAULT_MAX_STEPS,
-    STAT_ACCEPTED,
-    STAT_REJECTED,
-    STAT_RHS_CALLS,
     STAT_STATUS,
-    STATUS_MAX_STEPS,
     STATUS_MESSAGES,
-    STATUS_NOT_FINITE,
-    STATUS_STEP_TOO_SMALL,
     STATUS_SUCCESS,
     IntegrationError,
     dop853_fixed_steps,
     dop853_integrate,
     never_singular,
 )
+# The stats layout and stop codes of integrate_dop853_kernel, importable from here as before the engine.
+from spinorbit.core.integrators.dop853 import STAT_ACCEPTED, STAT_REJECTED, STAT_RHS_CALLS  # noqa: F401
+from spinorbit.core.integrators.dop853 import STATUS_MAX_STEPS, STATUS_NOT_FINITE, STATUS_STEP_TOO_SMALL  # noqa: F401
 from spinorbit.core.jit import jit
 from spinorbit.core.model.lunar_interior import INTERIOR_STATE_SIZE, has_interior
 

@@ -82,16 +82,13 @@ from spinorbit.core.averaging.short_period import mean_to_osculating, osculating
 
 #: Steps of the mean equations per 2π/n, n the fastest angular rate of a perturber's direction at
 #: the step's start (the time-stepped kernel: several or non-elliptic perturbers, quadrature,
-#: hand-back after a flyby). Measured over 1000 orbits against 96 per turn: Apophis-like 12 → 7e-9
-#: (rad or /Z, slow quantities); Toutatis-like (e = 0.63) 12 → 1.9e-3, 24 → 5e-7, 48 → 3e-10 — a
-#: stepping error 20× below that scene's averaging error (4e-2), 1e4× below Apophis' (1e-4).
+#: hand-back after a flyby): a stepping error far below the averaging error of the scenes measured
+#: (``docs/averaged.md``, "Stepping").
 STEPS_PER_TURN = 12.0
 #: Steps per 2π of the perturber's true anomaly (:func:`mean_elements_anomaly_kernel`, one elliptic
-#: perturber). Measured over 1000 orbits against 96 per turn (slow quantities, rad or /Z):
-#: Apophis-like 12 → 3e-10, 8 → 1.4e-8, 6 → 1.8e-7, 4 → 5.6e-6; Toutatis-like 12 → 1.9e-8,
-#: 8 → 5.6e-7, 6 → 5.0e-6, 4 → 7.7e-5. 8 keeps the stepping error ≥ 5000× (Apophis-like) and
-#: ≥ 6e4× (Toutatis-like) below the first-order theory's own error over the span; both scale with
-#: the torque (stepping ∝ ε, theory ∝ ε²), so at 100× weaker torques it is still 50× below.
+#: perturber): the stepping error stays ≥ 5000× below the first-order theory's own error over the
+#: span, and both scale with the torque (stepping ∝ ε, theory ∝ ε²), so the margin holds down to
+#: ~100× weaker torques (``docs/averaged.md``).
 STEPS_PER_ANOMALY_TURN = 8.0
 #: Largest step as a fraction of the radial time r/|ṙ| of a perturber not on an elliptic orbit: on a
 #: near-radial approach (a flyby) the rate n grows like 1/r², which the n-limit alone would step over.

@@ -31,7 +31,7 @@ Design choices
   the motion is unchanged). s itself is integrated (not s − a S t: S is not constant), and stays
   small, so its rounding does not grow with the span either. Without the shift ∂(l, g)/∂(S, Z),
   hence the RHS of s and z, carry terms proportional to s and the steps shrink as the run goes on
-  (2× more steps on 10³ turns of scene (c)). Element outputs are in the shifted representation.
+  (``docs/elements_integrator.md``). Element outputs are in the shifted representation.
 * **Singular sets are detected, not crossed**: at the end of each accepted step the RHS reports
   1 − m (or 1 − μ), sin J, sin I, the sine of the angle of M from the A axis and, for an exactly
   symmetric body, the sine of its angle from the equal-moment plane (permanent rotations); below the
@@ -82,18 +82,16 @@ MIN_SIN_J_A = 1e-3
 MIN_SIN_I = 1e-3
 #: Stop near a permanent rotation of an exactly symmetric body (M within angle P of the equal-moment
 #: plane: B = C, or A = B): the gap of the motion to it, (a − c) sin² P, is resolved by (S, Z) only to
-#: ≈ ε d, so the phase the elements carry is wrong by ≈ ε / sin² P, whatever rtol. Measured over 20
-#: turns under a weak torque (benchmarks/accuracy_symmetric_permanent.py, table in
-#: docs/elements_integrator.md): 5–30 ε / sin² P, i.e. 4.5e-11 (B = C) and 1.2e-11 rad (A = B) at
-#: sin P = 1e-2, no more than quaternion DOP853's own error at rtol 1e-12 (4.1e-11, 4.3e-10), but
-#: 4.2× it at 3e-3 and 108× at 1e-3 (B = C). A fixed value like the other thresholds (the kernel
-#: sees atol, not rtol); at rtol < 1e-12 the elements near it are less accurate than rtol asks.
+#: ≈ ε d, so the phase the elements carry is wrong by ≈ ε / sin² P, whatever rtol; 1e-2 is where
+#: that error reaches quaternion DOP853's own at rtol 1e-12 (``docs/elements_integrator.md``,
+#: ``benchmarks/accuracy_symmetric_permanent.py``). A fixed value like the other thresholds (the
+#: kernel sees atol, not rtol); at rtol < 1e-12 the elements near it are less accurate than rtol asks.
 MIN_SIN_P = 1e-2
 #: Refuse bodies closer to a sphere than (C − A)/C < MIN_ASPHERICITY_PER_RTOL × rtol: S lies in
 #: [√(A/C) Z, Z], an interval of relative width ≈ (C − A)/(2C), and the step error test allows
 #: rtol·G in S; below this ratio S (hence the energy, the mode parameter and the period) is not
 #: located within its interval to 1 %, and the run returns an attitude that is wrong by O(1) rad
-#: without any warning (measured 2.9 rad after 20 turns at (C − A)/C = 2e-12, rtol 1e-12).
+#: without any warning (``docs/elements_integrator.md``).
 MIN_ASPHERICITY_PER_RTOL = 200.0
 #: Same rule and value as spinorbit.state.AUTO_REFERENCE_MIN_SIN_I: if the initial sin I is below
 #: this, H and h are referred to the inertial frame turned by 90° about x.

@@ -85,6 +85,14 @@ def _cauchy(s, a, b, k):
 
 
 @jit(inline="always")
+def _set_vector(s, row, k, x, y, z):
+    """The order-k coefficients of the 3-vector series in rows row, row + 1, row + 2."""
+    s[row, k] = x
+    s[row + 1, k] = y
+    s[row + 2, k] = z
+
+
+@jit(inline="always")
 def _cauchy_cross(s, a, b, k, lo):
     """k-th coefficient of the cross product of the 3-row series at rows a and b: Σ_{j=lo}^{k} a^[j] × b^[k−j].
 
@@ -218,20 +226,21 @@ def taylor_coefficients_into(t, model, s, n_pert, order, h_bound, orbit_tol, orb
             lo = max(0, k - m)  # r, |r|⁻⁵ are zero above order m
             # c = u × r, u = (q1, q2, q3)
             cx, cy, cz = _cauchy_cross(s, _Q0 + 1, b + _X, k, lo)
-            s[b + _C, k] = cx
-            s[b + _C + 1, k] = cy
-            s[b + _C + 2, k] = cz
+            _set_vector(s, b + _C, k, cx, cy, cz)
             # r_body = r + 2 (u × c − q0 c)
-            ux, uy, uz = _cauchy_cross(s, _Q0 + 1, b + _C, k, 0)
-            bx = ux - _cauchy(s, _Q0, b + _C, k)
-            by = uy - _cauchy(s, _Q0, b + _C + 1, k)
-            bz = uz - _cauchy(s, _Q0, b + _C + 2, k)
+            bx = 0.0
+            by = 0.0
+            bz = 0.0
+            for j in range(k + 1):
+                q0, q1, q2, q3 = s[_Q0, j], s[_Q0 + 1, j], s[_Q0 + 2, j], s[_Q0 + 3, j]
+                cx, cy, cz = s[b + _C, k - j], s[b + _C + 1, k - j], s[b + _C + 2, k - j]
+                bx += q2 * cz - q3 * cy - q0 * cx
+                by += q3 * cx - q1 * cz - q0 * cy
+                bz += q1 * cy - q2 * cx - q0 * cz
             xk = s[b + _X, k] if k <= m else 0.0
             yk = s[b + _X + 1, k] if k <= m else 0.0
             zk = s[b + _X + 2, k] if k <= m else 0.0
-            s[b + _B, k] = xk + 2.0 * bx
-            s[b + _B + 1, k] = yk + 2.0 * by
-            s[b + _B + 2, k] = zk + 2.0 * bz
+            _set_vector(s, b + _B, k, xk + 2.0 * bx, yk + 2.0 * by, zk + 2.0 * bz)
             # Pair products (y z, z x, x y) of r_body, then N = 3μ |r|⁻⁵ ((C − B) yz, (A − C) zx, (B − A) xy)
             px = 0.0
             py = 0.0
@@ -241,9 +250,7 @@ def taylor_coefficients_into(t, model, s, n_pert, order, h_bound, orbit_tol, orb
                 px += byj * s[b + _B + 2, k - j]
                 py += bzj * s[b + _B, k - j]
                 pz += bxj * s[b + _B + 1, k - j]
-            s[b + _P, k] = px
-            s[b + _P + 1, k] = py
-            s[b + _P + 2, k] = pz
+            _set_vector(s, b + _P, k, px, py, pz)
             sx = 0.0
             sy = 0.0
             sz = 0.0
@@ -256,9 +263,7 @@ def taylor_coefficients_into(t, model, s, n_pert, order, h_bound, orbit_tol, orb
             nx += three_mu * (c_mom - b_mom) * sx
             ny += three_mu * (a_mom - c_mom) * sy
             nz += three_mu * (b_mom - a_mom) * sz
-        s[_N0, k] = nx
-        s[_N0 + 1, k] = ny
-        s[_N0 + 2, k] = nz
+        _set_vector(s, _N0, k, nx, ny, nz)
         # --- Euler: A ω̇x = (B − C) ωy ωz + Nx, cyclic; and q̇ = ½ q ⊗ (0, ω)
         wyz = 0.0
         wzx = 0.0

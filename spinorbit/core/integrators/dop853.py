@@ -108,9 +108,10 @@ def stage_input(y, h, k, s, out):
     zeros (a third of the entries below the diagonal).
     """
     n = y.shape[0]
+    a = A[s, 0] * h  # never a zero of the tableau; 0.0 + keeps the sign of zero of a sum started at 0
     for i in range(n):
-        out[i] = 0.0
-    for j in range(s):
+        out[i] = 0.0 + a * k[0, i]
+    for j in range(1, s):
         a = A[s, j] * h
         if a != 0.0:
             for i in range(n):
@@ -214,16 +215,6 @@ def rejected_step_factor(err):
 
 
 @jit
-def extra_stage_input(y, h, k, s, tmp):
-    """State at which the dense output's extra stage s is evaluated: y + h Σ_j A[s, j] k_j."""
-    for i in range(y.shape[0]):
-        acc = 0.0
-        for j in range(s):
-            acc += A[s, j] * k[j, i]
-        tmp[i] = y[i] + h * acc
-
-
-@jit
 def dense_rows(y, y_new, f_new, h, k, coeffs):
     """The 7 coefficient rows of DOP853's continuous extension from the 16 stages (scipy's F)."""
     for i in range(y.shape[0]):
@@ -242,7 +233,7 @@ def dense_rows(y, y_new, f_new, h, k, coeffs):
 def dense_coefficients(rhs, params, t, y, y_new, f_new, h, k, tmp, coeffs):
     """Extra stages 13..15 of the step (t, y) → (t + h, y_new), then the continuous-extension rows."""
     for s in range(N_STAGES + 1, N_STAGES_EXTENDED):
-        extra_stage_input(y, h, k, s, tmp)
+        stage_input(y, h, k, s, tmp)
         rhs(t + C[s] * h, tmp, params, k[s])
     dense_rows(y, y_new, f_new, h, k, coeffs)
 

@@ -14,9 +14,12 @@ Why DOP853 (Dormand & Prince's 8(5,3) pair, Hairer, Nørsett & Wanner, Solving O
   far from the asymptotic regime;
 - it has a 7th-order continuous extension (3 extra stages only on steps that contain output times), so
   output at requested times does not shorten the steps;
-- it is scipy's ``DOP853`` with the same coefficients (``_dop853_tableau.py``) and the same
+- it is scipy's ``DOP853`` with the same coefficients (:mod:`.dop853_tableau`) and the same
   error norm, so the work-precision comparison against scipy measures the implementation, not the
   method.
+
+The loop is the package's one DOP853 engine (:mod:`.dop853`) with :func:`rhs_into`, the plain
+step-size controller and the renormalisation below as its after-step and output hooks.
 
 Error control: on an accepted step, sqrt(mean_i (err_i / sc_i)²) ≤ 1 with
 sc_i = atol_i + rtol · max(|y_i|, |y_new,i|) over all seven components (q, ω), err being the combined

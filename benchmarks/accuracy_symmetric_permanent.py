@@ -17,6 +17,7 @@ import math
 import sys
 from pathlib import Path
 
+import numba
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -43,7 +44,7 @@ BODIES = [
 def without_sin_p_guard():
     """Run the elements' kernel as Python with every singular-set test but the one on sin P."""
     original = integrate_elements_module._singular_status
-    integrate_elements_module._singular_status = lambda d: original((d[0], d[1], d[2], d[3], 1.0))
+    integrate_elements_module._singular_status = numba.njit(lambda d: original((d[0], d[1], d[2], d[3], 1.0)))
     integrate_elements_module.integrate_elements_kernel = integrate_elements_module.integrate_elements_kernel.py_func
 
 

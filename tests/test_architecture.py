@@ -45,15 +45,6 @@ ANYWHERE = ("spinorbit", "spinorbit.old_paths")
 KNOWN_CIRCLES = [
 ]
 KNOWN_PRIVATE_CROSSINGS = [
-    "spinorbit.core.integrators.elements: from spinorbit.core.integrators.quaternion import _A",
-    "spinorbit.core.integrators.elements: from spinorbit.core.integrators.quaternion import _B",
-    "spinorbit.core.integrators.elements: from spinorbit.core.integrators.quaternion import _C",
-    "spinorbit.core.integrators.elements: from spinorbit.core.integrators.quaternion import _dense_polynomial",
-    "spinorbit.core.integrators.elements: from spinorbit.core.integrators.quaternion import _dense_rows",
-    "spinorbit.core.integrators.elements: from spinorbit.core.integrators.quaternion import _error_norm",
-    "spinorbit.core.integrators.elements: from spinorbit.core.integrators.quaternion import _extra_stage_input",
-    "spinorbit.core.integrators.handover: from spinorbit.core.integrators.elements import _SINGULAR",
-    "spinorbit.core.integrators.handover: from spinorbit.core.integrators.elements import _STATUS_MESSAGES",
 ]
 KNOWN_LONG = [
 ]

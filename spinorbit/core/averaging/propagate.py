@@ -23,18 +23,17 @@ Validity (checked at every step, :func:`validity_code`); averaging is refused wh
 
 There the run hands over to :func:`spinorbit.core.integrators.quaternion.integrate_quaternion`
 (osculating state from the mean one), continues in chunks of ``handover_chunk`` until the check
-passes again, and hands back (mean elements from the osculating ones). A hand-over that starts at
-the initial time continues from the given osculating state itself, not from a reconstruction.
+passes again, and hands back (mean elements from the osculating ones), through the package's one
+hand-over mechanism (:func:`spinorbit.core.integrators.handover.alternate_stretches`, which also
+serves the canonical elements ↔ quaternion hand-over). A hand-over that starts at the initial time
+continues from the given osculating state itself, not from a reconstruction.
 """
 
 import math
 
 import numpy as np
 
-from spinorbit.core.integrators.dop853_tableau import N_STAGES
-from spinorbit.core.integrators.dop853_tableau import A as _A_FULL
-from spinorbit.core.integrators.dop853_tableau import B as _B_FULL
-from spinorbit.core.integrators.dop853_tableau import C as _C_FULL
+from spinorbit.core.integrators.dop853 import dop853_scratch, dop853_step, landing_step
 from spinorbit.core.jit import jit
 from spinorbit.core.averaging.mean_equations import (
     MC_A,
@@ -58,8 +57,16 @@ from spinorbit.core.dynamics.equations import MODEL_PERTURBERS
 from spinorbit.core.dynamics.validation import validate_sampled_span, validate_state
 from spinorbit.core.elements.equations import attitude_and_momentum, inertial_quaternion, reduce_phase
 from spinorbit.core.model.gravity_field import BODY_NMAX
-from spinorbit.core.integrators.elements import elements_of_state, reference_frame_for
-from spinorbit.core.integrators.quaternion import integrate_quaternion
+from spinorbit.core.integrators.elements import (
+    ACTION_S,
+    ACTION_Z,
+    ANGLE_S,
+    ANGLE_Z,
+    ELEMENT_SIZE,
+    elements_of_state,
+    reference_frame_for,
+)
+from spinorbit.core.integrators.handover import alternate_stretches, quaternion_chunk
 from spinorbit.core.dynamics.validation import validate_output_times
 from spinorbit.core.model.perturbers import (
     K_E,
@@ -75,24 +82,17 @@ from spinorbit.core.averaging.short_period import mean_to_osculating, osculating
 
 #: Steps of the mean equations per 2π/n, n the fastest angular rate of a perturber's direction at
 #: the step's start (the time-stepped kernel: several or non-elliptic perturbers, quadrature,
-#: hand-back after a flyby). Measured over 1000 orbits against 96 per turn: Apophis-like 12 → 7e-9
-#: (rad or /Z, slow quantities); Toutatis-like (e = 0.63) 12 → 1.9e-3, 24 → 5e-7, 48 → 3e-10 — a
-#: stepping error 20× below that scene's averaging error (4e-2), 1e4× below Apophis' (1e-4).
+#: hand-back after a flyby): a stepping error far below the averaging error of the scenes measured
+#: (``docs/averaged.md``, "Stepping").
 STEPS_PER_TURN = 12.0
 #: Steps per 2π of the perturber's true anomaly (:func:`mean_elements_anomaly_kernel`, one elliptic
-#: perturber). Measured over 1000 orbits against 96 per turn (slow quantities, rad or /Z):
-#: Apophis-like 12 → 3e-10, 8 → 1.4e-8, 6 → 1.8e-7, 4 → 5.6e-6; Toutatis-like 12 → 1.9e-8,
-#: 8 → 5.6e-7, 6 → 5.0e-6, 4 → 7.7e-5. 8 keeps the stepping error ≥ 5000× (Apophis-like) and
-#: ≥ 6e4× (Toutatis-like) below the first-order theory's own error over the span; both scale with
-#: the torque (stepping ∝ ε, theory ∝ ε²), so at 100× weaker torques it is still 50× below.
+#: perturber): the stepping error stays ≥ 5000× below the first-order theory's own error over the
+#: span, and both scale with the torque (stepping ∝ ε, theory ∝ ε²), so the margin holds down to
+#: ~100× weaker torques (``docs/averaged.md``).
 STEPS_PER_ANOMALY_TURN = 8.0
 #: Largest step as a fraction of the radial time r/|ṙ| of a perturber not on an elliptic orbit: on a
 #: near-radial approach (a flyby) the rate n grows like 1/r², which the n-limit alone would step over.
 RADIAL_STEP_FRACTION = 0.1
-
-_A = np.ascontiguousarray(_A_FULL[:N_STAGES, :N_STAGES])
-_B = np.ascontiguousarray(_B_FULL)
-_C = np.ascontiguousarray(_C_FULL[:N_STAGES])
 
 #: Default validity thresholds (module docstring). 5: the first-order theory's neglected terms are
 #: ~ (n/Ω)²; Toutatis' slowest combination ω_s − ω_g is ~9× its perihelion rate, so 5 keeps it.
@@ -111,6 +111,11 @@ _WHY = {INVALID_RESONANCE: "resonance / fast perturber (a fast frequency is clos
         INVALID_SEPARATRIX: "near the separatrix"}
 
 
+# Layout of the array of :func:`free_motion_numbers`.
+FREE_OMEGA_MIN, FREE_ASYMMETRY, FREE_SEPARATRIX, FREE_PERIOD, FREE_ADVANCE_G = range(5)
+FREE_SIZE = 5
+
+
 @jit
 def free_motion_numbers(elements, ic):
     """(Ω_min, (C − A)/C, 1 − m, P, Δg) of the free motion of the elements' (S, Z): the slowest fast
@@ -124,10 +129,18 @@ def free_motion_numbers(elements, ic):
             if j == 0 and k <= 0:
                 continue
             omega_min = min(omega_min, abs(j * omega_s + k * omega_g))
-    mo = motion_from_elements(abs(elements[0]), elements[1], ic)
+    big_s, big_z = elements[ACTION_S], elements[ACTION_Z]
+    mo = motion_from_elements(abs(big_s), big_z, ic)
     sep = 0.0 if mo[MO_MODE] == MODE_UNIFORM else mo[MO_PARAM_C]
-    period, nu, _ = torus_frequencies(elements[0], elements[1], ic)
-    return np.array([omega_min, ic[5] / ic[0], sep, period, nu * period])  # (a − c)/a = 1 − A/C
+    period, nu, _ = torus_frequencies(big_s, big_z, ic)
+    a, _, _, _, _, a_minus_c = ic
+    free = np.empty(FREE_SIZE)
+    free[FREE_OMEGA_MIN] = omega_min
+    free[FREE_ASYMMETRY] = a_minus_c / a  # (a − c)/a = 1 − A/C = (C − A)/C
+    free[FREE_SEPARATRIX] = sep
+    free[FREE_PERIOD] = period
+    free[FREE_ADVANCE_G] = nu * period
+    return free
 
 
 @jit
@@ -139,14 +152,14 @@ def perturber_numbers(t, model):
     radial_time = np.inf
     for p in range(int(model[MODEL_PERTURBERS])):
         row = MODEL_PERTURBERS + 1 + p * PERTURBER_ROW
-        xv = perturber_state(t, model, row)
-        r2 = xv[0] ** 2 + xv[1] ** 2 + xv[2] ** 2
-        cx = xv[1] * xv[5] - xv[2] * xv[4]
-        cy = xv[2] * xv[3] - xv[0] * xv[5]
-        cz = xv[0] * xv[4] - xv[1] * xv[3]
+        x, y, z, vx, vy, vz = perturber_state(t, model, row)
+        r2 = x * x + y * y + z * z
+        cx = y * vz - z * vy
+        cy = z * vx - x * vz
+        cz = x * vy - y * vx
         rate_max = max(rate_max, math.sqrt(cx * cx + cy * cy + cz * cz) / r2)
         strength += 3.0 * model[row + 1] / r2 ** 1.5
-        r_dot = abs(xv[0] * xv[3] + xv[1] * xv[4] + xv[2] * xv[5])  # r·v = r ṙ
+        r_dot = abs(x * vx + y * vy + z * vz)  # r·v = r ṙ
         bound = model[row] == KIND_KEPLER and model[row + 2 + K_E] < 1.0
         if r_dot > 0.0 and not bound:  # elliptic orbits: the angular-rate limit is enough
             radial_time = min(radial_time, r2 / r_dot)
@@ -157,8 +170,9 @@ def perturber_numbers(t, model):
 def validity_numbers(t, model, free):
     """(Ω_min/n_max, ε, 1 − m) at time t; ``free`` from :func:`free_motion_numbers`."""
     rate_max, strength, _ = perturber_numbers(t, model)
-    ratio = free[0] / rate_max if rate_max > 0.0 else np.inf
-    return ratio, strength * free[1] / (free[0] * free[0]), free[2]
+    omega_min = free[FREE_OMEGA_MIN]
+    ratio = omega_min / rate_max if rate_max > 0.0 else np.inf
+    return ratio, strength * free[FREE_ASYMMETRY] / (omega_min * omega_min), free[FREE_SEPARATRIX]
 
 
 @jit
@@ -170,20 +184,23 @@ def validity_code(t, model, free, thresholds):
 
 @jit
 def _validity_from_numbers(rate_max, strength, free, thresholds):
-    ratio = free[0] / rate_max if rate_max > 0.0 else np.inf
-    eps = strength * free[1] / (free[0] * free[0])
-    sep = free[2]
-    if not (sep >= thresholds[2]):
+    omega_min = free[FREE_OMEGA_MIN]
+    ratio = omega_min / rate_max if rate_max > 0.0 else np.inf
+    eps = strength * free[FREE_ASYMMETRY] / (omega_min * omega_min)
+    min_ratio, max_eps, min_separatrix = thresholds
+    if not (free[FREE_SEPARATRIX] >= min_separatrix):
         return INVALID_SEPARATRIX
-    if not (ratio >= thresholds[0]):
+    if not (ratio >= min_ratio):
         return INVALID_RESONANCE
-    if not (eps <= thresholds[1]):
+    if not (eps <= max_eps):
         return INVALID_PERTURBATION
     return VALID
 
 
 @jit(inline="always")
-def _rhs(t, y, mc, model, frame, ic, kind, dy):
+def _rhs(t, y, params, dy):
+    """The mean equations in the engine's form; params = (mc, model, frame, ic, RHS_* kind)."""
+    mc, model, frame, ic, kind = params
     if kind == RHS_DEGREE2_ANOMALY:
         degree2_mean_rhs_anomaly(t, y, mc, model, frame, dy)
     elif kind == RHS_QUADRATURE:
@@ -193,69 +210,31 @@ def _rhs(t, y, mc, model, frame, ic, kind, dy):
 
 
 @jit
-def _rk8_step(t, y, h, mc, model, frame, ic, kind, k, tmp, y_new):
-    n = y.shape[0]
-    for s in range(N_STAGES):
-        for i in range(n):
-            tmp[i] = y[i]
-        for j in range(s):
-            a = _A[s, j] * h
-            if a != 0.0:
-                for i in range(n):
-                    tmp[i] += a * k[j, i]
-        _rhs(t + _C[s] * h, tmp, mc, model, frame, ic, kind, k[s])
-    for i in range(n):
-        y_new[i] = y[i]
-    for j in range(N_STAGES):
-        b = _B[j] * h
-        if b != 0.0:
-            for i in range(n):
-                y_new[i] += b * k[j, i]
-
-
-@jit
 def _shift_phase(y, period, advance_g):
     """:func:`spinorbit.core.elements.equations.reduce_phase` with the period P and advance Δg of the
     (constant) mean S, Z supplied: whole periods out of the working s, Δg each into z."""
-    sign = 1.0 if y[0] >= 0.0 else -1.0
-    periods = np.rint(sign * y[3] / period)
+    sign = 1.0 if y[ACTION_S] >= 0.0 else -1.0
+    periods = np.rint(sign * y[ANGLE_S] / period)
     if periods != 0.0:
-        y[3] -= sign * periods * period
-        z = y[4] + periods * advance_g
-        y[4] = z - 2.0 * math.pi * np.rint(z / (2.0 * math.pi))
-
-
-@jit
-def _rk8_scratch():
-    """Stage derivatives, stage state and new state of :func:`_rk8_step` (allocated once per run)."""
-    return np.empty((N_STAGES, 6)), np.empty(6), np.empty(6)
+        y[ANGLE_S] -= sign * periods * period
+        z = y[ANGLE_Z] + periods * advance_g
+        y[ANGLE_Z] = z - 2.0 * math.pi * np.rint(z / (2.0 * math.pi))
 
 
 @jit(inline="always")
 def _accept_step(y, y_new, free):
     """y ← y_new, whole periods of s moved into z (``free`` from :func:`free_motion_numbers`)."""
-    for c in range(6):
+    for c in range(ELEMENT_SIZE):
         y[c] = y_new[c]
-    _shift_phase(y, free[3], free[4])
+    _shift_phase(y, free[FREE_PERIOD], free[FREE_ADVANCE_G])
 
 
 @jit
 def _write_output(row, y, ic):
     """One output row: y in one representation (|κ s| ≤ 2K, :func:`reduce_phase`)."""
-    for c in range(6):
+    for c in range(ELEMENT_SIZE):
         row[c] = y[c]
     reduce_phase(row, ic)
-
-
-@jit(inline="always")
-def _landing_step(h, remaining):
-    """Step h shortened to land on an output ``remaining`` away: in one step if within 1 % of a
-    full step, else never leaving a sliver shorter than half a step."""
-    if remaining <= 1.01 * h:
-        return remaining
-    if remaining < 1.5 * h:
-        return 0.5 * remaining
-    return h
 
 
 @jit
@@ -273,7 +252,7 @@ def mean_elements_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, model, fr
     """
     y = el0.copy()
     t = t0
-    k, tmp, y_new = _rk8_scratch()
+    k, tmp, y_new = dop853_scratch(ELEMENT_SIZE)
     steps = 0
     for i in range(t_out.shape[0]):
         target = t_out[i]
@@ -287,8 +266,8 @@ def mean_elements_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, model, fr
             if rate > 0.0 and steps_per_turn > 0.0:
                 h = min(h, 2.0 * math.pi / (steps_per_turn * rate), RADIAL_STEP_FRACTION * radial_time)
             remaining = abs(target - t)
-            h = _landing_step(h, remaining)
-            _rk8_step(t, y, direction * h, mc, model, frame, ic, kind, k, tmp, y_new)
+            h = landing_step(h, remaining)
+            dop853_step(_rhs, (mc, model, frame, ic, kind), t, y, direction * h, k, tmp, y_new)
             t = target if h == remaining else t + direction * h
             _accept_step(y, y_new, free)
             steps += 1
@@ -348,8 +327,8 @@ def mean_elements_anomaly_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, m
     y = el0.copy()
     t = t0
     f = true_anomaly_of_time(t0, model, par)
-    free_rate = mc[MC_A] * el0[0]  # ds/dt of the free motion
-    k, tmp, y_new = _rk8_scratch()
+    free_rate = mc[MC_A] * el0[ACTION_S]  # ds/dt of the free motion
+    k, tmp, y_new = dop853_scratch(ELEMENT_SIZE)
     steps = 0
     for i in range(t_out.shape[0]):
         target = t_out[i]
@@ -363,14 +342,14 @@ def mean_elements_anomaly_kernel(el0, t0, t_out, max_step, steps_per_turn, mc, m
                 return i, t, y, code, steps
             h = min(2.0 * math.pi / steps_per_turn, max_step / dt_df)
             remaining = abs(f_target - f)
-            h = _landing_step(h, remaining)
-            _rk8_step(f, y, direction * h, mc, model, frame, ic, RHS_DEGREE2_ANOMALY, k, tmp, y_new)
+            h = landing_step(h, remaining)
+            dop853_step(_rhs, (mc, model, frame, ic, RHS_DEGREE2_ANOMALY), f, y, direction * h, k, tmp, y_new)
             if h == remaining:
                 f, t_new = f_target, target
             else:
                 f += direction * h
                 t_new = time_of_true_anomaly(f, model, par)
-            y_new[3] += free_rate * (t_new - t)
+            y_new[ANGLE_S] += free_rate * (t_new - t)
             t = t_new
             _accept_step(y, y_new, free)
             steps += 1
@@ -541,15 +520,17 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
     if handover_chunk is None:
         handover_chunk = 2.0 * math.pi / min(abs(omega_s), abs(omega_g))
     direction = 1.0 if t_out[-1] > t0 else -1.0
-    out_mean = np.full((t_out.size, 6), np.nan)
+    out_mean = np.full((t_out.size, ELEMENT_SIZE), np.nan)
     out_state = np.full((t_out.size, 7), np.nan) if osculating else None
     segments = []
-    t = t0
-    exact = y0  # the last osculating state known without short-period reconstruction, at time t
-    done = 0
     steps = 0
-    while done < t_out.size:
-        mc = mean_constants(mean[0], mean[1], ic, moments)
+    reason = ""  # why the current full segment started
+
+    def averaged_stretch(t, state, done):
+        """Mean elements from t until averaging is invalid; state = (exact osculating state at t or None, mean)."""
+        nonlocal steps, reason
+        exact, mean = state
+        mc = mean_constants(mean[ACTION_S], mean[ACTION_Z], ic, moments)
         if anomaly:
             written, t_stop, y_stop, code, n_steps = mean_elements_anomaly_kernel(
                 mean, t, t_out[done:], float(max_step), steps_per_turn, mc, model, frame, ic, thresholds,
@@ -566,36 +547,35 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
         segments.append((t, float(t_stop) if code != VALID else float(t_out[-1]), "averaged", ""))
         done += written
         if code == VALID:
-            break
+            return done, float(t_out[-1]), state, None
         if not hand_over:
             raise ValueError(f"averaging is invalid at t = {t_stop!r}: {_WHY[code]}; allow hand_over=True "
                              "or integrate this stretch with integrate_quaternion.")
-        # Full integration in chunks until the averaged theory is valid again.
         if float(t_stop) == t:
             y = exact  # invalid where the segment starts: continue from the exact state
         else:
             t = float(t_stop)
             y = state_of_elements(mean_to_osculating(t, y_stop, model, frame, ic), frame, moments)
         reason = _WHY[code]
-        while True:
-            t_next = t + direction * handover_chunk
-            pending = t_out[done:]
-            inside = pending[(pending - t_next) * direction < 0]
-            grid = np.concatenate([inside, [t_next]])
-            ys = integrate_quaternion(y, t, grid, model, rtol=rtol)
-            for i, yi in enumerate(ys[:-1]):
-                el = elements_of_state(yi, model, frame)
-                out_mean[done + i] = osculating_to_mean(float(inside[i]), el, model, frame, ic)
-                if osculating:
-                    out_state[done + i] = yi
-            done += inside.size
-            segments.append((t, float(t_next) if done < t_out.size else float(t_out[-1]), "full", reason))
-            t, y = float(t_next), ys[-1]
-            if done >= t_out.size:
-                break
-            el = elements_of_state(y, model, frame)
-            if validity_code(t, model, free_motion_numbers(el, ic), thresholds) == VALID:
-                mean = osculating_to_mean(t, el, model, frame, ic)
-                exact = y
-                break
+        return done, t, (y, None), reason
+
+    def full_chunk(t, state, done):
+        """The full integration over one chunk; hands back with the mean elements where averaging is valid."""
+        y, _ = state
+        n, ys, t_end, y_end = quaternion_chunk(y, t, t_out, done, handover_chunk, direction, model, rtol)
+        for i in range(n):
+            el = elements_of_state(ys[i], model, frame)
+            out_mean[done + i] = osculating_to_mean(float(t_out[done + i]), el, model, frame, ic)
+            if osculating:
+                out_state[done + i] = ys[i]
+        done += n
+        segments.append((t, float(t_end), "full", reason))
+        if done < t_out.size:
+            el = elements_of_state(y_end, model, frame)
+            if validity_code(t_end, model, free_motion_numbers(el, ic), thresholds) == VALID:
+                return done, float(t_end), (y_end, osculating_to_mean(t_end, el, model, frame, ic)), "valid again"
+        return done, float(t_end), (y_end, None), None
+
+    # Full integration in chunks where the averaged theory fails, until it is valid again.
+    alternate_stretches(t0, (y0, mean), t_out.size, (averaged_stretch, full_chunk), ("averaged", "full"))
     return AveragedResult(t_out, out_mean, out_state, segments, frame, steps)

@@ -31,7 +31,7 @@ Design choices
   the motion is unchanged). s itself is integrated (not s − a S t: S is not constant), and stays
   small, so its rounding does not grow with the span either. Without the shift ∂(l, g)/∂(S, Z),
   hence the RHS of s and z, carry terms proportional to s and the steps shrink as the run goes on
-  (2× more steps on 10³ turns of scene (c)). Element outputs are in the shifted representation.
+  (``docs/elements_integrator.md``). Element outputs are in the shifted representation.
 * **Singular sets are detected, not crossed**: at the end of each accepted step the RHS reports
   1 − m (or 1 − μ), sin J, sin I, the sine of the angle of M from the A axis and, for an exactly
   symmetric body, the sine of its angle from the equal-moment plane (permanent rotations); below the
@@ -39,27 +39,36 @@ Design choices
   time. Bodies too nearly spherical for the tolerance are refused up front
   (``MIN_ASPHERICITY_PER_RTOL``). The automatic hand-over to the
   quaternion integrator there (and back) is :mod:`spinorbit.core.integrators.handover`.
-* **Driver**: its own small DOP853 loop sharing the tableau (``_dop853_tableau.py``) and the error
-  norm with :mod:`spinorbit.core.integrators.quaternion`, whose kernel is specialised to the quaternion
-  RHS and the renormalisation of q; it is left untouched so its speed cannot change.
+* **Driver**: the package's one DOP853 engine (:mod:`spinorbit.core.integrators.dop853`) with the
+  element RHS, a purely absolute error test, the PI step-size controller (``STEP_BETA``), the
+  phase reduction as its after-step hook and the singular sets as its stop codes.
 """
 
 import math
 
 import numpy as np
 
-from spinorbit.core.jit import jit
+from spinorbit.core.dynamics.validation import validate_output_times, validate_sampled_span, validate_state
 from spinorbit.core.elements.canonical import FLIP_A, FLIP_B, FLIP_C, MODE_UNIFORM, elements_from_state, inertia_constants
-from spinorbit.core.dynamics.validation import validate_sampled_span, validate_state
 from spinorbit.core.elements.equations import attitude_and_momentum, elements_rhs_into, inertial_quaternion, reduce_phase
 from spinorbit.core.errors import SingularElementsError
-from spinorbit.core.model.gravity_field import BODY_A, BODY_B, BODY_C
-from spinorbit.core.integrators.quaternion import DEFAULT_MAX_STEPS, ERROR_EXPONENT, MAX_FACTOR, MIN_FACTOR, SAFETY, STAT_ACCEPTED, STAT_REJECTED, STAT_RHS_CALLS, STAT_STATUS, STATUS_MAX_STEPS, STATUS_NOT_FINITE, STATUS_STEP_TOO_SMALL, STATUS_SUCCESS, IntegrationError, _A, _B, _C, _dense_polynomial, _dense_rows, _error_norm, _extra_stage_input
-from spinorbit.core.dynamics.validation import validate_output_times
-from spinorbit.core.integrators.dop853_tableau import N_STAGES
+from spinorbit.core.integrators.dop853 import (
+    DEFAULT_MAX_STEPS,
+    STAT_STATUS,
+    STATUS_MESSAGES,
+    STATUS_SUCCESS,
+    IntegrationError,
+    dop853_fixed_steps,
+    dop853_integrate,
+    output_as_is,
+)
+from spinorbit.core.jit import jit
 from spinorbit.core.math.rotations import quat_to_attitude, rot1
+from spinorbit.core.model.gravity_field import BODY_A, BODY_B, BODY_C
 
 ELEMENT_SIZE = 6
+#: Layout of a signed element vector: the actions (S, Z, H), then their angles (s, z, h).
+ACTION_S, ACTION_Z, ACTION_H, ANGLE_S, ANGLE_Z, ANGLE_H = range(ELEMENT_SIZE)
 
 #: Stop before the separatrix: below this 1 − m (SAM) or 1 − μ (LAM) the elliptic period grows like
 #: log(1/(1 − m)) and the Jacobian's d-derivatives like 1/(1 − m) (∂m/∂d), so the steps shrink and
@@ -73,18 +82,16 @@ MIN_SIN_J_A = 1e-3
 MIN_SIN_I = 1e-3
 #: Stop near a permanent rotation of an exactly symmetric body (M within angle P of the equal-moment
 #: plane: B = C, or A = B): the gap of the motion to it, (a − c) sin² P, is resolved by (S, Z) only to
-#: ≈ ε d, so the phase the elements carry is wrong by ≈ ε / sin² P, whatever rtol. Measured over 20
-#: turns under a weak torque (benchmarks/accuracy_symmetric_permanent.py, table in
-#: docs/elements_integrator.md): 5–30 ε / sin² P, i.e. 4.5e-11 (B = C) and 1.2e-11 rad (A = B) at
-#: sin P = 1e-2, no more than quaternion DOP853's own error at rtol 1e-12 (4.1e-11, 4.3e-10), but
-#: 4.2× it at 3e-3 and 108× at 1e-3 (B = C). A fixed value like the other thresholds (the kernel
-#: sees atol, not rtol); at rtol < 1e-12 the elements near it are less accurate than rtol asks.
+#: ≈ ε d, so the phase the elements carry is wrong by ≈ ε / sin² P, whatever rtol; 1e-2 is where
+#: that error reaches quaternion DOP853's own at rtol 1e-12 (``docs/elements_integrator.md``,
+#: ``benchmarks/accuracy_symmetric_permanent.py``). A fixed value like the other thresholds (the
+#: kernel sees atol, not rtol); at rtol < 1e-12 the elements near it are less accurate than rtol asks.
 MIN_SIN_P = 1e-2
 #: Refuse bodies closer to a sphere than (C − A)/C < MIN_ASPHERICITY_PER_RTOL × rtol: S lies in
 #: [√(A/C) Z, Z], an interval of relative width ≈ (C − A)/(2C), and the step error test allows
 #: rtol·G in S; below this ratio S (hence the energy, the mode parameter and the period) is not
 #: located within its interval to 1 %, and the run returns an attitude that is wrong by O(1) rad
-#: without any warning (measured 2.9 rad after 20 turns at (C − A)/C = 2e-12, rtol 1e-12).
+#: without any warning (``docs/elements_integrator.md``).
 MIN_ASPHERICITY_PER_RTOL = 200.0
 #: Same rule and value as spinorbit.state.AUTO_REFERENCE_MIN_SIN_I: if the initial sin I is below
 #: this, H and h are referred to the inertial frame turned by 90° about x.
@@ -93,8 +100,6 @@ AUTO_REFERENCE_MIN_SIN_I = 0.1
 #: β of the PI step-size controller (Hairer, Solving ODEs I, §IV.2 / DOP853's BETA; 0 = the plain
 #: controller of integrate_quaternion). See docs/elements_integrator.md for the measured effect.
 STEP_BETA = 0.04
-#: Hairer's lower bound on the remembered error (FACOLD = 1e-4).
-PREVIOUS_ERROR_FLOOR = 1e-4
 
 STATUS_SEPARATRIX = 10
 STATUS_SPIN_ABOUT_C = 11
@@ -104,45 +109,19 @@ STATUS_SYMMETRIC_PERMANENT = 14
 
 
 @jit
-def _rk_step(t, y, f0, h, model, frame, ic, k, y_new, tmp):
-    """DOP853 stages 1..12 from (t, y) (f0 = f(t, y)), 8th-order y_new, FSAL f(t + h, y_new) in k[12].
-
-    Returns the singularity distances at (t + h, y_new).
-    """
-    n = y.shape[0]
-    for i in range(n):
-        k[0, i] = f0[i]
-    for s in range(1, N_STAGES):
-        for i in range(n):
-            tmp[i] = 0.0
-        for j in range(s):
-            a = _A[s, j] * h
-            if a != 0.0:
-                for i in range(n):
-                    tmp[i] += a * k[j, i]
-        for i in range(n):
-            tmp[i] += y[i]
-        elements_rhs_into(t + _C[s] * h, tmp, model, frame, ic, k[s])
-    for i in range(n):
-        y_new[i] = 0.0
-    for j in range(N_STAGES):
-        b = _B[j] * h
-        if b != 0.0:
-            for i in range(n):
-                y_new[i] += b * k[j, i]
-    for i in range(n):
-        y_new[i] += y[i]
-    return elements_rhs_into(t + h, y_new, model, frame, ic, k[N_STAGES])
+def _rhs(t, y, params, out):
+    """Paper eq. (11) in the engine's form; returns the singularity distances at (t, y)."""
+    model, frame, ic, _ = params
+    return elements_rhs_into(t, y, model, frame, ic, out)
 
 
 @jit
-def _dense_coefficients(t, y, y_new, f_new, h, model, frame, ic, k, coeffs):
-    """Extra stages 13..15 of the element RHS, then the shared continuous-extension rows."""
-    tmp = np.empty(y.shape[0])
-    for s in range(N_STAGES + 1, 16):
-        _extra_stage_input(y, h, k, s, tmp)
-        elements_rhs_into(t + _C[s] * h, tmp, model, frame, ic, k[s])
-    _dense_rows(y, y_new, f_new, h, k, coeffs)
+def _reduce_phase_after_step(params, t, y, f, distances):
+    """Whole periods out of s (same motion, new representation), whose derivative is then re-evaluated."""
+    model, frame, ic, reduce_phases = params
+    if reduce_phases and reduce_phase(y, ic) != 0.0:
+        return elements_rhs_into(t, y, model, frame, ic, f), 1
+    return distances, 0
 
 
 @jit
@@ -159,32 +138,6 @@ def _singular_status(distances):
     if not (sin_i >= MIN_SIN_I):
         return STATUS_REFERENCE_POLE
     return STATUS_SUCCESS
-
-
-@jit
-def _initial_step(t0, y0, f0, direction, atol, model, frame, ic):
-    """Hairer's starting step (absolute scales atol), as in integrate_quaternion."""
-    n = y0.shape[0]
-    d0 = 0.0
-    d1 = 0.0
-    for i in range(n):
-        d0 += (y0[i] / atol[i]) ** 2
-        d1 += (f0[i] / atol[i]) ** 2
-    d0 = math.sqrt(d0 / n)
-    d1 = math.sqrt(d1 / n)
-    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    y1 = y0 + direction * h0 * f0
-    f1 = np.empty(n)
-    elements_rhs_into(t0 + direction * h0, y1, model, frame, ic, f1)
-    d2 = 0.0
-    for i in range(n):
-        d2 += ((f1[i] - f0[i]) / atol[i]) ** 2
-    d2 = math.sqrt(d2 / n) / h0
-    if d1 <= 1e-15 and d2 <= 1e-15:
-        h1 = max(1e-6, h0 * 1e-3)
-    else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
-    return min(100.0 * h0, h1)
 
 
 @jit
@@ -234,122 +187,17 @@ def integrate_elements_kernel(el0, t0, t_out, model, frame, atol, max_steps, fir
     el_stop : (6,) ndarray
         Signed elements at ``t_stop`` (where a hand-over to the quaternion integrator starts).
     """
-    n = 6
-    n_out = t_out.shape[0]
-    states = np.full((n_out, 7), np.nan)
-    els = np.full((n_out, n), np.nan)
-    stats = np.zeros(4, dtype=np.int64)
     big_a, big_b, big_c = model[BODY_A], model[BODY_B], model[BODY_C]
     ic = inertia_constants(big_a, big_b, big_c)
-    k = np.zeros((16, n))
-    coeffs = np.zeros((7, n))
-    y = el0.copy()
-    y_new = np.empty(n)
-    scratch = np.empty(n)
-    f = np.empty(n)
-    f_new = np.empty(n)
-    t_end = t_out[n_out - 1]
-    direction = 1.0 if t_end >= t0 else -1.0
-    dist = elements_rhs_into(t0, y, model, frame, ic, f)
-    stats[STAT_RHS_CALLS] += 1
-    t = t0
-    status = _singular_status(dist)
-    if status != STATUS_SUCCESS:
-        stats[STAT_STATUS] = status
-        return states, els, stats, t, y
-    if first_step > 0.0:
-        h_abs = first_step
-    else:
-        h_abs = _initial_step(t0, y, f, direction, atol, model, frame, ic)
-        stats[STAT_RHS_CALLS] += 1
-    if not (math.isfinite(h_abs) and h_abs > 0.0):
-        stats[STAT_STATUS] = STATUS_NOT_FINITE
-        return states, els, stats, t, y
-    i_out = 0
-    while i_out < n_out and t_out[i_out] == t0:
-        els[i_out] = y
-        _state_at(y, frame, ic, big_a, big_b, big_c, states[i_out])
-        i_out += 1
-    steps = 0
-    previous_error = PREVIOUS_ERROR_FLOOR
-    while i_out < n_out:
-        min_step = 10.0 * abs(np.nextafter(t, t + direction) - t)
-        if h_abs < min_step:
-            h_abs = min_step
-        accepted = False
-        rejected = False
-        while not accepted:
-            if steps >= max_steps:
-                stats[STAT_STATUS] = STATUS_MAX_STEPS
-                return states, els, stats, t, y
-            if not (h_abs >= min_step):
-                stats[STAT_STATUS] = STATUS_STEP_TOO_SMALL
-                return states, els, stats, t, y
-            h = direction * h_abs
-            t_new = t + h
-            if direction * (t_new - t_end) > 0.0:
-                t_new = t_end
-            h = t_new - t
-            h_abs = abs(h)
-            dist = _rk_step(t, y, f, h, model, frame, ic, k, y_new, scratch)
-            stats[STAT_RHS_CALLS] += N_STAGES
-            steps += 1
-            err = _error_norm(k, h, y, y_new, 0.0, atol)
-            if not math.isfinite(err):
-                if h_abs <= min_step:
-                    stats[STAT_STATUS] = STATUS_NOT_FINITE
-                    return states, els, stats, t, y
-                h_abs *= MIN_FACTOR
-                rejected = True
-                stats[STAT_REJECTED] += 1
-                continue
-            if err < 1.0:
-                if err == 0.0:
-                    factor = MAX_FACTOR
-                else:
-                    # PI ("stabilised") control, Hairer's DOP853 with β = STEP_BETA: the previous
-                    # accepted error damps the oscillation of the step size that causes rejections.
-                    factor = min(MAX_FACTOR, SAFETY * err ** (ERROR_EXPONENT + 0.2 * STEP_BETA)
-                                 * previous_error ** STEP_BETA)
-                previous_error = max(err, PREVIOUS_ERROR_FLOOR)
-                if rejected:
-                    factor = min(1.0, factor)
-                h_abs *= factor
-                accepted = True
-            else:
-                h_abs *= max(MIN_FACTOR, SAFETY * err ** ERROR_EXPONENT)
-                rejected = True
-                stats[STAT_REJECTED] += 1
-        stats[STAT_ACCEPTED] += 1
-        for i in range(n):
-            f_new[i] = k[N_STAGES, i]
-        dense_ready = False
-        while i_out < n_out and direction * (t_out[i_out] - t_new) <= 0.0:
-            if t_out[i_out] == t_new:
-                for i in range(n):
-                    els[i_out, i] = y_new[i]
-            else:
-                if not dense_ready:
-                    _dense_coefficients(t, y, y_new, f_new, h, model, frame, ic, k, coeffs)
-                    stats[STAT_RHS_CALLS] += 3
-                    dense_ready = True
-                _dense_polynomial(coeffs, y, (t_out[i_out] - t) / h, els[i_out])
-            _state_at(els[i_out], frame, ic, big_a, big_b, big_c, states[i_out])
-            i_out += 1
-        t = t_new
-        for i in range(n):
-            y[i] = y_new[i]
-            f[i] = f_new[i]
-        if reduce_phases and reduce_phase(y, ic) != 0.0:
-            # Same motion, new representation (s, z): its derivative must be re-evaluated.
-            dist = elements_rhs_into(t, y, model, frame, ic, f)
-            stats[STAT_RHS_CALLS] += 1
-        status = _singular_status(dist)
-        if status != STATUS_SUCCESS and i_out < n_out:
-            stats[STAT_STATUS] = status
-            return states, els, stats, t, y
-    stats[STAT_STATUS] = STATUS_SUCCESS
-    return states, els, stats, t, y
+    # Purely absolute error test (rtol = 0) and the PI controller.
+    els, stats, t_stop, el_stop = dop853_integrate(_rhs, (model, frame, ic, reduce_phases), _singular_status,
+                                                   _reduce_phase_after_step, output_as_is, el0, t0, t_out, 0.0,
+                                                   atol, max_steps, False, first_step, STEP_BETA)
+    states = np.full((t_out.shape[0], 7), np.nan)
+    for i in range(t_out.shape[0]):
+        if not math.isnan(els[i, 0]):
+            _state_at(els[i], frame, ic, big_a, big_b, big_c, states[i])
+    return states, els, stats, t_stop, el_stop
 
 
 # ---------------------------------------------------------------------------------------------
@@ -372,7 +220,8 @@ class ElementsSingularityError(SingularElementsError):
         self.y_stop = y_stop
 
 
-_SINGULAR = {
+#: Singular-set stop codes of the kernel → (kind, why), for the errors and the hand-over's switches.
+SINGULAR_SETS = {
     STATUS_SEPARATRIX: ("separatrix", f"1 − m (or 1 − μ) fell below MIN_SEPARATRIX_DISTANCE = {MIN_SEPARATRIX_DISTANCE:g}"),
     STATUS_SPIN_ABOUT_C: ("spin about C", f"sin J fell below MIN_SIN_J = {MIN_SIN_J:g} (spin about ±C)"),
     STATUS_SPIN_ABOUT_A: ("spin about A", f"the angle of M from the A axis fell below MIN_SIN_J_A = {MIN_SIN_J_A:g} "
@@ -383,13 +232,6 @@ _SINGULAR = {
     STATUS_REFERENCE_POLE: ("reference pole", f"sin I fell below MIN_SIN_I = {MIN_SIN_I:g} (angular momentum "
                             "along the reference z axis)"),
 }
-
-_STATUS_MESSAGES = {
-    STATUS_MAX_STEPS: "reached max_steps; raise max_steps or loosen rtol",
-    STATUS_STEP_TOO_SMALL: "the step size underflowed",
-    STATUS_NOT_FINITE: "the state became NaN/inf; check that sampled perturbers cover the whole time span",
-}
-
 
 def reference_frame_for(y0, moments):
     """Inertial → reference rotation of H, h for an initial state (the "auto" rule, module docstring)."""
@@ -507,13 +349,13 @@ def integrate_elements(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=DE
     states, els, stats, t_stop, y_stop, frame = run_elements(y0, t0, t_out, model, rtol, atol, max_steps,
                                                              first_step, reduce_phases)
     status = int(stats[STAT_STATUS])
-    if status in _SINGULAR:
-        kind, why = _SINGULAR[status]
+    if status in SINGULAR_SETS:
+        kind, why = SINGULAR_SETS[status]
         raise ElementsSingularityError(
             f"integrate_elements stopped at t = {t_stop!r}: {why}; continue from there with "
             "integrate_quaternion.", t_stop, kind, y_stop)
     if status != STATUS_SUCCESS:
-        raise IntegrationError(f"integration stopped at step {int(stats[0] + stats[1])}: {_STATUS_MESSAGES[status]}.")
+        raise IntegrationError(f"integration stopped at step {int(stats[0] + stats[1])}: {STATUS_MESSAGES[status]}.")
     out = [states]
     if return_elements:
         out.append(els)
@@ -580,26 +422,13 @@ def integrate_elements_fixed_step_kernel(el0, t0, t1, n_steps, model, frame):
     For measuring the order of convergence of the element integrator (the adaptive kernel has no
     fixed-step mode). NaN if a step meets an element singularity.
     """
-    n = 6
     big_a, big_b, big_c = model[BODY_A], model[BODY_B], model[BODY_C]
     ic = inertia_constants(big_a, big_b, big_c)
-    k = np.zeros((16, n))
-    y = el0.copy()
-    y_new = np.empty(n)
-    scratch = np.empty(n)
-    f = np.empty(n)
+    y, status = dop853_fixed_steps(_rhs, (model, frame, ic, False), _singular_status, _reduce_phase_after_step,
+                                   el0, t0, t1, n_steps)
     out = np.full(7, np.nan)
-    h = (t1 - t0) / n_steps
-    if _singular_status(elements_rhs_into(t0, y, model, frame, ic, f)) != STATUS_SUCCESS:
-        return out
-    for step in range(n_steps):
-        dist = _rk_step(t0 + step * h, y, f, h, model, frame, ic, k, y_new, scratch)
-        if _singular_status(dist) != STATUS_SUCCESS:
-            return out
-        for i in range(n):
-            y[i] = y_new[i]
-            f[i] = k[N_STAGES, i]
-    _state_at(y, frame, ic, big_a, big_b, big_c, out)
+    if status == STATUS_SUCCESS:
+        _state_at(y, frame, ic, big_a, big_b, big_c, out)
     return out
 
 

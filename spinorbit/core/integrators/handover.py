@@ -23,6 +23,10 @@ between the integrators. Both maps are the existing exact ones, so a switch cost
 the state (≈ ε, far below any tolerance ≥ 1e-15 the integrators accept).
 
 Every switch is returned as a :class:`Switch` (time, integrator taken over, reason).
+
+The alternation itself (:func:`alternate_stretches`: run one integrator until it asks to hand over,
+then the other) and the fallback stretch (:func:`quaternion_chunk`) are shared with the averaged
+propagator's hand-over to the full integration (:mod:`spinorbit.core.averaging.propagate`).
 """
 
 import math
@@ -36,19 +40,19 @@ from spinorbit.core.elements.equations import singularity_distances_of_motion
 from spinorbit.core.errors import SingularElementsError
 from spinorbit.core.model.gravity_field import BODY_A, BODY_B, BODY_C
 from spinorbit.core.integrators.elements import (
-    _SINGULAR,
-    _STATUS_MESSAGES,
     MIN_ASPHERICITY_PER_RTOL,
     MIN_SEPARATRIX_DISTANCE,
     MIN_SIN_I,
     MIN_SIN_J,
     MIN_SIN_J_A,
     MIN_SIN_P,
+    SINGULAR_SETS,
     STATUS_SUCCESS,
     reference_frame_for,
     run_elements,
 )
-from spinorbit.core.integrators.quaternion import DEFAULT_MAX_STEPS, STAT_STATUS, IntegrationError, integrate_quaternion
+from spinorbit.core.integrators.dop853 import DEFAULT_MAX_STEPS, STAT_STATUS, STATUS_MESSAGES, IntegrationError
+from spinorbit.core.integrators.quaternion import integrate_quaternion
 from spinorbit.core.dynamics.validation import validate_output_times
 from spinorbit.core.math.rotations import quat_to_attitude
 
@@ -169,26 +173,67 @@ def integrate_with_handover(y0, t0, t_out, model, rtol=1e-10, check_interval=Non
         raise ValueError(f"check_interval: expected a probe length > 0 (time unit), got {check_interval!r}.")
     direction = 1.0 if t_out[-1] > t else -1.0
     ys = np.full((t_out.size, 7), np.nan)
-    switches = []
-    i_out = 0
+    # A body too nearly spherical for the elements at rtol: the quaternions integrate the whole run.
     resolvable = (moments[2] - moments[0]) / moments[2] >= MIN_ASPHERICITY_PER_RTOL * rtol
-    reason = _singular_reason(singularity_distances_of_state(y, moments), resume_margin) if resolvable else (
-        "nearly spherical body")
-    if reason is not None:
-        switches.append(Switch(t, QUATERNION, reason))
-    while i_out < t_out.size:
-        if not resolvable:  # the elements never take over (integrate_elements.MIN_ASPHERICITY_PER_RTOL)
-            i_out, t, y = _quaternion_probe(y, t, t_out, i_out, model, rtol, max_steps, direction, math.inf, ys)
-        elif reason is None:
-            i_out, t, y, reason = _elements_stretch(y, t, t_out, i_out, model, rtol, max_steps, ys)
-            if reason is not None:
-                switches.append(Switch(t, QUATERNION, reason))
-        else:
-            i_out, t, y = _quaternion_probe(y, t, t_out, i_out, model, rtol, max_steps, direction, check_interval, ys)
-            reason = _singular_reason(singularity_distances_of_state(y, moments), resume_margin)
-            if reason is None and i_out < t_out.size:
-                switches.append(Switch(t, ELEMENTS, "safely away"))
+
+    def elements_stretch(t, y, i_out):
+        return _elements_stretch(y, t, t_out, i_out, model, rtol, max_steps, ys)
+
+    def quaternion_stretch(t, y, i_out):
+        probe = check_interval if resolvable else math.inf
+        i_out, t, y = _quaternion_probe(y, t, t_out, i_out, model, rtol, max_steps, direction, probe, ys)
+        safe = resolvable and _singular_reason(singularity_distances_of_state(y, moments), resume_margin) is None
+        return i_out, t, y, "safely away" if safe else None
+
+    start = (_singular_reason(singularity_distances_of_state(y, moments), resume_margin) if resolvable
+             else "nearly spherical body")
+    switches = alternate_stretches(t, y, t_out.size, (elements_stretch, quaternion_stretch), (ELEMENTS, QUATERNION),
+                                   start)
     return ys, switches
+
+
+def alternate_stretches(t, state, n_out, stretches, names, start_reason=None):
+    """The one hand-over mechanism: run stretches of a primary integrator and a fallback, switching on request.
+
+    Used by :func:`integrate_with_handover` (canonical elements ↔ quaternion DOP853) and by
+    :func:`spinorbit.core.averaging.propagate.propagate_averaged` (mean elements ↔ the full
+    integration).
+
+    Parameters
+    ----------
+    t : float
+        Initial time.
+    state : object
+        Whatever the stretches pass each other (a state (q, ω), or a pair with the mean elements).
+    n_out : int
+        Number of output times; the run ends when a stretch has written the last one.
+    stretches : (callable, callable)
+        The primary's and the fallback's ``stretch(t, state, i_out) -> (i_out, t, state, switch)``:
+        integrate from (t, state) writing outputs i_out, … (the caller's arrays), stop where the
+        integrator should hand over (or after a probe), and return the outputs reached, the time and
+        state there and the reason to switch to the other integrator (None: keep going).
+    names : (str, str)
+        Names of the two integrators, for the :class:`Switch` records.
+    start_reason : str, optional
+        Start in the fallback for this reason (the primary is not valid at ``t``).
+
+    Returns
+    -------
+    list of :class:`Switch`
+        The hand-overs in time order (a start in the fallback first, at ``t``).
+    """
+    switches = []
+    current = 0
+    if start_reason is not None:
+        current = 1
+        switches.append(Switch(t, names[current], start_reason))
+    i_out = 0
+    while i_out < n_out:
+        i_out, t, state, switch = stretches[current](t, state, i_out)
+        if switch is not None and i_out < n_out:
+            current = 1 - current
+            switches.append(Switch(t, names[current], switch))
+    return switches
 
 
 def _elements_stretch(y, t, t_out, i_out, model, rtol, max_steps, ys):
@@ -205,22 +250,37 @@ def _elements_stretch(y, t, t_out, i_out, model, rtol, max_steps, ys):
     i_out += n_done
     if status == STATUS_SUCCESS:
         return i_out, t_stop, y_stop, None
-    if status in _SINGULAR:
-        return i_out, t_stop, y_stop, _SINGULAR[status][0]
-    raise IntegrationError(f"elements stretch from t = {t!r} stopped: {_STATUS_MESSAGES[status]}.")
+    if status in SINGULAR_SETS:
+        return i_out, t_stop, y_stop, SINGULAR_SETS[status][0]
+    raise IntegrationError(f"elements stretch from t = {t!r} stopped: {STATUS_MESSAGES[status]}.")
+
+
+def quaternion_chunk(y, t, t_out, i_out, interval, direction, model, rtol, max_steps=DEFAULT_MAX_STEPS):
+    """Quaternion DOP853 from (t, y) over ``interval`` (clipped to the last output), the fallback stretch of both
+    hand-overs.
+
+    Returns
+    -------
+    (n, states, t_end, y_end)
+        The number n of outputs t_out[i_out:] inside (t, t_end], the states there (n, 7), the time
+        reached and the state there.
+    """
+    t_end = t + direction * interval
+    if direction * (t_end - t_out[-1]) >= 0.0:
+        t_end = t_out[-1]
+    if t_end == t:  # a chunk shorter than the spacing of doubles at t: go to the next output
+        t_end = t_out[i_out]
+    inside = t_out[i_out:][direction * (t_out[i_out:] - t_end) <= 0.0]
+    times = inside if inside.size and inside[-1] == t_end else np.append(inside, t_end)
+    states = integrate_quaternion(y, t, times, model, rtol=rtol, max_steps=max_steps)
+    return inside.size, states[:inside.size], t_end, states[-1]
 
 
 def _quaternion_probe(y, t, t_out, i_out, model, rtol, max_steps, direction, check_interval, ys):
     """DOP853 from (t, y) over one probe; writes the outputs inside it. Returns (i_out, t, y)."""
     if check_interval is None:
         check_interval = CHECK_TURNS * 2.0 * math.pi / max(float(np.linalg.norm(y[4:])), 1e-300)
-    t_check = t + direction * check_interval
-    if direction * (t_check - t_out[-1]) >= 0.0:
-        t_check = t_out[-1]
-    if t_check == t:  # a probe shorter than the spacing of doubles at t: go to the next output
-        t_check = t_out[i_out]
-    inside = t_out[i_out:][direction * (t_out[i_out:] - t_check) <= 0.0]
-    times = inside if inside.size and inside[-1] == t_check else np.append(inside, t_check)
-    states = integrate_quaternion(y, t, times, model, rtol=rtol, max_steps=max_steps)
-    ys[i_out:i_out + inside.size] = states[:inside.size]
-    return i_out + inside.size, t_check, states[-1]
+    n, states, t_check, y_check = quaternion_chunk(y, t, t_out, i_out, check_interval, direction, model, rtol,
+                                                   max_steps)
+    ys[i_out:i_out + n] = states
+    return i_out + n, t_check, y_check

@@ -40,14 +40,6 @@ UPPER_LAYERS = (
 #: Modules every layer may import: the front door's lazy table and the old-path shims.
 ANYWHERE = ("spinorbit", "spinorbit.old_paths")
 
-# Still to mend in the reorganisation (issue 13); each entry is removed by the change that fixes it,
-# and the lists are deleted once empty.
-KNOWN_CIRCLES = [
-]
-KNOWN_PRIVATE_CROSSINGS = [
-]
-KNOWN_LONG = [
-]
 
 
 def _module_name(path):
@@ -186,7 +178,6 @@ def test_no_import_circles():
     for node in edges:
         if node not in index:
             visit(node)
-    circles = [c for c in circles if c not in KNOWN_CIRCLES]
     assert circles == [], f"import circles: {circles}"
 
 
@@ -199,7 +190,6 @@ def test_no_private_names_cross_modules():
             for name in names:
                 if name.startswith("_") and not name.startswith("__") and f"{target}.{name}" not in MODULES:
                     crossings.append(f"{module}: from {target} import {name}")
-    crossings = [c for c in crossings if c not in KNOWN_PRIVATE_CROSSINGS]
     assert crossings == [], "private names imported across modules (make them public where they belong):\n" + \
         "\n".join(crossings)
 
@@ -227,7 +217,7 @@ def test_no_module_is_too_long():
     for module, path in MODULES.items():
         lines = path.read_text().count("\n")
         docstring = ast.get_docstring(ast.parse(path.read_text())) or ""
-        if lines > 650 and "one concept" not in docstring and module not in KNOWN_LONG:
+        if lines > 650 and "one concept" not in docstring:
             long.append(f"{module}: {lines} lines")
     assert long == [], "modules over the size rule without a reason in their docstring:\n" + "\n".join(long)
 

@@ -4,7 +4,8 @@
 angular-momentum diagnostics, and the model-array layout; every integrator and every benchmark peer
 evaluates the dynamics through it. :mod:`.python_reference` is its pure-Python transcription, for the
 baselines that must not use compiled code (scipy with a plain-Python right-hand side); a test holds
-the two equal.
+the two equal. :mod:`.validation` holds the checks every integrator's wrapper makes on its input
+(state, output times, sampled span) before compiled code runs.
 """
 
 from spinorbit import old_paths

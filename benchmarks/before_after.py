@@ -146,10 +146,12 @@ def main():
     table = "\n".join(rows)
     print(table)
     if not args.no_write:
+        commit = subprocess.run(["git", "-C", str(trees["base"]), "rev-parse", "--short", "HEAD"],
+                                capture_output=True, text=True).stdout.strip() or args.base.name
         body = (
             f"`python benchmarks/before_after.py --base OLD_CHECKOUT` ({args.rounds} rounds × {args.repeat} "
             "repeats per checkout, worker processes alternated, CPU time per call after a warm-up call; "
-            f"base = {args.base.name}). {machine_line()}\n\n" + table + "\n"
+            f"base = commit {commit}). {machine_line()}\n\n" + table + "\n"
         )
         write_section("before_after", "## Before and after the reorganisation (`benchmarks/before_after.py`)\n\n" + body)
 

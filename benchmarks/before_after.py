@@ -153,7 +153,7 @@ def main():
             "repeats per checkout, worker processes alternated, CPU time per call after a warm-up call; "
             f"base = commit {commit}). {machine_line()}\n\n" + table + "\n"
         )
-        write_section("before_after", "## Before and after the reorganisation (`benchmarks/before_after.py`)\n\n" + body)
+        write_section("before_after", "### Old and new checkout, interleaved (`benchmarks/before_after.py`)\n\n" + body)
 
 
 if __name__ == "__main__":

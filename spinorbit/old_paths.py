@@ -51,8 +51,6 @@ MOVED_MODULES: dict[str, tuple[str, ...]] = {
     "spinorbit.asteroids": ("spinorbit.data.asteroids",),
     # The adapter is split by concept (simulation, extra_forces, rotation_hooks, snapshot, interrupts);
     # its door exports every public name the adapter had.
-    "spinorbit.coupling.rebound_adapter": ("spinorbit.coupling.rebound",),
-    "spinorbit.coupling.rebound.adapter": ("spinorbit.coupling.rebound",),
     "spinorbit.coupling.chunked_run": ("spinorbit.coupling.long_run",),
 }
 

@@ -95,6 +95,20 @@ class IntegrationError(RuntimeError):
     """The kernel stopped before the last output time (step cap, step underflow, non-finite state)."""
 
 
+def raise_for_engine_status(stats):
+    """Raise :class:`IntegrationError` for an engine stop code in ``stats`` (after the caller's own codes)."""
+    status = int(stats[STAT_STATUS])
+    if status != STATUS_SUCCESS:
+        steps = int(stats[STAT_ACCEPTED] + stats[STAT_REJECTED])
+        raise IntegrationError(f"integration stopped at step {steps}: {STATUS_MESSAGES[status]}.")
+
+
+def stats_record(stats):
+    """The stats array of :func:`dop853_integrate` as the wrappers' ``return_stats`` dict."""
+    return {"accepted": int(stats[STAT_ACCEPTED]), "rejected": int(stats[STAT_REJECTED]),
+            "rhs_calls": int(stats[STAT_RHS_CALLS])}
+
+
 # ---------------------------------------------------------------------------------------------
 # Stages and the step
 

@@ -55,12 +55,12 @@ from spinorbit.core.errors import SingularElementsError
 from spinorbit.core.integrators.dop853 import (
     DEFAULT_MAX_STEPS,
     STAT_STATUS,
-    STATUS_MESSAGES,
     STATUS_SUCCESS,
-    IntegrationError,
     dop853_fixed_steps,
     dop853_integrate,
     output_as_is,
+    raise_for_engine_status,
+    stats_record,
 )
 from spinorbit.core.jit import jit
 from spinorbit.core.math.rotations import quat_to_attitude, rot1
@@ -354,14 +354,12 @@ def integrate_elements(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=DE
         raise ElementsSingularityError(
             f"integrate_elements stopped at t = {t_stop!r}: {why}; continue from there with "
             "integrate_quaternion.", t_stop, kind, y_stop)
-    if status != STATUS_SUCCESS:
-        raise IntegrationError(f"integration stopped at step {int(stats[0] + stats[1])}: {STATUS_MESSAGES[status]}.")
+    raise_for_engine_status(stats)
     out = [states]
     if return_elements:
         out.append(els)
     if return_stats:
-        out.append({"accepted": int(stats[0]), "rejected": int(stats[1]), "rhs_calls": int(stats[2]),
-                    "frame": frame})
+        out.append({**stats_record(stats), "frame": frame})
     return out[0] if len(out) == 1 else tuple(out)
 
 

@@ -42,13 +42,12 @@ from spinorbit.core.dynamics.equations import STATE_SIZE, rhs_into
 from spinorbit.core.dynamics.validation import validate_output_times, validate_sampled_span, validate_state
 from spinorbit.core.integrators.dop853 import (
     DEFAULT_MAX_STEPS,
-    STAT_STATUS,
-    STATUS_MESSAGES,
-    STATUS_SUCCESS,
-    IntegrationError,
+    IntegrationError,  # noqa: F401  (raised through raise_for_engine_status; importable from here as before)
     dop853_fixed_steps,
     dop853_integrate,
     never_singular,
+    raise_for_engine_status,
+    stats_record,
 )
 # The stats layout and stop codes of integrate_dop853_kernel, importable from here as before the engine.
 from spinorbit.core.integrators.dop853 import STAT_ACCEPTED, STAT_REJECTED, STAT_RHS_CALLS  # noqa: F401
@@ -217,11 +216,9 @@ def integrate_quaternion(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=
     validate_sampled_span(model, t0, t_out)
     ys, stats = integrate_dop853_kernel(y0, t0, t_out, model, rtol, atol, int(max_steps),
                                         bool(hit_output_times), float(first_step))
-    status = int(stats[STAT_STATUS])
-    if status != STATUS_SUCCESS:
-        raise IntegrationError(f"integration stopped at step {int(stats[0] + stats[1])}: {STATUS_MESSAGES[status]}.")
+    raise_for_engine_status(stats)
     if return_stats:
-        return ys, {"accepted": int(stats[0]), "rejected": int(stats[1]), "rhs_calls": int(stats[2])}
+        return ys, stats_record(stats)
     return ys
 
 

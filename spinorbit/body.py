@@ -122,6 +122,7 @@ class RigidBody:
             not isinstance(self.radius, u.Quantity) or self.radius.unit.physical_type != "length"
         ):
             raise u.UnitTypeError(f"radius must be a Quantity in a length unit (e.g. 0.2 * u.km); got {self.radius!r}.")
+        values = values.copy()  # the body's own: np.asarray may have returned the caller's array
         to_principal = _principal_permutation(values)
         values.flags.writeable = False  # shared with the states built on this body: never changed
         to_principal.flags.writeable = False

@@ -39,6 +39,24 @@ def test_body_orders_axes_with_a_proper_rotation():
     assert np.allclose(np.abs(p @ np.diag([3.0836, 3.235, 1.0]) @ p.T), np.diag(body.principal_moments))
 
 
+@pytest.mark.parametrize("unit", [1.0, u.kg * u.m**2])
+def test_body_owns_its_moments(unit):
+    # The body keeps its own read-only copy: the caller's array stays writable, and changing it
+    # afterwards does not change the body (or the states built on it).
+    given = np.array([3.0836, 3.235, 1.0])
+    body = RigidBody(given * unit if unit != 1.0 else given)
+    state = RotationState.from_euler313(body, 0.1 * u.rad, 0.2 * u.rad, 0.3 * u.rad, [1.0, 2.0, 3.0] * u.rad / u.day)
+    momentum = state.angular_momentum.value.copy()
+    if unit == 1.0:
+        given[0] = 10.0
+    assert body.moment_values.tolist() == [3.0836, 3.235, 1.0]
+    assert np.array_equal(state.angular_momentum.value, momentum)
+    with pytest.raises(ValueError, match="read-only"):
+        body.moment_values[0] = 1.0
+    with pytest.raises(ValueError, match="read-only"):
+        body.to_principal[0, 0] = 1.0
+
+
 @pytest.mark.parametrize(
     "moments, error, message",
     [

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from astropy import units as u
 
+from spinorbit import pole as _pole
 from spinorbit.body import RigidBody
 from spinorbit.core.elements import andoyer as _andoyer
 from spinorbit.core.elements import canonical as _canonical
@@ -247,7 +248,8 @@ class RotationState:
 
     @property
     def mode(self) -> str:
-        """'SAM' (short-axis mode, about C), 'LAM' (long-axis mode, about A), 'separatrix' or 'permanent rotation'."""
+        """'SAM' (short-axis mode, about C), 'LAM' (long-axis mode, about A), 'separatrix' or 'permanent rotation'
+        (momentum exactly along A, B or C)."""
         mo, _, _, _ = self._motion()
         return MODE_NAMES[_summary.mode_code(mo)]
 
@@ -278,11 +280,52 @@ class RotationState:
         ⟨ġ⟩ = c G + PN_COEFF · Π(n|p)/K(p) · ν (eq. 7 averaged over a period); in LAM the long axis A,
         which gains one turn less per polhode period: P_φ = 2π/(⟨ġ⟩ − 2π/P_ψ). Checked: the Takahashi
         et al. (2013) Toutatis state gives 5.369 d / 7.412 d (tests/test_state.py). Both are
-        infinite on the separatrix; a permanent rotation has P_ψ = ∞ and P_φ = 2π/|ω|.
+        infinite on the separatrix; a permanent rotation (momentum exactly along A, B or C) has P_ψ = ∞
+        and P_φ = 2π/|ω|. Just off the A or C axis they are the small-wobble limits instead (about C:
+        P_ψ → 2π/ν₀, P_φ → 2π/(|ω| + ν₀), ν₀ = G√((a−c)(b−c))); :attr:`sidereal_period` is the
+        continuous one.
         """
         mo, _, momentum, moments = self._motion()
         rotation, precession = _summary.periods(mo, *momentum, *moments)  # the one definition (core)
         return rotation * u.day, precession * u.day
+
+    @property
+    def sidereal_period(self) -> u.Quantity:
+        """Sidereal rotation period (day): 2π/|ω| for a permanent rotation (momentum along A, B or C).
+
+        For a tumbler, 2π over the mean rate at which the body turns about its angular momentum: in
+        SAM 1/(1/P_φ − 1/P_ψ), in LAM 1/(1/P_φ + 1/P_ψ) — the lightcurve combination frequency that
+        becomes the rotation frequency as the wobble vanishes, so it is continuous as the state
+        approaches the A or C axis, where P_ψ and P_φ jump to (∞, 2π/|ω|) by their definition; on the
+        separatrix 2π B/G. ``docs/conventions.md`` ("Periods").
+        """
+        mo, _, momentum, moments = self._motion()
+        return _summary.sidereal_period(mo, *momentum, *moments) * u.day
+
+    @property
+    def pole_icrf(self) -> tuple[u.Quantity, u.Quantity]:
+        """(RA, Dec) of the angular momentum in ICRF (deg): the spin pole (``spinorbit.pole``)."""
+        ra, dec, _, _ = _pole.pole_angles_deg(self.angular_momentum_direction)
+        return ra[0] * u.deg, dec[0] * u.deg
+
+    @property
+    def pole_ecliptic(self) -> tuple[u.Quantity, u.Quantity]:
+        """(λ, β) of the angular momentum in ecliptic J2000 (deg; IAU 2006 obliquity, frame bias included)."""
+        _, _, lon, lat = _pole.pole_angles_deg(self.angular_momentum_direction)
+        return lon[0] * u.deg, lat[0] * u.deg
+
+    def obliquity(self, orbit_normal) -> u.Quantity:
+        """Angle (deg) between the angular momentum and ``orbit_normal``, the normal of the orbit plane.
+
+        Parameters
+        ----------
+        orbit_normal : array_like or Quantity, shape (3,)
+            ICRF components of the orbit's angular momentum r × v (any length; heliocentric for the
+            obliquity to the orbit about the Sun). :func:`spinorbit.pole.orbit_normals` makes it
+            from a position and velocity.
+        """
+        values = orbit_normal.value if isinstance(orbit_normal, u.Quantity) else orbit_normal
+        return _pole.obliquity_deg(self.angular_momentum_direction, np.reshape(np.asarray(values, float), (1, -1)))[0] * u.deg
 
     def _reference_frame(self, reference) -> np.ndarray:
         """Passive rotation inertial → frame of the Andoyer angles h, I (see :meth:`canonical_elements`)."""

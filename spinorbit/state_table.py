@@ -1,8 +1,10 @@
 """The output-table columns of many rotation states at once, with :class:`~spinorbit.RotationState`'s definitions.
 
 A run's table (:class:`spinorbit.scene.scene.SceneResult`, :func:`spinorbit.coupling.one_way.propagate_one_way`)
-reports for every row what the row's RotationState would: its unit quaternion, angular velocity,
-inertial momentum direction and, with "periods", the mode, E/E0, P_ψ and P_φ of its torque-free motion.
+reports for every row what the row's RotationState would: its unit quaternion, angular velocity, spin
+pole (RA, Dec; λ, β), the obliquity when the orbit normals are given and, with "periods", the mode,
+E/E0, P_ψ, P_φ and sidereal period of its torque-free motion — as scalar columns of the one output
+schema (``docs/conventions.md``, "Output tables").
 Building one RotationState per row cost ~0.1 ms a row (validation, Quantities, one compiled call per
 property), far more than the exact flow behind it; here the columns come from array operations and
 one compiled loop (:func:`spinorbit.core.free_motion.summary.motion_summary_many`, the kernels the
@@ -19,11 +21,13 @@ from __future__ import annotations
 import numpy as np
 from astropy import units as u
 
+from spinorbit import pole as _pole
 from spinorbit.core.free_motion import summary as _summary
 from spinorbit.core.math.rotations import attitude_to_quat_many, quat_to_attitude_many
 from spinorbit.state import MODE_NAMES, QUATERNION_NORM_TOLERANCE, InvalidStateError, RotationState
 
-__all__ = ["from_principal", "table_columns"]
+__all__ = ["MOTION_COLUMNS", "OMEGA_COLUMNS", "PERIOD_UNIT", "POLE_COLUMNS", "QUATERNION_COLUMNS", "add_obliquity", "from_principal",
+           "omega_array", "pole_directions", "quaternion_array", "schema_meta", "table_columns"]
 
 
 def from_principal(body, rows):
@@ -49,15 +53,22 @@ def _unit_quaternions(quaternions):
     return quaternions / norms[:, None]
 
 
+#: Names of the motion columns, in order (``docs/conventions.md``, "Output tables").
+MOTION_COLUMNS = ("mode", "energy_ratio", "P_psi", "P_phi", "sidereal_period")
+#: Unit of the period columns of every output table (the one output schema: hours).
+PERIOD_UNIT = u.h
+
+
 def _motion_columns(body, omegas):
-    """mode, E/E0, P_ψ, P_φ of every row's torque-free motion (the kernels of RotationState's properties)."""
+    """mode, E/E0, P_ψ, P_φ, P_sid of every row's torque-free motion (the kernels of RotationState's properties)."""
     momenta = np.ascontiguousarray((body.moment_values * omegas) @ body.to_principal.T)  # P (I ω), row by row
     if not np.all(np.any(momenta != 0.0, axis=1)):
         raise InvalidStateError("the body is not rotating (zero spin): it has no rotation mode or elements.")
     n = momenta.shape[0]
-    modes, ratios, p_psi, p_phi = np.empty(n, dtype=np.int64), np.empty(n), np.empty(n), np.empty(n)
-    _summary.motion_summary_many(momenta, *body.principal_moments, modes, ratios, p_psi, p_phi)
-    return _mode_names(modes), ratios, p_psi * u.day, p_phi * u.day
+    modes, ratios = np.empty(n, dtype=np.int64), np.empty(n)
+    p_psi, p_phi, p_sidereal = np.empty(n), np.empty(n), np.empty(n)
+    _summary.motion_summary_many(momenta, *body.principal_moments, modes, ratios, p_psi, p_phi, p_sidereal)
+    return (_mode_names(modes), ratios, *((p * u.day).to(PERIOD_UNIT) for p in (p_psi, p_phi, p_sidereal)))
 
 
 def _mode_names(codes):
@@ -73,12 +84,41 @@ def _mode_names(codes):
 def _constant_motion_columns(state, n):
     """The same columns for ``n`` rows of the torque-free motion of ``state``: its values, repeated."""
     p_psi, p_phi = state.periods
-    return (np.full(n, state.mode), np.full(n, state.energy_ratio), np.full(n, p_psi.to_value(u.day)) * u.day,
-            np.full(n, p_phi.to_value(u.day)) * u.day)
+    periods = (p.to_value(PERIOD_UNIT) for p in (p_psi, p_phi, state.sidereal_period))
+    return (np.full(n, state.mode), np.full(n, state.energy_ratio), *(np.full(n, p) * PERIOD_UNIT for p in periods))
 
 
-def table_columns(body, quaternions, omegas, omega=True, motion=None):
-    """Columns of a rotation table, in order: quaternion, [omega], momentum_direction, [mode, energy_ratio, P_psi, P_phi].
+def pole_directions(body, quaternions, omegas):
+    """Unit ICRF angular-momentum directions Rᵀ I ω / |…| of rows (N, 4) and (N, 3), user body axes."""
+    inertial = np.einsum("nji,nj->ni", quat_to_attitude_many(np.ascontiguousarray(quaternions)), body.moment_values * omegas)
+    norms = np.linalg.norm(inertial, axis=1, keepdims=True)
+    if not np.all(norms > 0.0):
+        raise InvalidStateError("the body is not rotating (zero spin) in some row: it has no spin pole, rotation mode "
+                                "or elements.")
+    return inertial / norms
+
+
+def quaternion_array(table):
+    """The (N, 4) scalar-first quaternions of a result table's ``q_w, q_x, q_y, q_z`` columns."""
+    return np.stack([np.asarray(table[name], dtype=float) for name in QUATERNION_COLUMNS], axis=1)
+
+
+def omega_array(table):
+    """The (N, 3) body angular velocities (rad/day) of a result table's ``omega_x, omega_y, omega_z`` columns."""
+    return np.stack([u.Quantity(table[name]).to_value(u.rad / u.day) for name in OMEGA_COLUMNS], axis=1)
+
+
+#: Scalar attitude and spin columns (the schema has no (N, k) columns, so API, ECSV and CSV agree).
+QUATERNION_COLUMNS = ("q_w", "q_x", "q_y", "q_z")
+OMEGA_COLUMNS = ("omega_x", "omega_y", "omega_z")
+POLE_COLUMNS = ("pole_ra", "pole_dec", "pole_lon", "pole_lat")
+
+
+def table_columns(body, quaternions, omegas, omega=True, motion=None, orbit_normals=None):
+    """Columns of a rotation table, in the order of the output schema (``docs/conventions.md``, "Output tables").
+
+    ``q_w, q_x, q_y, q_z``, [``omega_x, omega_y, omega_z``], ``pole_ra, pole_dec, pole_lon, pole_lat``,
+    [``obliquity``], [``mode, energy_ratio, P_psi, P_phi, sidereal_period``].
 
     Parameters
     ----------
@@ -89,23 +129,28 @@ def table_columns(body, quaternions, omegas, omega=True, motion=None):
     omegas : ndarray, shape (N, 3)
         Body angular velocity in user axes, rad/day.
     omega : bool
-        Include the ``omega`` column (Quantity, rad/day).
+        Include the ``omega_*`` columns (Quantity, rad/day).
     motion : None, "rows" or RotationState
         None: no motion columns; "rows": each row's own (osculating) mode, E/E0 and periods;
         a RotationState: those of its torque-free motion for every row (a torque-free run from it).
+    orbit_normals : None or ndarray, shape (N, 3) or (3,)
+        ICRF normals of the body's current heliocentric orbit plane: adds ``obliquity`` (deg).
 
     Returns
     -------
     dict
-        Column name → ndarray, list of str (``mode``) or Quantity (``omega`` rad/day, periods day).
+        Column name → ndarray, str array (``mode``) or Quantity (``omega_*`` rad/day, pole and
+        obliquity deg, periods h).
     """
     quaternions = _unit_quaternions(np.atleast_2d(np.asarray(quaternions, dtype=float)))
     omegas = np.atleast_2d(np.asarray(omegas, dtype=float))
-    columns = {"quaternion": quaternions}
+    columns = dict(zip(QUATERNION_COLUMNS, quaternions.T.copy()))
     if omega:
-        columns["omega"] = omegas * (u.rad / u.day)
-    inertial = np.einsum("nji,nj->ni", quat_to_attitude_many(np.ascontiguousarray(quaternions)), body.moment_values * omegas)
-    columns["momentum_direction"] = inertial / np.linalg.norm(inertial, axis=1, keepdims=True)  # Rᵀ I ω / |…|
+        columns.update(zip(OMEGA_COLUMNS, omegas.T.copy() * (u.rad / u.day)))
+    directions = pole_directions(body, quaternions, omegas)
+    columns.update(zip(POLE_COLUMNS, (angle * u.deg for angle in _pole.pole_angles_deg(directions))))
+    if orbit_normals is not None:
+        columns["obliquity"] = _pole.obliquity_deg(directions, orbit_normals) * u.deg
     if motion is None:
         return columns
     if isinstance(motion, RotationState):
@@ -114,5 +159,36 @@ def table_columns(body, quaternions, omegas, omega=True, motion=None):
         values = _motion_columns(body, omegas)
     else:
         raise ValueError(f"motion expects None, 'rows' or a RotationState; got {motion!r}.")
-    columns.update(zip(("mode", "energy_ratio", "P_psi", "P_phi"), values))
+    columns.update(zip(MOTION_COLUMNS, values))
     return columns
+
+
+def schema_meta(epoch, model):
+    """The ``table.meta`` every result table carries: ``epoch`` (ISO, TDB), ``frame``, ``model``, version, columns."""
+    from spinorbit import __version__
+
+    return {"epoch": epoch.tdb.isot, "frame": "ICRF", "model": model, "spinorbit_version": __version__,
+            "columns": dict(COLUMN_DESCRIPTIONS)}
+
+
+#: One line per column of the output schema (table.meta["columns"]; docs/conventions.md, "Output tables").
+COLUMN_DESCRIPTIONS = {
+    "time": "TDB",
+    "q_w": "attitude quaternion, scalar first, user body axes -> ICRF",
+    "omega_x": "body angular velocity along the user body axes (omega_y, omega_z likewise)",
+    "pole_ra": "right ascension of the angular momentum, ICRF (pole_dec: declination)",
+    "pole_lon": "ecliptic J2000 longitude of the angular momentum (pole_lat: latitude; IAU 2006 obliquity)",
+    "obliquity": "angle between the angular momentum and the osculating heliocentric orbit normal",
+    "mode": "SAM, LAM, separatrix or permanent rotation of the osculating torque-free motion",
+    "energy_ratio": "E/E0 = 2TC/G^2",
+    "P_psi": "rotation period of the tumbling (Pravec et al. 2005); inf for permanent rotation",
+    "P_phi": "precession period (Pravec et al. 2005); 2 pi/|omega| for permanent rotation",
+    "sidereal_period": "2 pi/|omega| for principal-axis rotation; 1/(1/P_phi -+ 1/P_psi) for SAM/LAM tumblers",
+}
+
+
+def add_obliquity(table, normals):
+    """Add the ``obliquity`` column (deg) of a table's ``pole_ra, pole_dec`` against orbit normals (N, 3), ICRF."""
+    ra, dec = (np.radians(u.Quantity(table[name]).to_value(u.deg)) for name in ("pole_ra", "pole_dec"))
+    directions = np.stack([np.cos(dec) * np.cos(ra), np.cos(dec) * np.sin(ra), np.sin(dec)], axis=1)
+    table["obliquity"] = _pole.obliquity_deg(directions, normals) * u.deg

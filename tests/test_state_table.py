@@ -14,7 +14,13 @@ from astropy import units as u
 from spinorbit import RigidBody, RotationState
 from spinorbit.core.math.rotations import quat_to_attitude
 from spinorbit.state import InvalidStateError
-from spinorbit.state_table import from_principal, table_columns
+from spinorbit.state_table import from_principal, omega_array, quaternion_array, table_columns
+
+COLUMNS = ["q_w", "q_x", "q_y", "q_z", "omega_x", "omega_y", "omega_z", "pole_ra", "pole_dec", "pole_lon", "pole_lat",
+           "mode", "energy_ratio", "P_psi", "P_phi", "sidereal_period"]
+#: A pole angle from directions that differ by ≤ 4 ulps (see momentum directions below), in degrees:
+#: atan2/asin of unit components move by ≤ 4 ulps / cos, a few 1e-14 deg at the latitudes used here.
+POLE_ATOL_DEG = 1e-12
 
 EPS = np.finfo(float).eps
 
@@ -54,17 +60,24 @@ def _rows(state):
 def test_columns_are_each_rows_rotation_state(name, state):
     quaternions, omegas, rows = _rows(state)
     columns = table_columns(state.body, quaternions, omegas, motion="rows")
-    assert list(columns) == ["quaternion", "omega", "momentum_direction", "mode", "energy_ratio", "P_psi", "P_phi"]
+    assert list(columns) == COLUMNS
     # The norms differ from RotationState's by the order of the sum: ≤ 1 ulp of each unit component.
-    assert np.abs(columns["quaternion"] - [s.quaternion for s in rows]).max() <= EPS
-    assert np.array_equal(columns["omega"].to_value(u.rad / u.day), [s.angular_velocity.value for s in rows])
-    # Rᵀ I ω of unit-size rows, then a norm: a few ulps of 1.
-    assert np.abs(columns["momentum_direction"] - [s.angular_momentum_direction for s in rows]).max() <= 4 * EPS
-    # Mode, E/E0 and the periods come from the very kernels RotationState calls: bit for bit.
+    assert np.abs(quaternion_array(columns) - [s.quaternion for s in rows]).max() <= EPS
+    assert np.array_equal(omega_array(columns), [s.angular_velocity.value for s in rows])
+    # Rᵀ I ω of unit-size rows, then a norm: a few ulps of 1; the angles of those directions:
+    for key, index, which in (("pole_ra", 0, "pole_icrf"), ("pole_dec", 1, "pole_icrf"), ("pole_lon", 0, "pole_ecliptic"),
+                              ("pole_lat", 1, "pole_ecliptic")):
+        expected = np.array([getattr(s, which)[index].to_value(u.deg) for s in rows])
+        difference = (columns[key].to_value(u.deg) - expected + 180.0) % 360.0 - 180.0  # RA, λ wrap at 360
+        assert np.abs(difference).max() <= POLE_ATOL_DEG
+    # Mode, E/E0 and the periods come from the very kernels RotationState calls: bit for bit (hours:
+    # the same day values times one conversion factor).
     assert list(columns["mode"]) == [s.mode for s in rows]
     assert np.array_equal(columns["energy_ratio"], [s.energy_ratio for s in rows])
-    assert np.array_equal(columns["P_psi"].to_value(u.day), [s.periods[0].to_value(u.day) for s in rows])
-    assert np.array_equal(columns["P_phi"].to_value(u.day), [s.periods[1].to_value(u.day) for s in rows])
+    assert np.array_equal(columns["P_psi"].to_value(u.h), [s.periods[0].to_value(u.h) for s in rows])
+    assert np.array_equal(columns["P_phi"].to_value(u.h), [s.periods[1].to_value(u.h) for s in rows])
+    assert np.array_equal(columns["sidereal_period"].to_value(u.h), [s.sidereal_period.to_value(u.h) for s in rows])
+    assert columns["P_psi"].unit == columns["P_phi"].unit == columns["sidereal_period"].unit == u.h
 
 
 @pytest.mark.parametrize("name, state", STATES, ids=[n for n, _ in STATES])
@@ -75,8 +88,9 @@ def test_torque_free_constants_are_the_rows_values_to_rounding(name, state):
     quaternions, omegas, rows = _rows(state)
     constant = table_columns(state.body, quaternions, omegas, motion=state)
     each = table_columns(state.body, quaternions, omegas, motion="rows")
-    assert np.array_equal(constant["quaternion"], each["quaternion"])
-    assert np.array_equal(constant["momentum_direction"], each["momentum_direction"])
+    assert np.array_equal(quaternion_array(constant), quaternion_array(each))
+    for key in ("pole_ra", "pole_dec", "pole_lon", "pole_lat"):
+        assert np.array_equal(constant[key], each[key])
     assert list(constant["mode"]) == list(each["mode"]) == [state.mode] * len(TIMES)
     # E/E0 of a rounded momentum: a few ulps (measured ≤ 1.5 ulps).
     assert np.abs(constant["energy_ratio"] / each["energy_ratio"] - 1).max() <= 4 * EPS
@@ -84,7 +98,7 @@ def test_torque_free_constants_are_the_rows_values_to_rounding(name, state):
     # b/|b − d| (~1e7 near the separatrix here; K ~ ln(1/(1 − m)) damps it): measured 6.1e-11 relative
     # there, so 1e-9; ≤ 2.5 ulps elsewhere, so 8 ulps.
     tolerance = 1e-9 if name == "near separatrix" else 8 * EPS
-    for key in ("P_psi", "P_phi"):
+    for key in ("P_psi", "P_phi", "sidereal_period"):
         a, b = constant[key].to_value(u.day), each[key].to_value(u.day)
         finite = np.isfinite(a)
         assert np.array_equal(finite, np.isfinite(b)) and (finite.all() or state.mode != "SAM")
@@ -134,11 +148,14 @@ def test_one_way_table_rows_are_their_rotation_states_and_osculate():
     # A strong nearby mass (GM 1e-3 au³/day² at 0.01 au) changes the periods visibly within 2 d.
     table = propagate_one_way(state, epoch, times, NoSamples(start, start + 2.0),
                               extra_sources=[fixed_source(1e-3, [0.01, 0.004, 0.002])])
-    rows = [RotationState(state.body, q, w) for q, w in zip(table["quaternion"], table["omega"].to_value(u.rad / u.day))]
-    assert np.abs(table["quaternion"] - [s.quaternion for s in rows]).max() <= EPS  # re-normalisation: ≤ 1 ulp
-    assert np.abs(table["momentum_direction"] - [s.angular_momentum_direction for s in rows]).max() <= 4 * EPS
+    rows = [RotationState(state.body, q, w) for q, w in zip(quaternion_array(table), omega_array(table))]
+    assert np.abs(quaternion_array(table) - [s.quaternion for s in rows]).max() <= EPS  # re-normalisation: ≤ 1 ulp
+    assert np.abs(table["pole_dec"].to_value(u.deg) - [s.pole_icrf[1].to_value(u.deg) for s in rows]).max() <= POLE_ATOL_DEG
+    # the first row is the first time asked (through TDB day floats: ~1e-11 d, so 10 µs)
+    assert abs((table["time"][0] - times[0]).to_value(u.s)) < 1e-5 and table.meta["epoch"] == epoch.tdb.isot and table.meta["frame"] == "ICRF"
     assert list(table["mode"]) == [s.mode for s in rows]
     assert np.array_equal(table["energy_ratio"], [s.energy_ratio for s in rows])
-    assert np.array_equal(table["P_psi"].to_value(u.day), [s.periods[0].to_value(u.day) for s in rows])
-    assert np.array_equal(table["P_phi"].to_value(u.day), [s.periods[1].to_value(u.day) for s in rows])
+    assert np.array_equal(table["P_psi"].to_value(u.h), [s.periods[0].to_value(u.h) for s in rows])
+    assert np.array_equal(table["P_phi"].to_value(u.h), [s.periods[1].to_value(u.h) for s in rows])
+    assert np.array_equal(table["sidereal_period"].to_value(u.h), [s.sidereal_period.to_value(u.h) for s in rows])
     assert np.ptp(table["P_psi"].to_value(u.day)) > 1e-6 * table["P_psi"][0].to_value(u.day)  # they do vary

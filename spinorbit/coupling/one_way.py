@@ -28,10 +28,10 @@ from spinorbit.core.dynamics.equations import make_model
 from spinorbit.core.integrators.quaternion import integrate_quaternion
 from spinorbit import old_paths
 from spinorbit.state import RotationState
-from spinorbit.state_table import from_principal, table_columns
+from spinorbit.state_table import from_principal, schema_meta, table_columns
 from spinorbit.time import tdb_days, time_from_tdb_days
 
-__all__ = ["DEFAULT_RTOL", "INTEGRATORS", "propagate_one_way"]
+__all__ = ["DEFAULT_RTOL", "INTEGRATORS", "heliocentric_normals", "propagate_one_way"]
 
 
 def __getattr__(name):
@@ -47,8 +47,27 @@ DEFAULT_RTOL = 1e-10
 INTEGRATORS = ("quaternion", "elements", "taylor")
 
 
+def heliocentric_normals(samples, days):
+    """Unit normals (N, 3) of the body's osculating heliocentric orbit plane at ``days``, from sampled Sun states.
+
+    ``samples`` must hold "sun" (relative to the body: the body's heliocentric state is its negative,
+    and r × v is the same for both). The normal r × v is formed at the sample knots and interpolated
+    linearly between them, then normalised: the knots follow the body's relative motion to the
+    sampler's tolerance, so the normal is good to far better than the 1e-6 deg an obliquity is quoted to
+    (``tests/test_pole.py`` measures it against DE421 states at the output times). None without "sun".
+    """
+    if "sun" not in samples.names:  # also scene.sampling.NoSamples, which has no perturbers
+        return None
+    sun = samples.states[:, samples.names.index("sun")]
+    knots = np.cross(sun[:, :3], sun[:, 3:])
+    knots /= np.linalg.norm(knots, axis=1, keepdims=True)
+    days = np.atleast_1d(np.asarray(days, dtype=float))
+    normals = np.stack([np.interp(days, samples.days, knots[:, k]) for k in range(3)], axis=1)
+    return normals / np.linalg.norm(normals, axis=1, keepdims=True)
+
+
 def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=True, integrator="quaternion",
-                      extra_sources=()):
+                      extra_sources=(), orbit_normals=None):
     """Integrate the rotation of ``state`` under the sampled perturbers' torques.
 
     Parameters
@@ -78,14 +97,19 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
         so it pays at least one step per sample inside the span).
     extra_sources : sequence
         More :mod:`spinorbit.core.model.perturbers` sources (e.g. ``fixed_source``) added to the sampled ones.
+    orbit_normals : ndarray (N, 3), optional
+        ICRF normals of the body's heliocentric orbit plane at ``times`` for the ``obliquity`` column;
+        by default :func:`heliocentric_normals` of ``samples`` when they hold the Sun (else no column).
 
     Returns
     -------
     astropy.table.QTable
-        Columns ``time`` (Time), ``quaternion`` (n, 4; scalar first, user body axes → ICRF),
-        ``omega`` (n, 3; rad/day, user body axes), ``momentum_direction`` (n, 3; unit, ICRF); with
-        ``periods``: ``mode``, ``energy_ratio`` (E/E0), ``P_psi``, ``P_phi`` (day).
-        ``table.meta`` holds the integrator statistics and the sampling error estimate: DOP853's
+        The one output schema (``docs/conventions.md``, "Output tables";
+        :func:`spinorbit.state_table.table_columns`): ``time`` (Time, TDB), ``q_w, q_x, q_y, q_z``
+        (scalar first, user body axes → ICRF), ``omega_x, omega_y, omega_z`` (rad/day, user body axes),
+        ``pole_ra, pole_dec, pole_lon, pole_lat`` (deg), ``obliquity`` (deg, with orbit normals); with
+        ``periods``: ``mode``, ``energy_ratio`` (E/E0), ``P_psi``, ``P_phi``, ``sidereal_period`` (h).
+        ``table.meta`` names ``epoch``, ``frame``, ``model`` and ``spinorbit_version``, and holds the integrator statistics and the sampling error estimate: DOP853's
         ``accepted``, ``rejected``, ``rhs_calls``; the Taylor method's ``steps``, ``order`` and
         ``mean_orbit_order``, with ``accepted`` = ``steps`` and ``rejected`` = 0 (it chooses each step
         after computing the series and never rejects one) and no ``rhs_calls`` (it evaluates no
@@ -120,11 +144,15 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
         stats.update(accepted=stats["steps"], rejected=0)
     else:
         ys, stats = integrate_quaternion(state.core_state(), t0, t_out, model, rtol=rtol, return_stats=True)
+    if orbit_normals is None:
+        orbit_normals = heliocentric_normals(samples, t_out)
     table = QTable()
     table["time"] = time_from_tdb_days(t_out)
     quaternions, omegas = from_principal(body, ys)  # all rows at once, no RotationState per row
-    for name, column in table_columns(body, quaternions, omegas, motion="rows" if periods else None).items():
+    for name, column in table_columns(body, quaternions, omegas, motion="rows" if periods else None,
+                                      orbit_normals=orbit_normals).items():
         table[name] = column
+    table.meta.update(schema_meta(epoch, f"one-way rotation under sampled torques ({integrator})"))
     table.meta.update(stats)
     table.meta["rtol"] = rtol
     table.meta["integrator"] = integrator

@@ -207,7 +207,7 @@ def tdb_day_array(time):
 
 
 def validate_times(epoch, times):
-    """(epoch_day, output_days, end_only) of a scalar epoch and output times strictly increasing after it."""
+    """(epoch_day, output_days, end_only) of a scalar epoch and output times strictly increasing from it on."""
     if not isinstance(epoch, Time) or not epoch.isscalar:
         raise SceneError(f"epoch expects a scalar astropy Time; got {epoch!r}.")
     if not isinstance(times, Time):
@@ -218,8 +218,8 @@ def validate_times(epoch, times):
     output_days = tdb_day_array(times)
     if not np.all(np.diff(output_days) > 0):
         raise SceneError("times expects strictly increasing output times.")
-    if not output_days[0] > epoch_day:
-        raise SceneError(f"times expects output times after the epoch; the first is "
+    if not output_days[0] >= epoch_day:  # the epoch itself may be the first row (the output schema)
+        raise SceneError(f"times expects output times at or after the epoch; the first is "
                          f"{output_days[0] - epoch_day:+.6g} d from it. Give later times or an earlier epoch.")
     return epoch_day, output_days, end_only
 

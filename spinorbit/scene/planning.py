@@ -160,12 +160,16 @@ def shape_decision(scene, skip=True):
                         f"two principal moments are exactly equal ({which}): exact, same accuracy as the "
                         "elliptic flow at parameter 0 and cheaper per output (docs/performance.md)")
     mode = scene.state.mode
+    _, momentum = scene.state.principal_attitude_and_momentum()
+    if mode == "permanent rotation" and momentum[1] == 0.0:  # exactly about A or C
+        return Decision("closed form", "elliptic free flow at parameter 0 (exact)",
+                        "the spin is exactly along the A or C axis (a permanent rotation): the flow's SAM or LAM "
+                        "formulas of zero amplitude give the uniform rotation")
     if mode == "permanent rotation":
         return Decision("closed form", "uniform rotation (no elliptic functions)",
                         "the spin is exactly along the intermediate axis B (a permanent rotation; spin along A or "
                         "C takes the elliptic flow at parameter 0)")
     asymmetry = min(big_b - big_a, big_c - big_b) / big_c
-    _, momentum = scene.state.principal_attitude_and_momentum()
     wobble = float(min(np.hypot(momentum[0], momentum[1]), np.hypot(momentum[1], momentum[2]))
                    / np.linalg.norm(momentum))
     return Decision("closed form", f"elliptic free flow, {mode} (exact; no approximate form taken)",

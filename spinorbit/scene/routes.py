@@ -20,10 +20,10 @@ from astropy.table import QTable
 
 from spinorbit.scene.sampling import NoSamples, subset_samples
 from spinorbit.scene.tolerances import MAX_RTOL_RETRIES, refine, sampling_error_bound
-from spinorbit.state_table import from_principal, table_columns
+from spinorbit.state_table import OMEGA_COLUMNS, from_principal, quaternion_array, schema_meta, table_columns
 from spinorbit.time import time_from_tdb_days
 
-__all__ = ["attitude_angles", "result_table", "run_coupled", "run_one_way", "run_torque_free"]
+__all__ = ["attitude_angles", "result_table", "run_coupled", "run_one_way", "run_torque_free", "scene_orbit_normals"]
 
 
 def attitude_angles(q1, q2):
@@ -46,6 +46,24 @@ def result_table(scene, quaternions, omegas, motion="rows"):
                                       motion=motion if "periods" in scene.quantities else None).items():
         table[name] = column
     return table
+
+
+def scene_orbit_normals(scene, plan):
+    """Unit normals of the body's heliocentric orbit plane at the output times, or (None, why not).
+
+    From the Sun sampled relative to the body on the scene's orbit (the samples a run already took at
+    the scene's sample tolerance are reused; :func:`spinorbit.coupling.one_way.heliocentric_normals`).
+    """
+    from spinorbit.coupling.one_way import heliocentric_normals
+
+    if scene.orbit is None:
+        return None, "the scene has no orbit"
+    source = plan.orbit_source if plan.orbit_source not in ("none",) else scene.orbit.kind
+    try:
+        samples = scene.sample_perturbers(source, ("sun",), scene.sample_tolerance)
+    except Exception as error:  # noqa: BLE001 - the obliquity is optional: say why it is missing
+        return None, f"the Sun could not be sampled on the scene's orbit ({type(error).__name__}: {error})"
+    return heliocentric_normals(samples, scene.output_days), None
 
 
 def run_torque_free(scene, plan):
@@ -82,7 +100,7 @@ def run_one_way(scene, plan, report):
                                 integrator=plan.integrator, extra_sources=fixed)
         check = propagate_one_way(scene.state, epoch, times, samples, rtol=check_rtol, periods=False,
                                   integrator=plan.integrator, extra_sources=fixed)
-        return run, float(np.max(attitude_angles(run["quaternion"], check["quaternion"])))
+        return run, float(np.max(attitude_angles(quaternion_array(run), quaternion_array(check))))
 
     def attempted(attempt):
         report(0.3 + 0.7 * (attempt + 1) / (MAX_RTOL_RETRIES + 1))
@@ -92,7 +110,7 @@ def run_one_way(scene, plan, report):
     kept_bound = sum(plan.estimates[n].worst_or_bound_rad for n in plan.kept)
     sampling = sampling_error_bound(scene.sample_tolerance, kept_bound) if named or moving else 0.0
     if "omega" not in scene.quantities:
-        run.remove_column("omega")
+        run.remove_columns(list(OMEGA_COLUMNS))
     run.meta["rtol"] = rtol
     # DOP853 reports accepted/rejected/rhs_calls; Taylor steps (= accepted, 0 rejected), order, no RHS calls.
     stats = {k: run.meta[k] for k in ("accepted", "rejected", "rhs_calls", "steps", "order") if k in run.meta}

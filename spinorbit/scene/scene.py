@@ -52,7 +52,7 @@ from spinorbit.scene import inputs
 from spinorbit.scene.inputs import QUANTITIES, SceneError
 from spinorbit.scene.plan import Plan
 from spinorbit.scene.planning import plan_scene
-from spinorbit.scene.routes import run_coupled, run_one_way, run_torque_free
+from spinorbit.scene.routes import run_coupled, run_one_way, run_torque_free, scene_orbit_normals
 from spinorbit.scene.sampling import SharedSamples, sample_perturbers
 
 __all__ = ["Scene", "SceneResult"]
@@ -83,10 +83,14 @@ class SceneResult:
     Attributes
     ----------
     table : astropy.table.QTable
-        ``time`` (Time, TDB), ``quaternion`` (scalar first, user body axes → ICRF), ``omega``
-        (rad/day, user body axes), ``momentum_direction`` (ICRF); with "periods" asked: ``mode``,
-        ``energy_ratio``, ``P_psi``, ``P_phi``. Only the quantities asked for are filled in beyond
-        time and quaternion. Each row holds what its RotationState would give
+        The one output schema (``docs/conventions.md``, "Output tables"): ``time`` (Time, TDB),
+        ``q_w, q_x, q_y, q_z`` (scalar first, user body axes → ICRF), ``omega_x, omega_y, omega_z``
+        (rad/day, user body axes), ``pole_ra, pole_dec`` (deg, ICRF), ``pole_lon, pole_lat`` (deg,
+        ecliptic J2000), ``obliquity`` (deg, to the osculating heliocentric orbit plane; with an
+        orbit); with "periods" asked: ``mode``, ``energy_ratio``, ``P_psi``, ``P_phi``,
+        ``sidereal_period`` (h). ``table.meta`` names ``epoch``, ``frame``, ``model``,
+        ``spinorbit_version`` and ``columns``. Only the quantities asked for are filled in beyond
+        time, attitude and pole. Each row holds what its RotationState would give
         (:func:`spinorbit.state_table.table_columns`, all rows at once); on the torque-free route
         mode, E/E0 and the periods are constants of the motion, taken once from the initial state.
     error_estimate : Quantity
@@ -135,7 +139,8 @@ class Scene:
     epoch : astropy.time.Time
         Time of ``state`` (scalar).
     times : astropy.time.Time
-        Output times, strictly increasing, after ``epoch``; a scalar Time means "the end only".
+        Output times, strictly increasing, from ``epoch`` on (the epoch itself may be the first, so
+        that the table starts with the state); a scalar Time means "the end only".
     perturbers : sequence of str, FixedPerturber or EphemerisPerturber
         DE421 body names (``"sun"``, ``"earth"``, ``"jupiter"``…; particle names for a REBOUND orbit)
         and/or :class:`FixedPerturber` s and :class:`EphemerisPerturber` s. Empty: torque-free.
@@ -256,6 +261,25 @@ class Scene:
             return plan_many(self.members, skip)
         return plan_scene(self, skip)
 
+    def _complete_table(self, table, plan):
+        """The output schema's obliquity (when the run has an orbit) and metadata, whatever the route."""
+        from spinorbit.state_table import add_obliquity, schema_meta
+
+        if self.orbit is not None and "obliquity" not in table.colnames:
+            normals, why_not = scene_orbit_normals(self, plan)
+            if normals is not None:
+                add_obliquity(table, normals)
+            else:
+                table.meta["obliquity"] = f"not computed: {why_not}"
+        kept = ", ".join(plan.kept) or "none"
+        meta = schema_meta(self.epoch, f"Scene, route {plan.route}, orbits from {plan.orbit_source}, "
+                                       f"integrator {plan.integrator}, torques of {kept} (degree 2)")
+        table.meta.update({k: v for k, v in meta.items() if k not in table.meta or k in ("model", "epoch")})
+        if "obliquity" in table.colnames and "mode" in table.colnames:  # the schema's order: before the motion
+            column = table["obliquity"]
+            table.remove_column("obliquity")
+            table.add_column(column, index=table.colnames.index("mode"), name="obliquity")
+
     @_sharing_samples
     def run(self, plan=None, progress=None):
         """Carry out ``plan`` (default: :meth:`plan`) and return a :class:`SceneResult`.
@@ -280,6 +304,7 @@ class Scene:
         else:
             table, parts, stats = run_one_way(self, plan, report)
         parts.setdefault("back_reaction", plan.back_reaction_rad)
+        self._complete_table(table, plan)
         report(1.0)
         parts_q = {k: (v * u.rad).to(u.arcsec) for k, v in parts.items()}
         total = sum(parts.values()) * u.rad

@@ -22,6 +22,7 @@ from spinorbit.data.asteroids import (
     encounter_state,
     toutatis_rotation_state,
 )
+from spinorbit.state_table import quaternion_array
 from spinorbit.core.dynamics.equations import make_model
 from spinorbit.core.integrators.quaternion import integrate_quaternion
 from spinorbit.core.model.perturbers import kepler_source, kepler_state
@@ -115,11 +116,14 @@ def test_propagate_one_way_returns_a_table_with_periods():
     samples = sample_from_ephemeris(de421_orbit("earth-moon barycenter"), start, start + 20 * u.day,
                                     perturbers=("sun",), tolerance=1e-9)
     table = propagate_one_way(toutatis_rotation_state(), start, start + [5, 10, 20] * u.day, samples)
-    assert table.colnames == ["time", "quaternion", "omega", "momentum_direction", "mode", "energy_ratio",
-                              "P_psi", "P_phi"]
+    # the one output schema (docs/conventions.md, "Output tables"); the samples hold the Sun: obliquity
+    assert table.colnames == ["time", "q_w", "q_x", "q_y", "q_z", "omega_x", "omega_y", "omega_z", "pole_ra", "pole_dec",
+                              "pole_lon", "pole_lat", "obliquity", "mode", "energy_ratio", "P_psi", "P_phi",
+                              "sidereal_period"]
     assert len(table) == 3 and set(table["mode"]) == {"LAM"}
-    assert table["P_psi"].unit == u.day
-    assert np.allclose(np.linalg.norm(table["quaternion"], axis=1), 1.0, atol=1e-14)
+    assert table["P_psi"].unit == u.h and table["obliquity"].unit == u.deg
+    assert np.allclose(np.linalg.norm(quaternion_array(table), axis=1), 1.0, atol=1e-14)
+    assert table.meta["frame"] == "ICRF" and table.meta["epoch"] == start.tdb.isot
 
 
 def test_encounter_geometry_has_the_published_distance_and_speed():

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from _offline import no_network  # noqa: F401
 from astropy.table import Table
+from astropy.time import Time
 
 from spinorbit import cli
 from spinorbit import RigidBody, RotationState
@@ -25,7 +26,9 @@ TOUTATIS = ["--moments", "3.0836", "3.235", "1", "--omega", "14.51", "33.529", "
             "--euler313", "145.498", "65.865", "241.524"]
 P_PSI_D, P_PHI_D = 5.369, 7.412
 PERIOD_TOLERANCE_D = 1e-3  # the published periods are given to 1e-3 d
-COLUMNS = ["time", "q_w", "q_x", "q_y", "q_z", "omega_x", "omega_y", "omega_z"]
+# The one output schema (docs/conventions.md, "Output tables"), the same as the API's torque-free table.
+COLUMNS = ["time", "q_w", "q_x", "q_y", "q_z", "omega_x", "omega_y", "omega_z", "pole_ra", "pole_dec", "pole_lon",
+           "pole_lat", "mode", "energy_ratio", "P_psi", "P_phi", "sidereal_period"]
 # The first row is the input state itself: the exact flow at t = 0 must return it to rounding.
 INITIAL_STATE_TOLERANCE = 1e-12
 
@@ -62,16 +65,19 @@ def test_toutatis_ecsv_reads_back_with_columns_units_and_initial_state(capsys, t
     table = Table.read(path, format="ascii.ecsv")
     assert table.colnames == COLUMNS
     assert len(table) == 21
-    assert table["time"].unit == u.day
-    assert table["omega_x"].unit == u.deg / u.day
+    assert isinstance(table["time"], Time) and table["time"].scale == "tdb"
+    assert table["time"][0] == Time("2000-01-01T12:00:00", scale="tdb")  # --epoch default, the first row
+    assert table["omega_x"].unit == u.rad / u.day and table["P_psi"].unit == u.h and table["pole_lat"].unit == u.deg
     assert all(table[f"q_{c}"].unit is None for c in "wxyz")
     assert table.meta["mode"] == "LAM" and table.meta["sense"] == "-A"
-    np.testing.assert_allclose(table["time"], np.arange(21) * 0.5)
+    assert table.meta["frame"] == "ICRF" and table.meta["epoch"] == "2000-01-01T12:00:00.000" and table.meta["model"]
+    np.testing.assert_allclose((table["time"] - table["time"][0]).to_value(u.day), np.arange(21) * 0.5, atol=1e-9)
 
     q = np.column_stack([table[f"q_{c}"] for c in "wxyz"])
-    omega = np.column_stack([table[f"omega_{c}"] for c in "xyz"])
+    omega = np.column_stack([table[f"omega_{c}"] for c in "xyz"]) * u.rad / u.day
     np.testing.assert_allclose(np.linalg.norm(q, axis=1), 1.0, atol=INITIAL_STATE_TOLERANCE)
-    np.testing.assert_allclose(omega[0], [14.51, 33.529, -98.709], rtol=INITIAL_STATE_TOLERANCE)
+    np.testing.assert_allclose(omega[0].to_value(u.deg / u.day), [14.51, 33.529, -98.709], rtol=INITIAL_STATE_TOLERANCE)
+    assert table["P_psi"][0] == pytest.approx(P_PSI_D * 24, abs=PERIOD_TOLERANCE_D * 24)
     body = RigidBody([3.0836, 3.235, 1.0])
     state = RotationState.from_euler313(body, 145.498 * u.deg, 65.865 * u.deg, 241.524 * u.deg,
                                         [14.51, 33.529, -98.709] * u.deg / u.day)
@@ -89,8 +95,10 @@ def test_n_times_and_omega_unit(capsys, tmp_path):
     assert status == 0, err
     assert periods(out) == pytest.approx((P_PSI_D, P_PHI_D), abs=PERIOD_TOLERANCE_D)
     table = Table.read(path)
-    assert len(table) == 7 and table["time"][-1] == pytest.approx(2 * 365.25)
-    assert table["omega_x"].unit == u.rad / u.s
+    assert len(table) == 7 and (table["time"][-1] - table["time"][0]).to_value(u.day) == pytest.approx(2 * 365.25)
+    # the schema's unit whatever --omega-unit was: the rad/s input comes back as rad/day
+    assert table["omega_x"].unit == u.rad / u.day
+    assert table["omega_x"][0] == pytest.approx(float(omega[0]) * 86400.0, rel=1e-12)
 
 
 def test_plot_is_a_png(capsys, tmp_path):

@@ -29,8 +29,10 @@ def add_scene_arguments(parser: argparse.ArgumentParser, span_default: str, pert
     run.add_argument("--no-skip", action="store_true",
                      help="run the reference plan: every perturber, the orbits as given, nothing skipped")
     files = parser.add_argument_group("output files")
-    files.add_argument("--output", metavar="FILE.ecsv", help="write time, attitude, spin and periods as ECSV")
-    files.add_argument("--plot", metavar="FILE.png", help="plot the periods and E/E0 (needs matplotlib)")
+    files.add_argument("--output", metavar="FILE.ecsv", help="write the result table (time, attitude, spin, pole, "
+                       "obliquity, periods; docs/conventions.md 'Output tables') as ECSV")
+    files.add_argument("--plot", metavar="FILE.png", help="plot periods, pole, obliquity and mode against the date, "
+                       "encounters marked (needs matplotlib; .png, .pdf or .svg)")
 
 
 def span_and_times(args, start, max_days: float):
@@ -46,7 +48,8 @@ def span_and_times(args, start, max_days: float):
         raise CommandError(f"--n-times expects between 2 and {MAX_TIMES} output times; got {args.n_times}.")
     if args.end_only:
         return span, start + days * u.day
-    return span, start + np.linspace(days / args.n_times, days, args.n_times) * u.day
+    # the first row is the start itself (the output schema), then evenly to the end
+    return span, start + np.linspace(0.0, days, args.n_times) * u.day
 
 
 def tolerance(args):
@@ -120,42 +123,30 @@ def summary(result, period_unit: str, plan_seconds: float = 0.0) -> list[str]:
     return lines
 
 
-def ecsv_table(result, name: str, period_unit: str):
-    """The result as a plain astropy Table with units, for ECSV."""
-    import astropy.units as u
-    from astropy.table import Table
-
+def ecsv_table(result, name: str, period_unit: str = "h"):
+    """The result table as a plain astropy Table for ECSV: the API's columns and units (the output
+    schema, periods in h whatever ``period_unit`` the summary prints), the plan in ``meta``."""
     from spinorbit import __version__
+    from spinorbit.commands._outputs import ecsv_table as schema_ecsv
 
-    qtable = result.table
-    table = Table(meta={
+    return schema_ecsv(result.table, {
         "software": f"spinorbit {__version__} {name}",
+        "model": f"spinorbit {name}: {result.table.meta.get('model', '')}",
         "route": result.plan.route,
         "orbits": result.plan.orbit_source,
         "perturbers_kept": list(result.plan.kept),
         "perturbers_dropped": list(result.plan.dropped),
         "tolerance_arcsec": result.plan.tolerance_rad * 206264.80624709636,
-        "error_estimate_arcsec": float(result.error_estimate.to_value(u.arcsec)),
+        "error_estimate_arcsec": float(result.error_estimate.to_value("arcsec")),
         "tolerance_met": result.tolerance_met,
         "plan": str(result.plan),
-        "conventions": "quaternion scalar first (w, x, y, z), body axes -> ICRF; omega in body axes",
+        "conventions": "quaternion scalar first (w, x, y, z), body axes -> ICRF; omega in body axes; "
+                       "docs/conventions.md 'Output tables'",
     })
-    table["time"] = qtable["time"].tdb
-    for i, axis in enumerate("wxyz"):
-        table[f"q_{axis}"] = qtable["quaternion"][:, i]
-    if "omega" in qtable.colnames:
-        for i, axis in enumerate("xyz"):
-            table[f"omega_{axis}"] = qtable["omega"][:, i].to(u.rad / u.day)
-    if "P_psi" in qtable.colnames:
-        table["mode"] = qtable["mode"]
-        table["P_psi"] = qtable["P_psi"].to(period_unit)
-        table["P_phi"] = qtable["P_phi"].to(period_unit)
-        table["energy_ratio"] = qtable["energy_ratio"]
-    return table
 
 
 def write_outputs(args, result, name: str, title: str, period_unit: str) -> None:
-    """ECSV and PNG, each atomically."""
+    """ECSV and plot, each atomically."""
     if args.output is not None:
         table = ecsv_table(result, name, period_unit)
         with atomic_output("--output", args.output) as temporary:
@@ -163,27 +154,13 @@ def write_outputs(args, result, name: str, title: str, period_unit: str) -> None
         print(f"wrote              {args.output} ({len(table)} rows)")
     if args.plot is not None:
         with atomic_output("--plot", args.plot) as temporary:
-            plot(result, temporary, title, period_unit)
+            plot(result, temporary, title, period_unit, args.plot)
         print(f"wrote              {args.plot}")
 
 
-def plot(result, path: str, title: str, period_unit: str) -> None:
-    """PNG: P_psi, P_phi and E/E0 against days from the first output."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+def plot(result, path: str, title: str, period_unit: str = "h", name: str | None = None) -> None:
+    """Periods, pole, obliquity and mode against the date, the run's closest approaches marked."""
+    from spinorbit.commands._outputs import plot_format, plot_rotation
 
-    table = result.table
-    days = (table["time"] - table["time"][0]).to_value("d")
-    figure = Figure(figsize=(7, 6), layout="constrained")
-    FigureCanvasAgg(figure)
-    axes = figure.subplots(3, 1, sharex=True)
-    if "P_psi" in table.colnames:
-        axes[0].plot(days, table["P_psi"].to_value(period_unit))
-        axes[1].plot(days, table["P_phi"].to_value(period_unit), color="C1")
-        axes[2].plot(days, table["energy_ratio"], color="C2")
-    axes[0].set_ylabel(f"P_psi [{period_unit}]")
-    axes[1].set_ylabel(f"P_phi [{period_unit}]")
-    axes[2].set_ylabel("E/E0")
-    axes[2].set_xlabel(f"days from {table['time'][0].tdb.iso[:16]} TDB")
-    axes[0].set_title(title)
-    figure.savefig(path, format="png", dpi=100)
+    plot_rotation(result.table, path, title, plot_format(name or path),
+                  encounters=result.table.meta.get("closest_approaches"))

@@ -79,6 +79,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     times = parser.add_argument_group("output times")
     times.add_argument(
+        "--epoch", default="2000-01-01T12:00:00", metavar="TIME",
+        help="date of the initial state, ISO in TDB (default J2000.0); the table's time column starts there",
+    )
+    times.add_argument(
         "--span", nargs="+", default=["100", "d"], metavar="SPAN",
         help="how long to propagate, e.g. '100 d', '2 yr', '36 h' (a number alone is days; default 100 d); "
         "negative goes back in time",
@@ -87,8 +91,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     spacing.add_argument("--step", nargs="+", metavar="STEP", help="spacing of output times, e.g. '1 d' (default 1 d)")
     spacing.add_argument("--n-times", type=_count, metavar="N", help="number of evenly spaced output times instead")
     files = parser.add_argument_group("output files")
-    files.add_argument("--output", metavar="FILE.ecsv", help="write the table (time, quaternion, omega) as ECSV")
-    files.add_argument("--plot", metavar="FILE.png", help="plot quaternion and omega against time (needs matplotlib)")
+    files.add_argument("--output", metavar="FILE.ecsv", help="write the table (time, attitude, spin, pole, periods; "
+                       "docs/conventions.md 'Output tables') as ECSV")
+    files.add_argument("--plot", metavar="FILE.png", help="plot periods, pole and mode against the date "
+                       "(needs matplotlib; .png, .pdf or .svg)")
 
 
 def _offsets(args):
@@ -109,6 +115,16 @@ def _offsets(args):
             f"--span/--step give {count} output times, more than {MAX_TIMES}; use a larger --step or --n-times."
         )
     return math.copysign(step, span) * np.arange(count)
+
+
+def _epoch(text):
+    """The --epoch Time (TDB)."""
+    from astropy.time import Time
+
+    try:
+        return Time(text, scale="tdb")
+    except ValueError:
+        raise CommandError(f"--epoch expects an ISO date such as 2000-01-01T12:00:00 (TDB); got '{text}'.") from None
 
 
 def _state(args):
@@ -165,14 +181,22 @@ def _continuous(quaternions):
     return quaternions
 
 
-def _table(args, state, offsets, quaternions, omegas, omega_unit):
+def _table(args, state, epoch, offsets, quaternions, omegas, omega_unit):
+    """The output schema's table (docs/conventions.md, "Output tables") of the run, with the inputs in meta."""
     import astropy.units as u
     from astropy.table import Table
 
     from spinorbit import __version__
+    from spinorbit.state_table import schema_meta, table_columns
 
     p_psi, p_phi = state.periods
-    table = Table(meta={
+    table = Table()
+    table["time"] = epoch + offsets * u.day
+    columns = table_columns(state.body, quaternions, omegas.to_value(u.rad / u.day), motion=state)
+    for name, column in columns.items():
+        table[name] = column
+    table.meta.update(schema_meta(epoch, "exact torque-free rotation (Fukushima's canonical elements, paper eq. 12)"))
+    table.meta.update({
         "software": f"spinorbit {__version__} torque-free",
         "moments_xyz": list(args.moments),
         "euler313_deg": list(args.euler313),
@@ -182,44 +206,20 @@ def _table(args, state, offsets, quaternions, omegas, omega_unit):
         "sense": state.sense,
         "P_psi_d": float(p_psi.to_value(u.day)),
         "P_phi_d": float(p_phi.to_value(u.day)),
+        "sidereal_period_d": float(state.sidereal_period.to_value(u.day)),
         "E_over_E0": state.energy_ratio,
         "conventions": (
-            "quaternion scalar first (w, x, y, z), body axes -> inertial, sign continuous in time; "
-            "omega in body axes; Euler angles passive 3-1-3, R = R3(psi) R1(theta) R3(phi)"
+            "quaternion scalar first (w, x, y, z), body axes -> inertial (ICRF), sign continuous in time; "
+            "omega in body axes, rad/day; Euler angles passive 3-1-3, R = R3(psi) R1(theta) R3(phi)"
         ),
     })
-    table.add_column(offsets, name="time")
-    table["time"].unit, table["time"].description = u.day, "time since the initial state"
-    for i, name in enumerate("wxyz"):
-        table[f"q_{name}"] = quaternions[:, i]
-        table[f"q_{name}"].description = f"attitude quaternion, component {name}"
-    omegas = omegas.to_value(omega_unit, equivalencies=u.dimensionless_angles())
-    for i, name in enumerate("xyz"):
-        table[f"omega_{name}"] = omegas[:, i]
-        table[f"omega_{name}"].unit = omega_unit
-        table[f"omega_{name}"].description = f"body angular velocity along body {name}"
     return table
 
 
-def _plot(table, path):
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+def _plot(table, path, name):
+    from spinorbit.commands._outputs import plot_format, plot_rotation
 
-    figure = Figure(figsize=(8, 6), layout="constrained")
-    FigureCanvasAgg(figure)
-    top, bottom = figure.subplots(2, 1, sharex=True)
-    t = table["time"].data
-    for name in "wxyz":
-        top.plot(t, table[f"q_{name}"].data, label=f"q_{name}")
-    for name in "xyz":
-        bottom.plot(t, table[f"omega_{name}"].data, label=f"omega_{name}")
-    top.set_ylabel("quaternion (body -> inertial)")
-    bottom.set_ylabel(f"omega [{table['omega_x'].unit}]")
-    bottom.set_xlabel("time since initial state [d]")
-    top.set_title(f"torque-free rotation: {table.meta['mode']} {table.meta['sense']}")
-    for axes in (top, bottom):
-        axes.legend(loc="upper right", fontsize="small")
-    figure.savefig(path, format="png", dpi=120)
+    plot_rotation(table, path, f"torque-free rotation: {table.meta['mode']} {table.meta['sense']}", plot_format(name))
 
 
 def _require_matplotlib():
@@ -239,11 +239,12 @@ def run(args) -> int:
     if args.plot is not None:
         _require_matplotlib()
     offsets = _offsets(args)
+    epoch = _epoch(args.epoch)
     state, omega_unit = _state(args)
     for line in _summary(state):
         print(line)
     quaternions, omegas = _propagate(state, offsets)
-    table = _table(args, state, offsets, quaternions, omegas, omega_unit)
+    table = _table(args, state, epoch, offsets, quaternions, omegas, omega_unit)
     span = f"{offsets[-1]:g} d"
     if args.output is not None:
         with atomic_output("--output", args.output) as temporary:
@@ -251,7 +252,7 @@ def run(args) -> int:
         print(f"wrote              {args.output} ({len(table)} rows over {span})")
     if args.plot is not None:
         with atomic_output("--plot", args.plot) as temporary:
-            _plot(table, temporary)
+            _plot(table, temporary, args.plot)
         print(f"wrote              {args.plot}")
     if args.output is None and args.plot is None:
         print(f"propagated         {len(table)} times over {span}; give --output FILE.ecsv to keep them")

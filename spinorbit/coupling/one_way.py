@@ -31,7 +31,7 @@ from spinorbit.state import RotationState
 from spinorbit.state_table import from_principal, schema_meta, table_columns
 from spinorbit.time import tdb_days, time_from_tdb_days
 
-__all__ = ["DEFAULT_RTOL", "INTEGRATORS", "heliocentric_normals", "propagate_one_way"]
+__all__ = ["DEFAULT_RTOL", "INTEGRATORS", "closest_approaches", "heliocentric_normals", "propagate_one_way"]
 
 
 def __getattr__(name):
@@ -64,6 +64,18 @@ def heliocentric_normals(samples, days):
     days = np.atleast_1d(np.asarray(days, dtype=float))
     normals = np.stack([np.interp(days, samples.days, knots[:, k]) for k in range(3)], axis=1)
     return normals / np.linalg.norm(normals, axis=1, keepdims=True)
+
+
+def closest_approaches(samples):
+    """{name: (TDB day, distance au)} of each sampled perturber's closest approach on the sample grid.
+
+    The grid is adaptive (denser where the relative motion bends), so its minimum is the encounter to
+    within a knot spacing: good for marking it on a plot, not for an encounter's exact time.
+    """
+    distances = np.linalg.norm(samples.states[:, :, :3], axis=2)
+    nearest = np.argmin(distances, axis=0)
+    return {name: (float(samples.days[j]), float(distances[j, i])) for i, (name, j) in enumerate(zip(samples.names,
+                                                                                                       nearest))}
 
 
 def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=True, integrator="quaternion",

@@ -116,6 +116,11 @@ def run_one_way(scene, plan, report):
     stats = {k: run.meta[k] for k in ("accepted", "rejected", "rhs_calls", "steps", "order") if k in run.meta}
     stats.update(integrator=plan.integrator, rtol=rtol, samples=int(samples.days.size),
                  passes=int(getattr(samples, "passes", 0)))
+    if samples.names:
+        from spinorbit.coupling.one_way import closest_approaches
+
+        run.meta["closest_approaches"] = {name: {"time": time_from_tdb_days(day).tdb.isot, "distance_au": distance}
+                                          for name, (day, distance) in closest_approaches(samples).items()}
     return run, {"dropped": plan.dropped_bound_rad, "integration": integration, "sampling": sampling}, stats
 
 

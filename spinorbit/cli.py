@@ -127,8 +127,11 @@ def main(argv=None) -> int:
         stdout was closed early.
     """
     args = build_parser().parse_args(argv)
+    from spinorbit.commands._compile_notice import compile_notice
+
     try:
-        return args._run(args)
+        with compile_notice():
+            return args._run(args)
     except BrokenPipeError:
         # stdout was closed early (`spinorbit ... | head`): stop quietly, as Unix tools do on SIGPIPE.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

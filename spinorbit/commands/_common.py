@@ -106,9 +106,11 @@ class Progress:
         Word shown before the bar.
     stream : file, optional
         Where to draw (stderr by default).
+    delay : float, optional
+        Seconds before the bar shows itself (:data:`PROGRESS_DELAY_S` by default).
     """
 
-    def __init__(self, total: int, label: str, stream=None):
+    def __init__(self, total: int, label: str, stream=None, delay: float | None = None):
         self.total, self.label = max(int(total), 1), label
         self.stream = sys.stderr if stream is None else stream
         self.enabled = bool(getattr(self.stream, "isatty", lambda: False)())
@@ -116,12 +118,13 @@ class Progress:
         self.last_draw = 0.0
         self.drawn = False
         self.done = 0
+        self.delay = PROGRESS_DELAY_S if delay is None else float(delay)
 
     def advance(self, count: int) -> None:
         """Record ``count`` more items done; redraw if due."""
         self.done += count
         now = time.monotonic()
-        if self.enabled and now - self.start >= PROGRESS_DELAY_S and now - self.last_draw >= PROGRESS_REDRAW_S:
+        if self.enabled and now - self.start >= self.delay and now - self.last_draw >= PROGRESS_REDRAW_S:
             self._draw(now)
 
     def _draw(self, now: float) -> None:

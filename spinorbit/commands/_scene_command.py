@@ -7,6 +7,8 @@ import argparse
 from spinorbit.cli import CommandError
 from spinorbit.commands._common import Progress, atomic_output, quantity
 
+#: Seconds of planning before its progress bar shows (issue 15: plans of long runs take tens of seconds).
+PLAN_PROGRESS_DELAY_S = 1.0
 #: Most output times a command accepts (each row builds a RotationState for the periods).
 MAX_TIMES = 100_000
 
@@ -65,12 +67,25 @@ def run_scene(scene, args):
     clock = time.perf_counter()
     if sys.stderr.isatty():  # planning samples the orbits (an N-body run): say so before the wait
         print("planning (sampling the orbits) ...", file=sys.stderr, flush=True)
-    plan = scene.plan(skip=not args.no_skip)
+    planning = Progress(100, "planning", delay=PLAN_PROGRESS_DELAY_S)
+    try:
+        plan = scene.plan(skip=not args.no_skip, progress=_advancing(planning))
+    finally:
+        planning.close()
     args.plan_seconds = time.perf_counter() - clock
     if args.plan:
         print(plan)
         return None
     progress = Progress(100, "running")
+    try:
+        result = scene.run(plan, progress=_advancing(progress))
+    finally:
+        progress.close()
+    return result
+
+
+def _advancing(progress):
+    """A fraction callback (Scene.plan / Scene.run) that moves a 100-item :class:`Progress`."""
     done = [0]
 
     def advance(fraction):
@@ -79,11 +94,7 @@ def run_scene(scene, args):
             progress.advance(step)
             done[0] += step
 
-    try:
-        result = scene.run(plan, progress=advance)
-    finally:
-        progress.close()
-    return result
+    return advance
 
 
 def run_and_report(args, state, start, times, orbit, name: str, title: str, period_unit: str) -> int:

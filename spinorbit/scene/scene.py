@@ -167,6 +167,7 @@ class Scene:
     def __init__(self, state, epoch, times, perturbers=(), orbit=None, tolerance=1 * u.arcsec,
                  quantities=QUANTITIES, integrator="auto", sample_tolerance=1e-10):
         self.members, self._cache = None, None  # _cache: the SharedSamples of the plan() / run() under way
+        self._report_planning = None  # plan()'s progress callback while it plans
         if isinstance(state, (list, tuple, dict)):
             from spinorbit.scene import many
 
@@ -226,6 +227,8 @@ class Scene:
         samples = self._sample(source, names, tolerance)
         if self._cache is not None:
             self._cache.add(source, tolerance, samples)
+        if self._report_planning is not None:  # the survey's sampling is most of a plan's time
+            self._report_planning(0.8)
         return samples
 
     def _sample(self, source, names, tolerance):
@@ -246,8 +249,12 @@ class Scene:
     # Planning and running
 
     @_sharing_samples
-    def plan(self, skip=True):
+    def plan(self, skip=True, progress=None):
         """Decide how to run the scene; ``skip=False`` gives the reference plan (nothing skipped).
+
+        ``progress``, if given, is called with a fraction in [0, 1] as planning advances (0 at the
+        start, after the survey of the perturbers — the sampling of their orbits, the long part —
+        and 1 at the end), like :meth:`run`'s.
 
         Returns
         -------
@@ -259,7 +266,15 @@ class Scene:
             from spinorbit.scene.many import plan_many
 
             return plan_many(self.members, skip)
-        return plan_scene(self, skip)
+        report = progress or (lambda fraction: None)
+        report(0.0)
+        self._report_planning = report
+        try:
+            plan = plan_scene(self, skip)
+        finally:
+            self._report_planning = None
+        report(1.0)
+        return plan
 
     def _complete_table(self, table, plan):
         """The output schema's obliquity (when the run has an orbit) and metadata, whatever the route."""

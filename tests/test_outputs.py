@@ -1,0 +1,133 @@
+"""The one output schema across API and commands, the plots' content, plan progress and the compile notice."""
+
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+from astropy import units as u
+from astropy.table import Table
+from astropy.time import Time
+
+from spinorbit import RigidBody, RotationState, Scene
+from spinorbit.scene import FixedPerturber, Orbit
+from spinorbit.state_table import MOTION_COLUMNS, OMEGA_COLUMNS, POLE_COLUMNS, QUATERNION_COLUMNS
+
+ROOT = Path(__file__).resolve().parents[1]
+SCHEMA = ["time", *QUATERNION_COLUMNS, *OMEGA_COLUMNS, *POLE_COLUMNS]
+EPOCH = Time("2020-01-01T00:00:00", scale="tdb")
+
+
+def _state():
+    return RotationState.from_euler313(RigidBody([0.61, 0.965, 1.0]), 10 * u.deg, 40 * u.deg, 70 * u.deg,
+                                       [5, 3, 40] * u.deg / u.hour)
+
+
+def test_torque_free_scene_table_starts_at_the_epoch_with_the_schema():
+    times = EPOCH + np.linspace(0.0, 10.0, 11) * u.day
+    result = Scene(_state(), EPOCH, times).run()
+    table = result.table
+    assert table.colnames == [*SCHEMA, *MOTION_COLUMNS]
+    assert table["time"].scale == "tdb" and table["time"][0] == EPOCH
+    # the first row is the state itself
+    assert np.allclose(np.stack([table[c] for c in QUATERNION_COLUMNS], axis=1)[0] * np.sign(table["q_w"][0]),
+                       _state().quaternion * np.sign(_state().quaternion[0]), atol=1e-15)
+    assert table.meta["epoch"] == EPOCH.isot and table.meta["frame"] == "ICRF" and "torque-free" in table.meta["model"]
+    assert table["P_psi"].unit == u.h and table["pole_ra"].unit == u.deg and table["omega_x"].unit == u.rad / u.day
+
+
+def test_scene_with_an_orbit_has_the_obliquity_against_the_orbit_plane():
+    # a circular barycentric orbit; the obliquity is to the *heliocentric* plane: body minus DE421's Sun
+    # (the Sun's own barycentric motion tilts it by ~0.02° from the circle's +z)
+    from spinorbit.ephemeris import barycentric_state_au
+    from spinorbit.pole import obliquity_deg, orbit_normals
+    from spinorbit.scene.inputs import tdb_day_array
+
+    orbit = Orbit.circular(2.5 * u.au)
+    times = EPOCH + np.linspace(0.0, 2.0, 5) * u.day
+    table = Scene(_state(), EPOCH, times, perturbers=("sun",), orbit=orbit, tolerance=1e3 * u.arcsec).run().table
+    assert "obliquity" in table.colnames and table.colnames.index("obliquity") == table.colnames.index("mode") - 1
+    days = tdb_day_array(times)
+    (r, v), (sun_r, sun_v) = orbit.function(days), barycentric_state_au("sun", days)
+    ra, dec = (np.radians(table[c].to_value(u.deg)) for c in ("pole_ra", "pole_dec"))
+    poles = np.stack([np.cos(dec) * np.cos(ra), np.cos(dec) * np.sin(ra), np.sin(dec)], axis=1)
+    expected = obliquity_deg(poles, orbit_normals(r - sun_r, v - sun_v))
+    # the normals come from the Sun sampled relative to the body (1e-10), linearly between knots:
+    # within 1e-5 deg (tests/test_pole.py)
+    assert np.abs(table["obliquity"].to_value(u.deg) - expected).max() < 1e-5
+
+
+def test_plan_reports_progress():
+    fractions = []
+    times = EPOCH + np.linspace(0.0, 2.0, 5) * u.day
+    scene = Scene(_state(), EPOCH, times, perturbers=("sun", "jupiter"), orbit=Orbit.circular(2.5 * u.au))
+    scene.plan(progress=fractions.append)
+    assert fractions[0] == 0.0 and fractions[-1] == 1.0 and len(fractions) >= 3
+    assert fractions == sorted(fractions)
+
+
+@pytest.mark.parametrize("extension", ["png", "pdf", "svg"])
+def test_plot_shows_dates_periods_pole_obliquity_and_encounters(tmp_path, extension):
+    pytest.importorskip("matplotlib")
+    from spinorbit.commands._outputs import plot_rotation
+
+    times = EPOCH + np.linspace(0.0, 5.0, 30) * u.day
+    near = FixedPerturber("companion", 1e-9 * u.au**3 / u.day**2, [0.01, 0, 0] * u.au)
+    table = Scene(_state(), EPOCH, times, perturbers=(near,), tolerance=1e3 * u.arcsec).run().table
+    table["obliquity"] = 30 * u.deg
+    path = tmp_path / f"run.{extension}"
+    plot_rotation(table, str(path), "test", extension,
+                  encounters={"earth": {"time": (EPOCH + 2 * u.day).isot, "distance_au": 0.01}})
+    data = path.read_bytes()
+    assert data[:4] in (b"\x89PNG", b"%PDF", b"<?xm")
+    if extension == "svg":
+        text = data.decode()
+        for words in ("period [h]", "pole [deg]", "obliquity [deg]", "date (TDB)", "earth 0.01 au", "2020-Jan"):
+            assert words in text or words.replace(" ", "") in text.replace(" ", ""), words
+
+
+def test_compile_notice_on_a_cold_cache_only(tmp_path):
+    """A fresh NUMBA_CACHE_DIR: the first run says it compiles, the second (warm) says nothing."""
+    module = tmp_path / "kernel_module.py"
+    module.write_text(textwrap.dedent("""
+        import numba
+        @numba.njit(cache=True)
+        def twice(x):
+            return 2 * x
+    """))
+    code = ("import sys; sys.path[:0] = [%r, %r]\n"
+            "from spinorbit.commands._compile_notice import compile_notice\n"
+            "with compile_notice():\n"
+            "    import kernel_module; kernel_module.twice(2.0)\n") % (str(tmp_path), str(ROOT))
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    first = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120)
+    second = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120)
+    assert first.returncode == 0 and second.returncode == 0, first.stderr + second.stderr
+    assert "compiling the numba kernels" in first.stderr and len(first.stderr.strip().splitlines()) == 1
+    assert second.stderr == ""
+
+
+@pytest.mark.slow
+def test_cli_compile_notice_cold_then_silent(tmp_path):
+    """The real command with an empty cache (≈ 20 s of compiling), then warm."""
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"), "PYTHONPATH": str(ROOT)}
+    command = [sys.executable, "-m", "spinorbit", "torque-free", "--moments", "1", "2", "3", "--omega", "1", "2", "30"]
+    cold = subprocess.run(command, capture_output=True, text=True, env=env, timeout=600, cwd=tmp_path)
+    warm = subprocess.run(command, capture_output=True, text=True, env=env, timeout=600, cwd=tmp_path)
+    assert cold.returncode == 0 and warm.returncode == 0
+    assert "compiling the numba kernels" in cold.stderr and warm.stderr == ""
+
+
+def test_command_ecsv_has_the_api_columns(tmp_path):
+    from spinorbit import cli
+
+    path = tmp_path / "t.ecsv"
+    assert cli.main(["torque-free", "--moments", "1", "2", "3", "--omega", "1", "2", "30", "--span", "3", "d",
+                     "--epoch", "2024-05-01T00:00:00", "--output", str(path)]) == 0
+    table = Table.read(path)
+    assert table.colnames == [*SCHEMA, *MOTION_COLUMNS]
+    assert isinstance(table["time"], Time) and table["time"][0] == Time("2024-05-01T00:00:00", scale="tdb")
+    assert table.meta["epoch"] == "2024-05-01T00:00:00.000" and table.meta["frame"] == "ICRF"

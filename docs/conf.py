@@ -1,8 +1,12 @@
 """Sphinx configuration for the spinorbit documentation.
 
 Builds offline: no intersphinx, no remote images, no extension that fetches anything. The API pages
-(``docs/api/*.rst``) are written by hand with autodoc directives, so a build never writes generated
-files into the source tree. Build with ``sphinx-build -W -b html docs docs/_build/html``.
+(``docs/api/*.rst``) are written by hand with autodoc directives. The one thing generated into the
+source tree is sphinx-gallery's ``auto_examples/`` (and its ``sg_execution_times.rst``), which it
+cannot write elsewhere; both are git-ignored and rebuilt by every build. The gallery does not run the
+examples (they integrate orbits for seconds to minutes): each page shows the script with the output and
+plot that ``docs/gallery_outputs.py`` committed under ``docs/gallery/`` (:func:`_gallery_outputs`).
+Build with ``sphinx-build -W -b html docs docs/_build/html``.
 """
 
 import os
@@ -26,11 +30,12 @@ extensions = [
     "sphinx.ext.autosummary",
     "sphinx.ext.napoleon",  # numpydoc-style sections (Parameters, Returns, Raises, Notes, Examples)
     "sphinx.ext.mathjax",
+    "sphinx_gallery.gen_gallery",  # the examples gallery over examples/*.py
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build", "Thumbs.db", ".DS_Store"]
+exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "gallery/*.txt"]
 
 # -- Markdown (myst) ------------------------------------------------------------------------------
 myst_heading_anchors = 3
@@ -66,11 +71,47 @@ def _plain_bars(app, what, name, obj, options, lines):
     lines[:] = [_escape_bars(line) for line in lines]
 
 
+# -- Examples gallery (sphinx-gallery) ------------------------------------------------------------
+# Every examples/*.py whose module docstring starts with a reST title becomes a page; other helpers'
+# examples join by that alone. Not executed at build time (plot_gallery False): the committed output
+# of docs/gallery_outputs.py is shown instead.
+sphinx_gallery_conf = {
+    "examples_dirs": "../examples",
+    "gallery_dirs": "auto_examples",
+    "filename_pattern": r"\.py$",
+    "plot_gallery": False,
+    "download_all_examples": False,
+    "show_signature": False,
+    "remove_config_comments": True,
+    "within_subsection_order": "FileNameSortKey",
+}
+
+GALLERY_OUTPUTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "gallery")
+
+
+def _gallery_outputs(app, docname, source):
+    """Append an example's committed plot and printed output (docs/gallery/<name>.png, .txt) to its page."""
+    if not docname.startswith("auto_examples/") or docname.endswith("index"):
+        return
+    name = docname.split("/", 1)[1]
+    image, text = (os.path.join(GALLERY_OUTPUTS, f"{name}.{ext}") for ext in ("png", "txt"))
+    extra = []
+    if os.path.isfile(text) or os.path.isfile(image):
+        heading = "Output of the run (``docs/gallery_outputs.py``)"
+        extra.append(f"\n\n{heading}\n{'-' * len(heading)}\n")
+    if os.path.isfile(image):
+        extra.append(f"\n.. image:: /gallery/{name}.png\n   :alt: plot of {name}\n")
+    if os.path.isfile(text):
+        extra.append(f"\n.. literalinclude:: /gallery/{name}.txt\n   :language: text\n")
+    source[0] += "".join(extra)
+
+
 def setup(app):
     app.connect("autodoc-process-docstring", _plain_bars)
+    app.connect("source-read", _gallery_outputs)
 
 
 # -- HTML -----------------------------------------------------------------------------------------
-html_theme = "alabaster"  # ships with Sphinx: no extra dependency, no web fonts fetched
+html_theme = "furo"  # wide, readable, used across the astropy ecosystem; its fonts are local (none fetched)
 html_title = f"spinorbit {release}"
 html_static_path = []

@@ -1,4 +1,8 @@
-"""(99942) Apophis through its 2029-04-13 Earth encounter: the tumbling spin before and after.
+"""
+Apophis through the 2029 Earth encounter
+========================================
+
+(99942) Apophis through its 2029-04-13 Earth encounter: the tumbling spin before and after.
 
 Initial spin: Pravec et al. 2014 (Icarus 233, 48) — SAM, retrograde, P_ψ = 263 h, P_φ = 27.38 h,
 moments 0.61 : 0.965 : 1, angular momentum towards ecliptic (λ, β) = (250°, −75°)
@@ -19,11 +23,12 @@ Usage::
     python examples/apophis_2029.py                 # ±5 d around perigee, 8 phases (a few seconds)
     python examples/apophis_2029.py --days 60 --phases 48 --output apophis.png
 """
+# gallery-arguments: --days 2 --phases 4 --output apophis_2029.png
+
 
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 import time
 from pathlib import Path
@@ -45,17 +50,11 @@ from spinorbit.data.asteroids import (
 )
 from spinorbit.coupling.one_way import propagate_one_way
 from spinorbit.coupling.sampling import sample_from_rebound
-from spinorbit.frames import icrf_to_ecliptic_matrix
 from spinorbit.time import tdb_days
 
 
-def ecliptic_lon_lat(direction_icrf):
-    e = icrf_to_ecliptic_matrix() @ np.asarray(direction_icrf)
-    return math.degrees(math.atan2(e[1], e[0])) % 360.0, math.degrees(math.asin(max(-1.0, min(1.0, e[2]))))
-
-
 def describe(label, row):
-    lon, lat = ecliptic_lon_lat(row["momentum_direction"])
+    lon, lat = row["pole_lon"].to_value(u.deg), row["pole_lat"].to_value(u.deg)  # ecliptic J2000
     return (f"{label:>7} {row['time'].tdb.iso[:16]} TDB  {row['mode']}  P_psi = {row['P_psi'].to_value(u.h):8.3f} h  "
             f"P_phi = {row['P_phi'].to_value(u.h):7.3f} h  E/E0 = {row['energy_ratio']:.5f}  "
             f"L -> (lambda, beta) = ({lon:6.2f}, {lat:6.2f}) deg")

@@ -1,4 +1,8 @@
-"""The lunar physical libration from DE421 at J2000, integrated with the orbits, against DE421.
+"""
+The Moon's physical libration against DE421
+===========================================
+
+The lunar physical libration from DE421 at J2000, integrated with the orbits, against DE421.
 
 Usage::
 
@@ -13,6 +17,8 @@ optionally writes a PNG per model (needs matplotlib) with the difference and the
 ``--ablation`` reruns the de421 model with one term switched off at a time (which terms matter).
 See docs/coupling.md for the measured numbers.
 """
+# gallery-arguments: --models de421 --plot moon.png
+
 
 import argparse
 import time
@@ -87,7 +93,7 @@ def ablation(span, step):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
     parser.add_argument("--years", type=float, default=1.0, help="span from J2000 in Julian years (default 1)")
     parser.add_argument("--step", type=float, default=None, help="comparison spacing in days (default: 1 d per year of span)")
     parser.add_argument("--models", nargs="+", choices=MOON_MODELS, default=list(MOON_MODELS))

@@ -1,4 +1,8 @@
-"""(4179) Toutatis 1992–2012: the tumbling spin under solar and Earth torques, through the 2004 flyby.
+"""
+Toutatis 1992–2012
+==================
+
+(4179) Toutatis 1992–2012: the tumbling spin under solar and Earth torques, through the 2004 flyby.
 
 Initial state: Takahashi, Busch & Scheeres 2013 (AJ 146, 95, Table 2) at 1992-11-09T17:49:47 UTC
 (:func:`spinorbit.data.asteroids.toutatis_rotation_state`; the Euler-angle reading is documented there).
@@ -19,6 +23,8 @@ Usage::
     python examples/toutatis.py --quick             # ±150 d around the 2004 flyby only
     python examples/toutatis.py --quick --phases 24 # and the flyby's effect over 24 rotation phases
 """
+# gallery-arguments: --quick --output toutatis.png
+
 
 from __future__ import annotations
 

@@ -45,11 +45,16 @@ API_NAMES = {
                  "torus_mean_rhs", "validity_code"],
 }
 NARRATIVE_PAGES = ["index", "cli", "conventions", "theory", "design", "elliptic", "ephemeris", "performance",
-                   "scenes", "tutorials", "validation"]
+                   "scenes", "tutorials", "validation", "auto_examples/index"]
+
+
+#: What sphinx-gallery generates into the source tree (it cannot write elsewhere; git-ignored, rebuilt each build).
+GALLERY_GENERATED = ("auto_examples", "sg_execution_times.rst")
 
 
 def _source_files():
-    return sorted(p.relative_to(DOCS) for p in DOCS.rglob("*") if "_build" not in p.parts)
+    return sorted(p.relative_to(DOCS) for p in DOCS.rglob("*")
+                  if "_build" not in p.parts and p.relative_to(DOCS).parts[0] not in GALLERY_GENERATED)
 
 
 @pytest.fixture(scope="module")
@@ -62,6 +67,40 @@ def built_docs(tmp_path_factory):
     assert result.returncode == 0, f"sphinx-build -W failed:\n{result.stderr}"
     assert _source_files() == before, "the build wrote files into docs/ (generated stubs belong in the build dir)"
     return out
+
+
+def test_the_theme_is_a_wide_one(built_docs):
+    assert "furo" in (built_docs / "index.html").read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize("example", sorted(p.stem for p in (ROOT / "examples").glob("*.py")))
+def test_every_example_is_a_gallery_page_with_its_committed_output(built_docs, example):
+    html = (built_docs / "auto_examples" / f"{example}.html").read_text(encoding="utf-8")
+    assert "<h1>" in html  # its docstring title
+    output = DOCS / "gallery" / f"{example}.txt"
+    if output.is_file():  # docs/gallery_outputs.py has run it: the page shows what it printed and plotted
+        assert "Output of the run" in html
+        last = [line for line in output.read_text(encoding="utf-8").splitlines() if line.strip()][-1]
+        assert html.count(last.split()[-1]) >= 1
+        if output.with_suffix(".png").is_file():
+            assert (built_docs / "_images" / f"{example}.png").is_file() and f"{example}.png" in html
+
+
+def _tutorial_outputs():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("tutorial_outputs", DOCS / "tutorial_outputs.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.parametrize("index", _tutorial_outputs().CHEAP)
+def test_tutorial_outputs_are_a_fresh_run(index):
+    """The printed output on docs/tutorials.md is what the snippet prints now (docs/tutorial_outputs.py)."""
+    module = _tutorial_outputs()
+    code, committed, _ = module.snippets(module.PAGE.read_text(encoding="utf-8"))[index]
+    assert module.run_snippet(code) == committed, "stale: run python docs/tutorial_outputs.py"
 
 
 def test_docs_build_warning_free_and_offline(built_docs):

@@ -41,6 +41,7 @@ from _report import interleaved_timings, machine_line, repeat_main
 from spinorbit.data import asteroids
 from spinorbit import RigidBody, RotationState
 from spinorbit.coupling.rebound import body_index, simulation_from_de421
+from spinorbit.state_table import quaternion_array
 from spinorbit.ephemeris import de421_constants, moon_orientation
 from spinorbit.scene import EphemerisPerturber, Orbit, Scene
 from spinorbit.scene.routes import attitude_angles as _angles
@@ -269,7 +270,7 @@ def measure(repeat):
             repeat, (lambda s=full_scene: s.run(s.plan())) if same_plan else (lambda s=full_scene, p=full_plan: s.run(p)),
             lambda s=planned_scene: s.run(s.plan()))
         n = len(planned.table)
-        error = float(np.max(_angles(planned.table["quaternion"], full.table["quaternion"][-n:])))
+        error = float(np.max(_angles(quaternion_array(planned.table), quaternion_array(full.table)[-n:])))
         rows.append({"skip": skip, "description": description, "full": full_time, "planned": planned_time,
                          "error": error * 206264.80624709636, "estimate": planned.error_estimate.to_value(u.arcsec),
                          "tolerance": planned.plan.tolerance_rad * 206264.80624709636, "route": planned.plan.route,

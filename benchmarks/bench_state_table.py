@@ -49,14 +49,19 @@ def per_row_table(body, quaternions, omegas):
     """The former build: one RotationState per row and its properties."""
     states = [RotationState(body, q, w) for q, w in zip(quaternions, omegas)]
     table = QTable()
-    table["quaternion"] = np.array([s.quaternion for s in states])
-    table["omega"] = np.array([s.angular_velocity.to_value(u.rad / u.day) for s in states]) * (u.rad / u.day)
-    table["momentum_direction"] = np.array([s.angular_momentum_direction for s in states])
+    for i, name in enumerate(("q_w", "q_x", "q_y", "q_z")):
+        table[name] = np.array([s.quaternion[i] for s in states])
+    for i, name in enumerate(("omega_x", "omega_y", "omega_z")):
+        table[name] = np.array([s.angular_velocity[i].to_value(u.rad / u.day) for s in states]) * (u.rad / u.day)
+    icrf, ecliptic = [s.pole_icrf for s in states], [s.pole_ecliptic for s in states]
+    table["pole_ra"], table["pole_dec"] = ([p[i].to_value(u.deg) for p in icrf] * u.deg for i in (0, 1))
+    table["pole_lon"], table["pole_lat"] = ([p[i].to_value(u.deg) for p in ecliptic] * u.deg for i in (0, 1))
     table["mode"] = [s.mode for s in states]
     table["energy_ratio"] = [s.energy_ratio for s in states]
     pairs = [s.periods for s in states]
-    table["P_psi"] = [p[0].to_value(u.day) for p in pairs] * u.day
-    table["P_phi"] = [p[1].to_value(u.day) for p in pairs] * u.day
+    table["P_psi"] = [p[0].to_value(u.h) for p in pairs] * u.h
+    table["P_phi"] = [p[1].to_value(u.h) for p in pairs] * u.h
+    table["sidereal_period"] = [s.sidereal_period.to_value(u.h) for s in states] * u.h
     return table
 
 
@@ -85,7 +90,7 @@ def measure(repeat):
         timings, _ = interleaved_timings(work.values(), repeat, warm_up=True)  # warm-up: numba compilation
         best = dict(zip(work, timings))
         old, new = per_row_table(body, quaternions, omegas), columns_table(body, quaternions, omegas, state)
-        spread = max(float(np.max(np.abs(new[k].value / old[k].value - 1))) for k in ("energy_ratio", "P_psi", "P_phi"))
+        spread = max(float(np.max(np.abs(new[k].value / old[k].value - 1))) for k in ("energy_ratio", "P_psi", "P_phi", "sidereal_period"))
         rows.append({"case": name, **best, "spread": spread})
         print(f"{name}: " + "  ".join(f"{k} {v.text(fmt='.3f')} ms" for k, v in best.items()) + f"  max rel {spread:.1e}")
     return rows

@@ -90,7 +90,8 @@ def test_plot_shows_dates_periods_pole_obliquity_and_encounters(tmp_path, extens
 
 
 def test_compile_notice_on_a_cold_cache_only(tmp_path):
-    """A fresh NUMBA_CACHE_DIR: the first run says it compiles, the second (warm) says nothing."""
+    """A fresh NUMBA_CACHE_DIR: the first run says it compiles, the second (warm) says nothing; a stream
+    that is not a terminal (a pipe, a log) never hears it."""
     module = tmp_path / "kernel_module.py"
     module.write_text(textwrap.dedent("""
         import numba
@@ -99,26 +100,54 @@ def test_compile_notice_on_a_cold_cache_only(tmp_path):
             return 2 * x
     """))
     code = ("import sys; sys.path[:0] = [%r, %r]\n"
+            "class Terminal:\n"
+            "    def isatty(self): return %s\n"
+            "    def write(self, text): sys.stderr.write(text)\n"
+            "    def flush(self): sys.stderr.flush()\n"
             "from spinorbit.commands._compile_notice import compile_notice\n"
-            "with compile_notice():\n"
-            "    import kernel_module; kernel_module.twice(2.0)\n") % (str(tmp_path), str(ROOT))
-    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
-    first = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120)
-    second = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120)
-    assert first.returncode == 0 and second.returncode == 0, first.stderr + second.stderr
-    assert "compiling the numba kernels" in first.stderr and len(first.stderr.strip().splitlines()) == 1
-    assert second.stderr == ""
+            "with compile_notice(Terminal()):\n"
+            "    import kernel_module; kernel_module.twice(2.0)\n")
+
+    def run(cache, terminal=True):
+        env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / cache)}
+        result = subprocess.run([sys.executable, "-c", code % (str(tmp_path), str(ROOT), terminal)],
+                                capture_output=True, text=True, env=env, timeout=120)
+        assert result.returncode == 0, result.stderr
+        return result.stderr
+
+    first, second = run("cache"), run("cache")
+    assert "compiling the numba kernels" in first and len(first.strip().splitlines()) == 1
+    assert second == ""
+    assert run("other cache", terminal=False) == ""  # cold, but not a terminal
 
 
 @pytest.mark.slow
 def test_cli_compile_notice_cold_then_silent(tmp_path):
-    """The real command with an empty cache (≈ 20 s of compiling), then warm."""
+    """The real command on a pseudo-terminal with an empty cache (≈ 20 s of compiling), then warm."""
+    import pty
+
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"), "PYTHONPATH": str(ROOT)}
     command = [sys.executable, "-m", "spinorbit", "torque-free", "--moments", "1", "2", "3", "--omega", "1", "2", "30"]
-    cold = subprocess.run(command, capture_output=True, text=True, env=env, timeout=600, cwd=tmp_path)
-    warm = subprocess.run(command, capture_output=True, text=True, env=env, timeout=600, cwd=tmp_path)
-    assert cold.returncode == 0 and warm.returncode == 0
-    assert "compiling the numba kernels" in cold.stderr and warm.stderr == ""
+
+    def stderr_on_a_terminal():
+        primary, secondary = pty.openpty()
+        result = subprocess.run(command, stdout=subprocess.DEVNULL, stderr=secondary, env=env, timeout=600, cwd=tmp_path)
+        os.close(secondary)
+        chunks = []
+        while True:
+            try:
+                chunk = os.read(primary, 4096)
+            except OSError:
+                break
+            if not chunk:
+                break
+            chunks.append(chunk)
+        os.close(primary)
+        assert result.returncode == 0
+        return b"".join(chunks).decode()
+
+    cold, warm = stderr_on_a_terminal(), stderr_on_a_terminal()
+    assert "compiling the numba kernels" in cold and "compiling" not in warm
 
 
 def test_command_ecsv_has_the_api_columns(tmp_path):

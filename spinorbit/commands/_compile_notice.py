@@ -5,6 +5,9 @@ spinorbit's kernels are cached on disk (``cache=True``, :mod:`spinorbit.core.jit
 seconds during which a command would otherwise print nothing. numba announces every real compilation
 with a ``numba:compile`` event (its event API, :mod:`numba.core.event`); a load from the cache raises
 none. So the notice is printed at the first such event and never on a warm run, at no cost to it.
+Like the progress bars (:class:`spinorbit.commands._common.Progress`) it speaks only to a terminal:
+pipes, logs and scripts that read stderr (one line for an error, ``tests/stress/test_bad_input.py``)
+see nothing extra.
 """
 
 from __future__ import annotations
@@ -19,10 +22,16 @@ NOTICE = ("spinorbit: compiling the numba kernels (first run with this cache; th
 
 @contextlib.contextmanager
 def compile_notice(stream=None):
-    """Within the block, print :data:`NOTICE` once to ``stream`` (stderr) when numba starts a compilation."""
+    """Within the block, print :data:`NOTICE` once to ``stream`` (stderr) when numba starts a compilation.
+
+    Nothing is installed, and nothing printed, when ``stream`` is not a terminal.
+    """
     from numba.core import event
 
     stream = sys.stderr if stream is None else stream
+    if not getattr(stream, "isatty", lambda: False)():
+        yield None
+        return
 
     class Notice(event.Listener):
         said = False

@@ -61,7 +61,7 @@ def scene_orbit_normals(scene, plan):
     source = plan.orbit_source if plan.orbit_source not in ("none",) else scene.orbit.kind
     try:
         samples = scene.sample_perturbers(source, ("sun",), scene.sample_tolerance)
-    except Exception as error:  # noqa: BLE001 - the obliquity is optional: say why it is missing
+    except (LookupError, ValueError) as error:  # no "sun" particle (MissingBodyError), outside DE421, …
         return None, f"the Sun could not be sampled on the scene's orbit ({type(error).__name__}: {error})"
     return heliocentric_normals(samples, scene.output_days), None
 

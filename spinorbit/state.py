@@ -325,7 +325,8 @@ class RotationState:
             from a position and velocity.
         """
         values = orbit_normal.value if isinstance(orbit_normal, u.Quantity) else orbit_normal
-        return _pole.obliquity_deg(self.angular_momentum_direction, np.reshape(np.asarray(values, float), (1, -1)))[0] * u.deg
+        normal = np.reshape(np.asarray(values, dtype=float), (1, -1))
+        return _pole.obliquity_deg(self.angular_momentum_direction, normal)[0] * u.deg
 
     def _reference_frame(self, reference) -> np.ndarray:
         """Passive rotation inertial → frame of the Andoyer angles h, I (see :meth:`canonical_elements`)."""

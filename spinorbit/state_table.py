@@ -26,8 +26,8 @@ from spinorbit.core.free_motion import summary as _summary
 from spinorbit.core.math.rotations import attitude_to_quat_many, quat_to_attitude_many
 from spinorbit.state import MODE_NAMES, QUATERNION_NORM_TOLERANCE, InvalidStateError, RotationState
 
-__all__ = ["MOTION_COLUMNS", "OMEGA_COLUMNS", "PERIOD_UNIT", "POLE_COLUMNS", "QUATERNION_COLUMNS", "add_obliquity", "from_principal",
-           "omega_array", "pole_directions", "quaternion_array", "schema_meta", "table_columns"]
+__all__ = ["MOTION_COLUMNS", "OMEGA_COLUMNS", "PERIOD_UNIT", "POLE_COLUMNS", "QUATERNION_COLUMNS", "add_obliquity",
+           "from_principal", "omega_array", "pole_directions", "quaternion_array", "schema_meta", "table_columns"]
 
 
 def from_principal(body, rows):
@@ -51,6 +51,12 @@ def _unit_quaternions(quaternions):
     if worst > QUATERNION_NORM_TOLERANCE:
         raise InvalidStateError(f"attitude quaternions must have unit norm; a propagated row has |q| − 1 = {worst!r}.")
     return quaternions / norms[:, None]
+
+
+#: Scalar attitude and spin columns (the schema has no (N, k) columns, so API, ECSV and CSV agree).
+QUATERNION_COLUMNS = ("q_w", "q_x", "q_y", "q_z")
+OMEGA_COLUMNS = ("omega_x", "omega_y", "omega_z")
+POLE_COLUMNS = ("pole_ra", "pole_dec", "pole_lon", "pole_lat")
 
 
 #: Names of the motion columns, in order (``docs/conventions.md``, "Output tables").
@@ -106,12 +112,6 @@ def quaternion_array(table):
 def omega_array(table):
     """The (N, 3) body angular velocities (rad/day) of a result table's ``omega_x, omega_y, omega_z`` columns."""
     return np.stack([u.Quantity(table[name]).to_value(u.rad / u.day) for name in OMEGA_COLUMNS], axis=1)
-
-
-#: Scalar attitude and spin columns (the schema has no (N, k) columns, so API, ECSV and CSV agree).
-QUATERNION_COLUMNS = ("q_w", "q_x", "q_y", "q_z")
-OMEGA_COLUMNS = ("omega_x", "omega_y", "omega_z")
-POLE_COLUMNS = ("pole_ra", "pole_dec", "pole_lon", "pole_lat")
 
 
 def table_columns(body, quaternions, omegas, omega=True, motion=None, orbit_normals=None):

@@ -55,7 +55,7 @@ def plot_rotation(table, path, title, file_format="png", encounters=None):
         ax = by_name["periods"]
         for name, label in (("P_psi", "P_ψ"), ("P_phi", "P_φ"), ("sidereal_period", "sidereal")):
             if name in table.colnames:
-                values = np.asarray(table[name].to_value("h") if hasattr(table[name], "to_value") else table[name], float)
+                values = _values(table[name], "h")
                 if np.any(np.isfinite(values)):
                     ax.plot(dates, np.where(np.isfinite(values), values, np.nan), label=label)
         ax.set_ylabel("period [h]")

@@ -121,7 +121,8 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
         (scalar first, user body axes → ICRF), ``omega_x, omega_y, omega_z`` (rad/day, user body axes),
         ``pole_ra, pole_dec, pole_lon, pole_lat`` (deg), ``obliquity`` (deg, with orbit normals); with
         ``periods``: ``mode``, ``energy_ratio`` (E/E0), ``P_psi``, ``P_phi``, ``sidereal_period`` (h).
-        ``table.meta`` names ``epoch``, ``frame``, ``model`` and ``spinorbit_version``, and holds the integrator statistics and the sampling error estimate: DOP853's
+        ``table.meta`` names ``epoch``, ``frame``, ``model`` and ``spinorbit_version``, and holds the
+        integrator statistics and the sampling error estimate: DOP853's
         ``accepted``, ``rejected``, ``rhs_calls``; the Taylor method's ``steps``, ``order`` and
         ``mean_orbit_order``, with ``accepted`` = ``steps`` and ``rejected`` = 0 (it chooses each step
         after computing the series and never rejects one) and no ``rhs_calls`` (it evaluates no

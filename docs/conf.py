@@ -103,7 +103,10 @@ def _gallery_outputs(app, docname, source):
         extra.append(f"\n.. image:: /gallery/{name}.png\n   :alt: plot of {name}\n")
     if os.path.isfile(text):
         extra.append(f"\n.. literalinclude:: /gallery/{name}.txt\n   :language: text\n")
-    source[0] += "".join(extra)
+    # before sphinx-gallery's download links at the end of the page, right after the code
+    marker = source[0].find("\n.. _sphx_glr_download_")
+    at = marker if marker >= 0 else len(source[0])
+    source[0] = source[0][:at] + "".join(extra) + "\n" + source[0][at:]
 
 
 def setup(app):

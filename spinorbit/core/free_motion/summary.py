@@ -98,6 +98,24 @@ def polhode_rates(mo, big_c):
 
 
 @jit
+def all_periods(mo, mx, my, mz, big_a, big_b, big_c):
+    """(P_ψ, P_φ, P_sid) of :func:`periods` and :func:`sidereal_period` with one evaluation of K and Π."""
+    if on_principal_axis(mo):
+        rotation = 2.0 * math.pi / spin_rate(mx, my, mz, big_a, big_b, big_c)
+        return math.inf, rotation, rotation
+    if mo[MO_PARAM_C] == 0.0:
+        return math.inf, math.inf, 2.0 * math.pi * big_b / mo[MO_G]
+    rotation_period, mean_g_rate = polhode_rates(mo, big_c)
+    turn_rate = 2.0 * math.pi / rotation_period
+    if mo[MO_MODE] == MODE_LAM:
+        # In LAM, l librates and the long axis A circulates about the momentum: its azimuth gains one
+        # turn less than g per polhode period; the body turns about the momentum at ⟨ġ⟩ itself.
+        return rotation_period, 2.0 * math.pi / (mean_g_rate - turn_rate), 2.0 * math.pi / mean_g_rate
+    # In SAM, the C axis's azimuth follows g; l circulates against g, so the body turns at ⟨ġ⟩ − 2π/P_ψ.
+    return rotation_period, 2.0 * math.pi / mean_g_rate, 2.0 * math.pi / (mean_g_rate - turn_rate)
+
+
+@jit
 def periods(mo, mx, my, mz, big_a, big_b, big_c):
     """(P_ψ, P_φ) in the time unit of the momentum (day for rad/day), Pravec et al. (2005) convention.
 
@@ -109,16 +127,8 @@ def periods(mo, mx, my, mz, big_a, big_b, big_c):
     on the separatrix; a permanent rotation (momentum exactly along A, B or C) has P_ψ = ∞ and
     P_φ = 2π/|ω|.
     """
-    if on_principal_axis(mo):
-        return math.inf, 2.0 * math.pi / spin_rate(mx, my, mz, big_a, big_b, big_c)
-    if mo[MO_PARAM_C] == 0.0:
-        return math.inf, math.inf
-    rotation_period, mean_g_rate = polhode_rates(mo, big_c)
-    if mo[MO_MODE] == MODE_LAM:
-        # In LAM, l librates and the long axis A circulates about the momentum: its azimuth gains
-        # one turn less than g per polhode period.
-        mean_g_rate -= 2.0 * math.pi / rotation_period
-    return rotation_period, 2.0 * math.pi / mean_g_rate
+    p_psi, p_phi, _ = all_periods(mo, mx, my, mz, big_a, big_b, big_c)
+    return p_psi, p_phi
 
 
 @jit
@@ -132,23 +142,15 @@ def sidereal_period(mo, mx, my, mz, big_a, big_b, big_c):
     continuous as the momentum approaches A or C (and → 2π B/G at the separatrix, from both sides),
     where P_ψ and P_φ are not. On the separatrix itself it is 2π B/G, the rotation the motion tends to.
     """
-    if on_principal_axis(mo):
-        return 2.0 * math.pi / spin_rate(mx, my, mz, big_a, big_b, big_c)
-    if mo[MO_PARAM_C] == 0.0:
-        return 2.0 * math.pi * big_b / mo[MO_G]
-    rotation_period, mean_g_rate = polhode_rates(mo, big_c)
-    if mo[MO_MODE] == MODE_SAM:
-        mean_g_rate -= 2.0 * math.pi / rotation_period
-    return 2.0 * math.pi / mean_g_rate
+    return all_periods(mo, mx, my, mz, big_a, big_b, big_c)[2]
 
 
 @jit
 def motion_summary(mx, my, mz, big_a, big_b, big_c):
     """(mode code, E/E0, P_ψ, P_φ, sidereal period) of the torque-free motion through body momentum M (M ≠ 0)."""
     mo, _ = motion_from_momentum(mx, my, mz, inertia_constants(big_a, big_b, big_c))
-    p_psi, p_phi = periods(mo, mx, my, mz, big_a, big_b, big_c)
-    return (mode_code(mo), energy_ratio(mx, my, mz, big_a, big_b, big_c), p_psi, p_phi,
-            sidereal_period(mo, mx, my, mz, big_a, big_b, big_c))
+    p_psi, p_phi, p_sidereal = all_periods(mo, mx, my, mz, big_a, big_b, big_c)
+    return mode_code(mo), energy_ratio(mx, my, mz, big_a, big_b, big_c), p_psi, p_phi, p_sidereal
 
 
 @jit

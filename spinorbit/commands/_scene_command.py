@@ -122,6 +122,7 @@ def summary(result, period_unit: str, plan_seconds: float = 0.0) -> list[str]:
             lines.append(f"{label:5s} {row['time'].tdb.iso[:16]} TDB  {row['mode']:3s}  "
                          f"P_psi = {row['P_psi'].to_value(period_unit):9.4f} {period_unit}  "
                          f"P_phi = {row['P_phi'].to_value(period_unit):9.4f} {period_unit}  "
+                         f"P_sid = {row['sidereal_period'].to_value(period_unit):9.4f} {period_unit}  "
                          f"E/E0 = {row['energy_ratio']:.5f}")
     parts = ", ".join(f"{k} {v.to_value(u.arcsec):.2g}" for k, v in result.error_parts.items())
     lines.append(f"wall time          {plan_seconds + result.wall_seconds:.2f} s (plan {plan_seconds:.2f} s, "

@@ -151,6 +151,8 @@ def _summary(state) -> list[str]:
         f"mode               {state.mode}, sense {state.sense}",
         f"periods            P_psi = {p_psi.to_value('d'):.4f} d (rotation), "
         f"P_phi = {p_phi.to_value('d'):.4f} d (precession)",
+        f"sidereal period    {state.sidereal_period.to_value('d'):.4f} d (2π/|ω| for principal-axis rotation; "
+        "docs/conventions.md, 'Periods')",
         f"E/E0               {state.energy_ratio:.6f}",
     ]
 

@@ -161,7 +161,7 @@ class Scene:
     Raises
     ------
     SceneError
-        Inputs of the wrong kind, times not after the epoch, perturbers without an orbit, …
+        Inputs of the wrong kind, times before the epoch, perturbers without an orbit, …
     """
 
     def __init__(self, state, epoch, times, perturbers=(), orbit=None, tolerance=1 * u.arcsec,

@@ -9,6 +9,10 @@ gallery page. An example chooses its gallery arguments with one comment line in 
 
     # gallery-arguments: --quick --output plot.png
 
+and its gallery thumbnail, the committed plot, with sphinx-gallery's own comment (hidden on the page)::
+
+    # sphinx_gallery_thumbnail_path = "gallery/<name>.png"
+
 Usage::
 
     python docs/gallery_outputs.py                 # every example (minutes)

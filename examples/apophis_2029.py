@@ -24,6 +24,7 @@ Usage::
     python examples/apophis_2029.py --days 60 --phases 48 --output apophis.png
 """
 # gallery-arguments: --days 2 --phases 4 --output apophis_2029.png
+# sphinx_gallery_thumbnail_path = "gallery/apophis_2029.png"
 
 
 from __future__ import annotations

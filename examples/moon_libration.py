@@ -18,6 +18,7 @@ optionally writes a PNG per model (needs matplotlib) with the difference and the
 See docs/coupling.md for the measured numbers.
 """
 # gallery-arguments: --models de421 --plot moon.png
+# sphinx_gallery_thumbnail_path = "gallery/moon_libration.png"
 
 
 import argparse

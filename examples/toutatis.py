@@ -24,6 +24,7 @@ Usage::
     python examples/toutatis.py --quick --phases 24 # and the flyby's effect over 24 rotation phases
 """
 # gallery-arguments: --quick --output toutatis.png
+# sphinx_gallery_thumbnail_path = "gallery/toutatis.png"
 
 
 from __future__ import annotations

@@ -187,3 +187,25 @@ def test_a_principal_axis_rotator_through_a_scene_keeps_its_8_h():
     nu0 = np.sqrt((a - c) * (b - c))  # ν₀/|ω|, since G = C|ω| with C = 1
     assert np.allclose(torqued["P_psi"][1:].to_value(u.h), 8.0 / nu0, rtol=1e-12)
     assert np.allclose(torqued["P_phi"][1:].to_value(u.h), 8.0 / (1 + nu0), rtol=1e-12)
+
+
+def test_command_planning_shows_a_progress_bar_on_a_terminal(monkeypatch):
+    """spinorbit's scene commands draw the planning bar on a terminal once planning passes its delay."""
+    import argparse
+    import io
+
+    from spinorbit.commands import _scene_command
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    stderr = Terminal()
+    monkeypatch.setattr(sys, "stderr", stderr)
+    monkeypatch.setattr(_scene_command, "PLAN_PROGRESS_DELAY_S", 0.0)
+    times = EPOCH + np.linspace(0.0, 2.0, 5) * u.day
+    scene = Scene(_state(), EPOCH, times, perturbers=("sun", "jupiter"), orbit=Orbit.circular(2.5 * u.au))
+    args = argparse.Namespace(no_skip=False, plan=True)
+    assert _scene_command.run_scene(scene, args) is None  # --plan: printed, not run
+    drawn = stderr.getvalue()
+    assert "planning [" in drawn and "100%" in drawn and drawn.endswith("\n")

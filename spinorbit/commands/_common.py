@@ -123,6 +123,10 @@ class Progress:
     def advance(self, count: int) -> None:
         """Record ``count`` more items done; redraw if due."""
         self.done += count
+        self.tick()
+
+    def tick(self) -> None:
+        """Redraw if due (the elapsed time moves on even while no item is done)."""
         now = time.monotonic()
         if self.enabled and now - self.start >= self.delay and now - self.last_draw >= PROGRESS_REDRAW_S:
             self._draw(now)

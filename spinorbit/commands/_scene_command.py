@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import threading
 
 from spinorbit.cli import CommandError
 from spinorbit.commands._common import Progress, atomic_output, quantity
@@ -68,10 +70,11 @@ def run_scene(scene, args):
     if sys.stderr.isatty():  # planning samples the orbits (an N-body run): say so before the wait
         print("planning (sampling the orbits) ...", file=sys.stderr, flush=True)
     planning = Progress(100, "planning", delay=PLAN_PROGRESS_DELAY_S)
-    try:
-        plan = scene.plan(skip=not args.no_skip, progress=_advancing(planning))
-    finally:
-        planning.close()
+    with _ticking(planning):  # the survey samples the orbits for seconds without a fraction to report
+        try:
+            plan = scene.plan(skip=not args.no_skip, progress=_advancing(planning))
+        finally:
+            planning.close()
     args.plan_seconds = time.perf_counter() - clock
     if args.plan:
         print(plan)
@@ -82,6 +85,24 @@ def run_scene(scene, args):
     finally:
         progress.close()
     return result
+
+
+@contextlib.contextmanager
+def _ticking(progress, every_s: float = 0.25):
+    """Within the block, a background thread redraws ``progress`` every ``every_s`` (its clock moves on)."""
+    stop = threading.Event()
+
+    def tick():
+        while not stop.wait(every_s):
+            progress.tick()
+
+    thread = threading.Thread(target=tick, name="spinorbit-progress", daemon=True)
+    thread.start()
+    try:
+        yield progress
+    finally:
+        stop.set()
+        thread.join()
 
 
 def _advancing(progress):

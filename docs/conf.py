@@ -75,10 +75,31 @@ def _plain_bars(app, what, name, obj, options, lines):
 # Every examples/*.py whose module docstring starts with a reST title becomes a page; other helpers'
 # examples join by that alone. Not executed at build time (plot_gallery False): the committed output
 # of docs/gallery_outputs.py is shown instead.
+EXAMPLES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "examples")
+_TITLED = re.compile(r'^\s*(?:#[^\n]*\n)*\s*[rRuU]?"""\s*(?P<title>[^\n]+)\n(?P<rule>[=\-~^#*+]+)\s*\n')
+
+
+def _untitled_examples():
+    """Names of examples/*.py whose module docstring does not open with a reST title (title line, rule)."""
+    names = []
+    for name in sorted(os.listdir(EXAMPLES)):
+        if name.endswith(".py"):
+            with open(os.path.join(EXAMPLES, name), encoding="utf-8") as file:
+                match = _TITLED.match(file.read())
+            if match is None or len(match["rule"]) < len(match["title"].strip()):
+                names.append(name)
+    return names
+
+
+# An example without a title would stop the whole build; it is left out instead, and
+# tests/test_docs.py names it (every example must have its page).
+_IGNORED = "|".join(re.escape(name) for name in ["__init__.py", *_untitled_examples()])
+
 sphinx_gallery_conf = {
     "examples_dirs": "../examples",
     "gallery_dirs": "auto_examples",
     "filename_pattern": r"\.py$",
+    "ignore_pattern": rf"(^|/)({_IGNORED})$",
     "plot_gallery": False,
     "download_all_examples": False,
     "show_signature": False,

@@ -75,7 +75,10 @@ def test_the_theme_is_a_wide_one(built_docs):
 
 @pytest.mark.parametrize("example", sorted(p.stem for p in (ROOT / "examples").glob("*.py")))
 def test_every_example_is_a_gallery_page_with_its_committed_output(built_docs, example):
-    html = (built_docs / "auto_examples" / f"{example}.html").read_text(encoding="utf-8")
+    page = built_docs / "auto_examples" / f"{example}.html"
+    assert page.is_file(), (f"examples/{example}.py has no gallery page: its module docstring must open with a reST "
+                            "title (a line, then a rule of = as long as it), as sphinx-gallery needs")
+    html = page.read_text(encoding="utf-8")
     assert "<h1>" in html  # its docstring title
     output = DOCS / "gallery" / f"{example}.txt"
     if output.is_file():  # docs/gallery_outputs.py has run it: the page shows what it printed and plotted

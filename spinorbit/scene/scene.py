@@ -288,7 +288,7 @@ class Scene:
                 table.meta["obliquity"] = f"not computed: {why_not}"
         kept = ", ".join(plan.kept) or "none"
         meta = schema_meta(self.epoch, f"Scene, route {plan.route}, orbits from {plan.orbit_source}, "
-                                       f"integrator {plan.integrator}, torques of {kept} (degree 2)")
+                                       f"integrator {plan.integrator}, torques of {kept}")
         table.meta.update({k: v for k, v in meta.items() if k not in table.meta or k in ("model", "epoch")})
         if "obliquity" in table.colnames and "mode" in table.colnames:  # the schema's order: before the motion
             column = table["obliquity"]

@@ -106,8 +106,8 @@ def markdown(rows, repeat):
               "alternated in one process) of the exact flow, of the table from one `RotationState` per row (the former build), of "
               "the same columns from `state_table.table_columns` with each row's own mode/E/E0/periods (`rows`: the "
               "one-way route) and with them taken once as constants of the motion (the torque-free route), and of "
-              "the whole `Scene.run` (planning included). Max rel = largest relative difference of E/E0, P_psi, "
-              "P_phi between the constants and the per-row values."), "",
+              "the whole `Scene.run` (planning included). Max rel = largest relative difference of E/E0, P_psi, P_phi, "
+              "the sidereal period between the constants and the per-row values (the columns include the spin pole since issue 15)."), "",
              "| body | flow | per row | columns, rows | columns, constants | per row / constants | Scene.run | max rel |",
              "|---|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:

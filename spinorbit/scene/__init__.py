@@ -17,6 +17,7 @@ One module per concept:
 - :mod:`~spinorbit.scene.integrator_choice` — Taylor or DOP853 (or the canonical elements);
 - :mod:`~spinorbit.scene.sampling` — the perturbers sampled relative to the body, shared within a call;
 - :mod:`~spinorbit.scene.routes` — the runners of the torque-free, one-way and coupled routes;
+- :mod:`~spinorbit.scene.epochs` — output times before the epoch: the backward leg in mirrored time;
 - :mod:`~spinorbit.scene.many` — several bodies (:class:`ScenePlans`, :class:`SceneResults`);
 - :mod:`~spinorbit.scene.scene` — :class:`Scene` and :class:`SceneResult`.
 """

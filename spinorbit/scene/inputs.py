@@ -147,8 +147,9 @@ def tdb_day_array(time):
     return np.atleast_1d(np.asarray(whole, dtype=float) + np.asarray(rest, dtype=float))
 
 
-def validate_times(epoch, times):
-    """(epoch_day, output_days, end_only) of a scalar epoch and output times strictly increasing after it."""
+def validate_times(epoch, times, either_side=False):
+    """(epoch_day, output_days, end_only) of a scalar epoch and output times strictly increasing after it
+    (or, with ``either_side``, on either side of it: :mod:`spinorbit.scene.epochs`)."""
     if not isinstance(epoch, Time) or not epoch.isscalar:
         raise SceneError(f"epoch expects a scalar astropy Time; got {epoch!r}.")
     if not isinstance(times, Time):
@@ -159,7 +160,9 @@ def validate_times(epoch, times):
     output_days = tdb_day_array(times)
     if not np.all(np.diff(output_days) > 0):
         raise SceneError("times expects strictly increasing output times.")
-    if not output_days[0] > epoch_day:
+    if not np.all(np.isfinite(output_days)):
+        raise SceneError("times expects finite output times.")
+    if not either_side and not output_days[0] > epoch_day:
         raise SceneError(f"times expects output times after the epoch; the first is "
                          f"{output_days[0] - epoch_day:+.6g} d from it. Give later times or an earlier epoch.")
     return epoch_day, output_days, end_only

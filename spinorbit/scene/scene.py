@@ -135,7 +135,10 @@ class Scene:
     epoch : astropy.time.Time
         Time of ``state`` (scalar).
     times : astropy.time.Time
-        Output times, strictly increasing, after ``epoch``; a scalar Time means "the end only".
+        Output times, strictly increasing; a scalar Time means "the end only". They may lie before
+        ``epoch`` or on both sides of it: the state belongs to its epoch, and the run goes from there
+        forwards and backwards (:mod:`spinorbit.scene.epochs`), so the state at a given time does not
+        depend on the span asked for.
     perturbers : sequence of str, FixedPerturber or EphemerisPerturber
         DE421 body names (``"sun"``, ``"earth"``, ``"jupiter"``…; particle names for a REBOUND orbit)
         and/or :class:`FixedPerturber` s and :class:`EphemerisPerturber` s. Empty: torque-free.
@@ -174,7 +177,7 @@ class Scene:
                 many.common_times(self.members))
             return
         self.state = inputs.validate_state(state)
-        self.epoch_day, self.output_days, self.end_only = inputs.validate_times(epoch, times)
+        self.epoch_day, self.output_days, self.end_only = inputs.validate_times(epoch, times, either_side=True)
         self.epoch, self.times = epoch, times
         self.tolerance_rad, self.quantities = inputs.validate_options(tolerance, quantities, integrator,
                                                                       sample_tolerance)
@@ -182,6 +185,15 @@ class Scene:
         self.named, self.fixed, self.moving = inputs.validate_perturbers(perturbers, orbit)
         self.orbit = orbit
         self.moments_per_mass = inputs.moments_per_mass(state.body, orbit)
+        self.backward = self.forward = None  # the two legs when times are not all after the epoch
+        if self.output_days[0] <= self.epoch_day:
+            from spinorbit.scene import epochs
+
+            def make(leg_state, leg_epoch, leg_times, leg_perturbers, leg_orbit):
+                return Scene(leg_state, leg_epoch, leg_times, leg_perturbers, leg_orbit, tolerance,
+                             tuple(dict.fromkeys(("omega", *self.quantities))), integrator, sample_tolerance)
+
+            epochs.split_legs(self, make, perturbers, orbit)
 
     @property
     def span_days(self):
@@ -254,6 +266,10 @@ class Scene:
             from spinorbit.scene.many import plan_many
 
             return plan_many(self.members, skip)
+        if self.backward is not None or self.forward is not None:
+            from spinorbit.scene.epochs import plan_legs
+
+            return plan_legs(self, skip)
         return plan_scene(self, skip)
 
     @_sharing_samples
@@ -267,6 +283,11 @@ class Scene:
             from spinorbit.scene.many import run_many
 
             return run_many(self.members, self.plan() if plan is None else plan, progress)
+        if self.backward is not None or self.forward is not None:
+            from spinorbit.scene.epochs import run_legs
+            from spinorbit.scene.routes import result_table
+
+            return run_legs(self, plan, progress, SceneResult, result_table)
         clock = _time.perf_counter()
         plan = self.plan() if plan is None else plan
         if not isinstance(plan, Plan):

@@ -1,0 +1,94 @@
+"""A state belongs to its epoch: a Scene runs from it forwards and backwards (spinorbit.scene.epochs).
+
+References: the exact free motion at negative times; a direct backward DOP853 run
+(``propagate_one_way`` integrates towards earlier times natively) on the same samples, against which
+the mirrored-time leg is checked; and the same time asked for inside spans of different lengths
+and directions.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from _offline import no_network  # noqa: F401
+from astropy import units as u
+from astropy.time import Time
+
+from spinorbit import RigidBody, RotationState
+from spinorbit.coupling.one_way import propagate_one_way
+from spinorbit.coupling.sampling import sample_from_ephemeris
+from spinorbit.scene import Orbit, Scene
+from spinorbit.scene.epochs import LegPlans
+from spinorbit.scene.routes import attitude_angles
+
+EPOCH = Time("2020-01-01", scale="tdb")
+#: A Sun 0.05 au away on a 4-day circle: a torque that changes the spin visibly within days.
+ORBIT = Orbit.circular(0.05 * u.au)
+TOLERANCE = 5e-2 * u.arcsec
+
+
+def state():
+    return RotationState.from_euler313(RigidBody([0.61, 0.965, 1.0]), 10 * u.deg, 40 * u.deg, 70 * u.deg,
+                                       [5, 3, 40] * u.deg / u.hour)
+
+
+def row_at(result, when):
+    k = int(np.argmin(np.abs((result.table["time"] - when).to_value(u.day))))
+    assert abs((result.table["time"][k] - when).to_value(u.s)) < 1e-3
+    return result.table[k]
+
+
+def test_backward_torque_free_is_the_exact_free_motion_at_negative_times():
+    times = EPOCH - [10.0, 2.0, 1.0] * u.day
+    result = Scene(state(), EPOCH, times).run()
+    quaternions, omegas = state().propagate_torque_free([-10.0, -2.0, -1.0])
+    assert np.max(attitude_angles(result.table["quaternion"], quaternions)) < 1e-13
+    assert np.allclose(result.table["omega"].to_value(u.rad / u.day), omegas.to_value(u.rad / u.day),
+                       rtol=0, atol=1e-12)
+    assert np.all(np.diff((result.table["time"] - EPOCH).to_value(u.day)) > 0)
+
+
+def test_backward_leg_matches_a_direct_backward_integration():
+    """The mirrored-time leg against DOP853 integrating towards earlier times on the same DE421-free
+    samples of the circle: equal to 2e-9 rad (each run's own error, rtol 1e-12, is ≈ 1e-10 rad; the
+    torque turns the attitude by ≈ 0.3 rad from the free motion over the 6 days)."""
+    times = EPOCH - np.array([6.0, 3.0, 0.5]) * u.day
+    result = Scene(state(), EPOCH, times, perturbers=("sun",), orbit=ORBIT, tolerance=TOLERANCE).run()
+    samples = sample_from_ephemeris(ORBIT.function, EPOCH - 7 * u.day, EPOCH, perturbers=("sun",), tolerance=1e-11)
+    direct = propagate_one_way(state(), EPOCH, times[::-1], samples, rtol=1e-12)
+    assert np.max(attitude_angles(result.table["quaternion"], np.asarray(direct["quaternion"])[::-1])) < 2e-9
+    free, _ = state().propagate_torque_free([-6.0])
+    assert attitude_angles(result.table["quaternion"][:1], free)[0] > 1e-3  # the torque matters here
+
+
+def test_the_state_at_a_time_does_not_depend_on_the_span_asked_for():
+    """The same two times (3 d before and 2 d after the epoch) inside four spans: backward only, around
+    the epoch, forward only, end only. They agree to twice the tolerance (5e-2″; each run's estimate is below
+    it), where placing the state at each span's start would differ by the spin's whole evolution."""
+    before, after = EPOCH - 3 * u.day, EPOCH + 2 * u.day
+    spans = {
+        "backward": EPOCH - np.linspace(5.0, 0.5, 10) * u.day,
+        "around": EPOCH + np.linspace(-8.0, 4.0, 13) * u.day,
+        "forward": EPOCH + np.linspace(0.5, 2.0, 4) * u.day,
+        "end before": before,
+        "end after": after,
+    }
+    results = {label: Scene(state(), EPOCH, times, perturbers=("sun",), orbit=ORBIT, tolerance=TOLERANCE).run()
+               for label, times in spans.items()}
+    for result in results.values():
+        assert result.tolerance_met
+    limit = 2 * TOLERANCE.to_value(u.rad)
+    for group, when in ((("backward", "around", "end before"), before), (("around", "forward", "end after"), after)):
+        rows = [row_at(results[label], when) for label in group]
+        for other in rows[1:]:
+            assert attitude_angles(rows[0]["quaternion"], other["quaternion"])[0] < limit
+            assert np.allclose(rows[0]["omega"].value, other["omega"].value, rtol=1e-8)
+    assert isinstance(results["around"].plan, LegPlans)
+    assert "backward leg" in str(results["around"].plan) and "forward leg" in str(results["around"].plan)
+
+
+def test_a_time_at_the_epoch_is_the_state_itself():
+    times = EPOCH + [-1.0, 0.0, 1.0] * u.day
+    result = Scene(state(), EPOCH, times, perturbers=("sun",), orbit=ORBIT, tolerance=TOLERANCE).run()
+    assert attitude_angles(result.table["quaternion"][1:2], state().quaternion)[0] == 0.0
+    assert result.table["P_psi"].shape == (3,)

@@ -92,3 +92,33 @@ def test_a_time_at_the_epoch_is_the_state_itself():
     result = Scene(state(), EPOCH, times, perturbers=("sun",), orbit=ORBIT, tolerance=TOLERANCE).run()
     assert attitude_angles(result.table["quaternion"][1:2], state().quaternion)[0] == 0.0
     assert result.table["P_psi"].shape == (3,)
+
+
+@pytest.fixture(scope="module")
+def apophis_orbit():
+    from spinorbit.data.asteroids import apophis_encounter_simulation
+
+    return Orbit.rebound(apophis_encounter_simulation("published"), "Apophis")
+
+
+def test_apophis_after_the_encounter_does_not_depend_on_the_span(apophis_orbit):
+    """The issue's case: spans of 4, 6 and 14 d around the 2029 perigee (the last with a backward leg
+    from the state's epoch, 5 d before perigee, through a REBOUND orbit read backwards) and the end
+    alone all give the same state 2 d after perigee, to twice the tolerance (1″), where placing the
+    published state at each span's start gave SAM 156 h, LAM 268 h, SAM 243 h."""
+    from spinorbit.data.asteroids import APOPHIS_2029, APOPHIS_STATE_EPOCH, apophis_rotation_state
+
+    perigee = APOPHIS_2029.time_tdb
+    when = perigee + 2 * u.day
+    spans = {"4 d": perigee + np.linspace(-2.0, 2.0, 9) * u.day, "6 d": perigee + np.linspace(-3.0, 2.0, 11) * u.day,
+             "14 d": perigee + np.linspace(-12.0, 2.0, 15) * u.day, "end": when}
+    rows = []
+    for times in spans.values():
+        result = Scene(apophis_rotation_state(), APOPHIS_STATE_EPOCH, times, perturbers=("sun", "earth", "moon"),
+                       orbit=apophis_orbit, tolerance=0.5 * u.arcsec).run()
+        assert result.tolerance_met
+        rows.append(row_at(result, when))
+    for other in rows[1:]:
+        assert attitude_angles(rows[0]["quaternion"], other["quaternion"])[0] < 2 * (0.5 * u.arcsec).to_value(u.rad)
+        assert other["P_psi"].to_value(u.h) == pytest.approx(rows[0]["P_psi"].to_value(u.h), abs=1e-4)
+    assert rows[0]["mode"] == "SAM" and abs(rows[0]["P_psi"].to_value(u.h) - 263.0) > 10  # the encounter acted

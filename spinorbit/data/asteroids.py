@@ -80,6 +80,7 @@ __all__ = [
     "closest_approach",
     "apophis_encounter_simulation",
     "apophis_rotation_state",
+    "APOPHIS_STATE_EPOCH",
     "toutatis_rotation_state",
     "sam_state_from_periods",
     "ecliptic_direction",
@@ -547,16 +548,36 @@ APOPHIS_P_PHI = 27.38 * u.hour
 APOPHIS_MOMENTUM_ECLIPTIC_DEG = (250.0, -75.0)
 
 
-def apophis_rotation_state():
+#: Where the Apophis state is placed: 5 days before the 2029 perigee (APOPHIS_2029, TDB). The published
+#: periods and pole (2012-2013 photometry) do not fix the rotation phase 16 years later, so the state
+#: at this epoch is the constructed one moved along its free motion by ``phase`` × P_psi.
+APOPHIS_STATE_EPOCH = APOPHIS_2029.time_tdb - 5 * u.day
+
+
+def apophis_rotation_state(phase=0.0):
     """Apophis (Pravec et al. 2014) as a :class:`RotationState` with the attitude relative to ICRF.
 
     SAM with P_ψ = 263 h, P_φ = 27.38 h, moments 0.61 : 0.965 : 1; angular momentum towards ecliptic
     (λ, β) = (250°, −75°) — a retrograde spin (β < 0). E/E0 then follows from the moments and periods
-    (the examples print it against the published 1.024 ± 0.013). The rotation phase is not published
-    with these numbers: :func:`sam_state_from_periods` picks the smallest rotation.
+    (the examples print it against the published 1.024 ± 0.013). The state belongs to
+    :data:`APOPHIS_STATE_EPOCH` (5 d before the 2029 perigee).
+
+    Parameters
+    ----------
+    phase : float
+        The rotation phase, which the published solution leaves unknown at 2029, in [0, 1): the
+        state is :func:`sam_state_from_periods`' (the smallest rotation putting the momentum on its
+        direction) moved along its own free motion by ``phase`` × P_ψ. 0 (default) is that state
+        itself, the one the examples and docs quote as "phase as constructed".
     """
-    return sam_state_from_periods(APOPHIS_BODY, APOPHIS_P_PSI, APOPHIS_P_PHI,
-                                  ecliptic_direction(*APOPHIS_MOMENTUM_ECLIPTIC_DEG))
+    if not (isinstance(phase, (int, float)) and 0.0 <= phase < 1.0):
+        raise ValueError(f"phase expects a fraction of the rotation period P_psi in [0, 1); got {phase!r}.")
+    state = sam_state_from_periods(APOPHIS_BODY, APOPHIS_P_PSI, APOPHIS_P_PHI,
+                                   ecliptic_direction(*APOPHIS_MOMENTUM_ECLIPTIC_DEG))
+    if phase == 0.0:
+        return state
+    quaternions, omegas = state.propagate_torque_free(phase * APOPHIS_P_PSI)
+    return RotationState(APOPHIS_BODY, quaternions[0], omegas[0])
 
 
 #: Takahashi et al. (2013) Toutatis Euler angles (deg) and body angular velocity (deg/day, x, y, z).

@@ -145,6 +145,7 @@ class LegPlans:
     backward: object
     forward: object
     tolerance_rad: float
+    backward_source: str = "none"
 
     @property
     def legs(self):
@@ -157,7 +158,8 @@ class LegPlans:
 
     @property
     def orbit_source(self):
-        return " / ".join(f"{label} {plan.orbit_source}" for label, plan in self.legs)
+        return " / ".join(f"{label} {self.backward_source if label == 'backward' else plan.orbit_source}"
+                          for label, plan in self.legs)
 
     @property
     def integrator(self):
@@ -179,8 +181,9 @@ class LegPlans:
 
 def plan_legs(scene, skip):
     """Each leg's plan (:meth:`Scene.plan`), as one :class:`LegPlans`."""
+    source = "none" if scene.orbit is None else f"{scene.orbit.kind} read backwards"
     return LegPlans(None if scene.backward is None else scene.backward.plan(skip),
-                    None if scene.forward is None else scene.forward.plan(skip), scene.tolerance_rad)
+                    None if scene.forward is None else scene.forward.plan(skip), scene.tolerance_rad, source)
 
 
 def run_legs(scene, plan, progress, result_type, result_table):

@@ -286,6 +286,31 @@ class Orbit:
             function = self.function
         return approaches.ephemeris_separation(function, resolve_body(target))
 
+    def relative_state(self, body, times):
+        """Position and velocity of the orbit's body relative to ``body`` at ``times`` (ICRF axes).
+
+        Parameters
+        ----------
+        body : str
+            A particle of the REBOUND simulation (for a REBOUND orbit) or a DE421 body ("sun" for the
+            heliocentric state, whose r × v is the orbit's pole).
+        times : astropy.time.Time
+            Scalar or 1-D, inside DE421's span.
+
+        Returns
+        -------
+        position : Quantity, shape (n, 3), au
+        velocity : Quantity, shape (n, 3), au/day
+        """
+        if not isinstance(times, Time):
+            raise SceneError(f"times expects an astropy Time; got {type(times).__name__}.")
+        whole, rest = tdb_days(times)
+        days = np.atleast_1d(np.asarray(whole, dtype=float) + np.asarray(rest, dtype=float))
+        _check_inside_de421("times", float(days.min()), float(days.max()))
+        separation = self._separation(body)
+        states = [separation(float(day)) for day in days]
+        return (np.array([r for r, _ in states]) * u.au, np.array([v for _, v in states]) * u.au / u.day)
+
     def approaches(self, body, start, end):
         """Every local minimum of the distance to ``body`` between ``start`` and ``end``.
 

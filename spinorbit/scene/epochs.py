@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from astropy import units as u
 
-from spinorbit.scene.inputs import EphemerisPerturber, Orbit, SceneError
+from spinorbit.scene.inputs import EphemerisPerturber, Orbit, SceneError  # noqa: F401 (re-read by the legs)
 from spinorbit.state import RotationState
 from spinorbit.time import time_from_tdb_days
 

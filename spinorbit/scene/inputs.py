@@ -22,8 +22,8 @@ from spinorbit.scene.orbit import Orbit
 from spinorbit.state import RotationState
 from spinorbit.time import tdb_days
 
-__all__ = ["INTEGRATORS", "MASS_MISMATCH", "QUANTITIES", "EphemerisPerturber", "FixedPerturber", "Orbit",
-           "SceneError", "as_angle", "check_gm", "gm_in_orbit_model", "moments_per_mass", "resolve_perturbers",
+__all__ = ["INTEGRATORS", "MASS_MISMATCH", "QUANTITIES", "EphemerisPerturber", "FixedPerturber",
+           "as_angle", "check_gm", "gm_in_orbit_model", "moments_per_mass", "resolve_perturbers",
            "tdb_day_array", "validate_options", "validate_perturbers", "validate_state", "validate_times"]
 
 #: Quantities a scene can ask for.

@@ -247,3 +247,27 @@ def test_toutatis_elements_orbit_is_near_earth_in_december_1992(toutatis_approac
     orbit = TOUTATIS_ELEMENT_SETS["2008"].orbit()
     when, distance = orbit.closest_approach("earth", Time("2004-09-01", scale="tdb"), Time("2004-10-30", scale="tdb"))
     assert distance.to_value(u.au) == pytest.approx(0.0104, rel=0.05)
+
+
+def test_orbit_from_elements_starts_on_the_kepler_state_and_reads_back_heliocentric():
+    """At its epoch the built orbit's heliocentric state is the elements' Kepler state (in DE421's au)
+    to 1e-15 au (rounding of the Sun's position added and subtracted); a day later it is on the Kepler
+    orbit advanced by n·1 d to 1e-7 au (what the planets do in a day at 2.5 au: Jupiter's direct and
+    indirect pulls ≈ 1e-7 au/d² give ≲ 1e-7 au), and the Sun-relative pole r × v is the elements'
+    (i, Ω) to 1e-6 rad."""
+    orbit = Orbit.from_elements(**GOOD, frame="icrf", name="probe")
+    constants = de421_constants()
+    values = [GOOD["a"].to_value(u.km) / constants.au_km, GOOD["e"],
+              *(GOOD[k].to_value(u.rad) for k in ("inc", "raan", "argp", "mean_anomaly"))]
+    r_kepler, v_kepler = elements_to_state(*values, constants.gm["sun"], frame="icrf")
+    r, v = orbit.relative_state("sun", EPOCH + [0.0, 1.0] * u.day)
+    assert np.max(np.abs(r[0].to_value(u.au) - r_kepler)) < 1e-15
+    assert np.max(np.abs(v[0].to_value(u.au / u.day) - v_kepler)) < 1e-17
+    mean_motion = math.sqrt(constants.gm["sun"] / values[0] ** 3)
+    r_day, _ = elements_to_state(*values[:5], values[5] + mean_motion, constants.gm["sun"], frame="icrf")
+    assert np.linalg.norm(r[1].to_value(u.au) - r_day) < 1e-7
+    pole = np.cross(r[1].value, v[1].value)
+    pole /= np.linalg.norm(pole)
+    inc, raan = GOOD["inc"].to_value(u.rad), GOOD["raan"].to_value(u.rad)
+    expected = np.array([math.sin(inc) * math.sin(raan), -math.sin(inc) * math.cos(raan), math.cos(inc)])
+    assert np.linalg.norm(pole - expected) < 1e-6

@@ -52,9 +52,6 @@ class _ReboundStates:
     """Barycentric states of several particles of one REBOUND run, one integration per set of times."""
 
     def __init__(self, simulation, names):
-        from spinorbit.coupling.sampling import rebound_orbit
-
-        self.functions = {name: rebound_orbit(simulation, name) for name in names}
         self.simulation, self.names, self.key, self.states = simulation, tuple(names), None, None
 
     def function(self, name):

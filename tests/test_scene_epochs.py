@@ -122,3 +122,15 @@ def test_apophis_after_the_encounter_does_not_depend_on_the_span(apophis_orbit):
         assert attitude_angles(rows[0]["quaternion"], other["quaternion"])[0] < 2 * (0.5 * u.arcsec).to_value(u.rad)
         assert other["P_psi"].to_value(u.h) == pytest.approx(rows[0]["P_psi"].to_value(u.h), abs=1e-4)
     assert rows[0]["mode"] == "SAM" and abs(rows[0]["P_psi"].to_value(u.h) - 263.0) > 10  # the encounter acted
+
+
+def test_several_bodies_around_the_epoch_equal_their_single_scenes():
+    """Two bodies with times on both sides of the epoch: each body's rows are those of its own scene."""
+    other = RotationState.from_euler313(RigidBody([0.5, 0.8, 1.0], name="b"), 1 * u.deg, 2 * u.deg, 3 * u.deg,
+                                        [1, 2, 30] * u.deg / u.hour)
+    first = RotationState(RigidBody([0.61, 0.965, 1.0], name="a"), state().quaternion, state().angular_velocity)
+    times = EPOCH + np.linspace(-3.0, 3.0, 7) * u.day
+    both = Scene([first, other], EPOCH, times, perturbers=("sun",), orbit=ORBIT, tolerance=TOLERANCE).run()
+    for name, single_state in (("a", first), ("b", other)):
+        single = Scene(single_state, EPOCH, times, perturbers=("sun",), orbit=ORBIT, tolerance=TOLERANCE).run()
+        assert np.max(attitude_angles(both[name].table["quaternion"], single.table["quaternion"])) < 1e-12

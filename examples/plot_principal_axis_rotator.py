@@ -21,6 +21,12 @@ Runs offline in well under a minute.
 # %%
 # The body, its spin state and its orbit
 # --------------------------------------
+# sphinx_gallery_start_ignore
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # a checkout's spinorbit first, uninstalled
+# sphinx_gallery_end_ignore
 import matplotlib.pyplot as plt
 import numpy as np
 from astropy import units as u

@@ -18,6 +18,12 @@ Runs offline in about half a minute.
 # %%
 # The orbit from published elements
 # ----------------------------------
+# sphinx_gallery_start_ignore
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # a checkout's spinorbit first, uninstalled
+# sphinx_gallery_end_ignore
 import matplotlib.pyplot as plt
 import numpy as np
 from astropy import units as u

@@ -377,9 +377,10 @@ def test_asteroid_options_win_over_the_scene_file(capsys):
     ({"--elements": ["2.2", "0.1", "200", "80", "30", "10"]}, "inc expects an inclination"),
     ({"--epoch": ["2250-01-01"]}, "DE421's span"),
     ({"--epoch": ["yesterday"]}, "expects a TDB time"),
+    ({"--epoch": ["2190-01-01"], "--span": ["20", "yr"]}, "DE421's span"),
 ])
 def test_asteroid_bad_options_in_words(capsys, change, words):
-    argv = list(OWN_ASTEROID)
+    argv = [*OWN_ASTEROID, "--span", "30", "d"]
     for option, values in change.items():
         k = argv.index(option)
         argv[k + 1:k + 1 + len(values)] = values

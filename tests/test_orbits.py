@@ -294,3 +294,15 @@ def test_toutatis_spin_from_1992_on_the_elements_orbit_feels_the_2004_flyby():
     change = p_phi[after].mean() - p_phi[before].mean()
     assert 1e-3 < abs(change) < 2e-2
     assert np.all(np.abs(result.table["P_psi"].to_value(u.day) - 5.3685) < 1e-3)
+
+
+def test_scene_on_a_built_orbit_refuses_times_outside_de421():
+    from spinorbit import RigidBody, RotationState
+    from spinorbit.scene import Scene
+
+    orbit = Orbit.from_elements(**GOOD)
+    state = RotationState(RigidBody([0.7, 0.9, 1.0]), [1, 0, 0, 0], [0, 0, 3] * u.rad / u.day)
+    with pytest.raises(EphemerisRangeError, match="DE421's span"):
+        Scene(state, EPOCH, Time("2201-01-01", scale="tdb"), perturbers=("sun",), orbit=orbit)
+    with pytest.raises(EphemerisRangeError, match="DE421's span"):
+        Scene(state, EPOCH, Time("1899-01-01", scale="tdb"), perturbers=("sun",), orbit=orbit)

@@ -218,5 +218,11 @@ def run(args) -> int:
     print(f"orbit              {orbit.description}")
     print(f"spin state         at {epoch.tdb.iso[:19]} TDB: mode {state.mode}, "
           f"P_psi = {state.periods[0].to_value('h'):.4f} h, P_phi = {state.periods[1].to_value('h'):.4f} h")
-    return run_and_report(args, state, epoch, times, orbit, NAME,
-                          f"{name}: {span.value:g} {span.unit} from {start.tdb.iso[:10]}", "h")
+    from spinorbit.cli import CommandError
+    from spinorbit.ephemeris import EphemerisRangeError
+
+    try:
+        return run_and_report(args, state, epoch, times, orbit, NAME,
+                              f"{name}: {span.value:g} {span.unit} from {start.tdb.iso[:10]}", "h")
+    except EphemerisRangeError as error:
+        raise CommandError(str(error)) from None

@@ -88,6 +88,8 @@ class Orbit:
     function: object = None
     simulation: object = None
     description: str = ""
+    #: Built here among DE421's planets: runs stay inside DE421's span (:meth:`check_span`).
+    de421_planets: bool = False
 
     @classmethod
     def de421(cls, name):
@@ -265,7 +267,13 @@ class Orbit:
             description += ", non-gravitational " + ", ".join(f"{k} = {v:.4g} au/d2" for k, v in terms.items())
         if extra_forces:
             description += ", EIH 1PN + Earth J2"
-        return cls("rebound", name, simulation=sim, description=description)
+        return cls("rebound", name, simulation=sim, description=description, de421_planets=True)
+
+    def check_span(self, *days):
+        """EphemerisRangeError if an orbit built among DE421's planets is asked about times (TDB days
+        since J2000) outside DE421's span: its planets start from DE421 and are compared with it."""
+        if self.de421_planets:
+            _check_inside_de421(f"the orbit of {self.name}", *(float(d) for d in days))
 
     # --------------------------------------------------------------------------------------------
     # Close approaches

@@ -184,6 +184,8 @@ class Scene:
         self.integrator, self.sample_tolerance = integrator, sample_tolerance
         self.named, self.fixed, self.moving = inputs.validate_perturbers(perturbers, orbit)
         self.orbit = orbit
+        if orbit is not None:
+            orbit.check_span(self.epoch_day, self.output_days[0], self.output_days[-1])
         self.moments_per_mass = inputs.moments_per_mass(state.body, orbit)
         self.backward = self.forward = None  # the two legs when times are not all after the epoch
         if self.output_days[0] <= self.epoch_day:

@@ -2,7 +2,7 @@
 
 Sections written (``<!-- BEGIN name -->`` … ``<!-- END name -->`` of docs/cli.md): ``cli_apophis``
 (``spinorbit apophis`` at four spans, which agree after the encounter since the state belongs to its
-epoch) and ``cli_asteroid`` (``spinorbit asteroid`` with ``examples/asteroid_scene.toml``). The
+epoch), ``cli_toutatis_plan`` (a plan of ``spinorbit toutatis``) and ``cli_asteroid`` (``spinorbit asteroid`` with ``examples/asteroid_scene.toml``). The
 numbers in those sections come from this script only.
 
 Usage::
@@ -46,6 +46,7 @@ def main():
         try:
             apophis = [(span, printed(["apophis", "--span", span, "d"])) for span in ("4", "4.1", "6", "10")]
             asteroid = printed(["asteroid", "--scene", str(scene)])
+            toutatis = printed(["toutatis", "--plan", "--span", "0.01", "d", "--tolerance", "100", "arcsec"])
         finally:
             os.chdir(here)
     blocks = [machine_line(), "`PYTHONPATH=$PWD python benchmarks/cli_examples.py`:", ""]
@@ -55,6 +56,9 @@ def main():
     write_section("cli_asteroid", "\n".join([machine_line(), "`PYTHONPATH=$PWD python benchmarks/cli_examples.py`:", "",
                                              f"```text\n$ spinorbit asteroid --scene examples/asteroid_scene.toml\n"
                                              f"{asteroid}\n```"]), page="cli.md")
+    write_section("cli_toutatis_plan", "\n".join([
+        machine_line(), "`PYTHONPATH=$PWD python benchmarks/cli_examples.py`:", "",
+        f"```text\n$ spinorbit toutatis --plan --span 0.01 d --tolerance 100 arcsec\n{toutatis}\n```"]), page="cli.md")
     print("\n".join(blocks))
     print(asteroid)
 

@@ -92,6 +92,13 @@ def test_a_time_at_the_epoch_is_the_state_itself():
     result = Scene(state(), EPOCH, times, perturbers=("sun",), orbit=ORBIT, tolerance=TOLERANCE).run()
     assert attitude_angles(result.table["quaternion"][1:2], state().quaternion)[0] == 0.0
     assert result.table["P_psi"].shape == (3,)
+    worse = max((result.stats[leg] for leg in ("backward", "forward")), key=lambda s: s.get("rtol", 0))
+    assert worse  # both legs ran
+    assert sum(result.error_parts.values()).to_value(u.arcsec) == pytest.approx(
+        result.error_estimate.to_value(u.arcsec), rel=1e-12)
+    only = Scene(state(), EPOCH, EPOCH, perturbers=("sun",), orbit=ORBIT, tolerance=TOLERANCE).run()
+    assert len(only.table) == 1 and only.error_estimate.to_value(u.arcsec) == 0.0
+    assert attitude_angles(only.table["quaternion"], state().quaternion)[0] == 0.0
 
 
 @pytest.fixture(scope="module")

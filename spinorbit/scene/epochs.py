@@ -191,7 +191,7 @@ def run_legs(scene, plan, progress, result_type, result_table):
         raise SceneError(f"plan expects the LegPlans of this scene's plan(); got {type(plan).__name__}.")
     report = progress or (lambda fraction: None)
     results, quaternions, omegas = {}, [], []
-    share = 1.0 / len(plan.legs)
+    share = 1.0 / max(len(plan.legs), 1)
     for k, (label, leg_plan) in enumerate(plan.legs):
         leg = getattr(scene, label)
         result = leg.run(leg_plan, progress=lambda f, k=k: report(share * (k + f)))
@@ -208,11 +208,11 @@ def run_legs(scene, plan, progress, result_type, result_table):
         quaternions.append(np.asarray(table["quaternion"]))
         omegas.append(table["omega"].to_value(u.rad / u.day))
     table = result_table(scene, np.concatenate(quaternions), np.concatenate(omegas))
-    parts = {}
-    for result in results.values():
-        for key, value in result.error_parts.items():
-            parts[key] = max(parts.get(key, 0.0 * u.arcsec), value)
-    total = max(result.error_estimate for result in results.values())
+    # A row's error comes from its own leg: the estimate and its parts are the worse leg's (only the
+    # epoch asked for: the state itself, no error).
+    worst = max(results.values(), key=lambda result: result.error_estimate, default=None)
+    parts = {"dropped": 0.0 * u.arcsec} if worst is None else dict(worst.error_parts)
+    total = 0.0 * u.arcsec if worst is None else worst.error_estimate
     table.meta.update(error_estimate_arcsec=float(total.to_value(u.arcsec)), route=plan.route,
                       tolerance_met=bool(total.to_value(u.rad) <= plan.tolerance_rad))
     report(1.0)

@@ -188,7 +188,8 @@ class Scene:
             orbit.check_span(self.epoch_day, self.output_days[0], self.output_days[-1])
         self.moments_per_mass = inputs.moments_per_mass(state.body, orbit)
         self.backward = self.forward = None  # the two legs when times are not all after the epoch
-        if self.output_days[0] <= self.epoch_day:
+        self.in_legs = bool(self.output_days[0] <= self.epoch_day)
+        if self.in_legs:
             from spinorbit.scene import epochs
 
             def make(leg_state, leg_epoch, leg_times, leg_perturbers, leg_orbit):
@@ -268,7 +269,7 @@ class Scene:
             from spinorbit.scene.many import plan_many
 
             return plan_many(self.members, skip)
-        if self.backward is not None or self.forward is not None:
+        if self.in_legs:
             from spinorbit.scene.epochs import plan_legs
 
             return plan_legs(self, skip)
@@ -285,7 +286,7 @@ class Scene:
             from spinorbit.scene.many import run_many
 
             return run_many(self.members, self.plan() if plan is None else plan, progress)
-        if self.backward is not None or self.forward is not None:
+        if self.in_legs:
             from spinorbit.scene.epochs import run_legs
             from spinorbit.scene.routes import result_table
 

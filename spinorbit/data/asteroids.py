@@ -348,10 +348,11 @@ def published_orbit_simulation(state=APOPHIS_HORIZONS, time=None, bodies=DEFAULT
 
 
 def closest_approach(sim, body, near, window_days=1.0, target="earth"):
-    """Closest approach of ``body`` to ``target`` within ``near`` ± ``window_days`` (moves ``sim``).
+    """Closest approach of ``body`` to ``target`` within ``near`` ± ``window_days`` (``sim`` is not moved).
 
-    A 10-minute scan of the window, then Brent's method on the distance (IAS15 with
-    ``exact_finish_time`` runs back and forth; the simulation is left at the closest approach).
+    The smallest minimum of their distance found by :func:`spinorbit.coupling.approaches.approaches`
+    on a copy of the simulation (the root of the range rate, to 1e-9 d); the same finder as
+    :meth:`spinorbit.scene.Orbit.closest_approach`.
 
     Returns
     -------
@@ -361,26 +362,16 @@ def closest_approach(sim, body, near, window_days=1.0, target="earth"):
     speed_km_s : float
         Relative speed at closest approach.
     """
+    from spinorbit.coupling.approaches import approaches, rebound_separation
+
     au_km = de421_constants().au_km
-    i, j = body_index(sim, body), body_index(sim, target)
     day, fraction = tdb_day_and_fraction(near)
     centre = day + fraction
-
-    def distance(t):
-        sim.integrate(t)
-        a, b = sim.particles[i], sim.particles[j]
-        return math.dist((a.x, a.y, a.z), (b.x, b.y, b.z))
-
-    scan = centre + np.arange(-window_days, window_days + 1e-9, 1.0 / 144.0)
-    values = [distance(t) for t in scan]
-    k = int(np.argmin(values))
-    if k in (0, len(scan) - 1):
+    found = approaches(rebound_separation(sim, body, target), centre - window_days, centre + window_days)
+    if not found:
         raise ValueError(f"no closest approach of {body} to {target} inside ±{window_days} d of {near.tdb.iso}.")
-    result = minimize_scalar(distance, bracket=(scan[k - 1], scan[k], scan[k + 1]), tol=1e-12)
-    distance(result.x)
-    a, b = sim.particles[i], sim.particles[j]
-    speed = math.dist((a.vx, a.vy, a.vz), (b.vx, b.vy, b.vz))
-    return time_from_tdb_days(result.x), result.fun * au_km, speed * au_km / 86400.0
+    when, distance, speed = min(found, key=lambda minimum: minimum[1])
+    return time_from_tdb_days(when), distance * au_km, speed * au_km / 86400.0
 
 
 def apophis_encounter_simulation(orbit="published", extra_forces=None):

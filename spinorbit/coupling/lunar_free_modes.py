@@ -88,13 +88,16 @@ class FreeModeFit:
 
 @dataclass(frozen=True)
 class FreeModes:
-    """The free modes of one model (``modes[name]`` for each of :data:`FREE_MODES`)."""
+    """The free modes of one model: ``modes[name]`` (a :class:`FreeModeFit`) and ``signals[name]``
+    (TDB days, the kicked − reference signal fitted, arcsec; complex for latitude and wobble) for each
+    mode asked for."""
 
     model: str
     start_day: float
     span_days: float
     step_days: float
     modes: dict
+    signals: dict
     wall_seconds: float
 
     def relative_to(self, reference: str = "Yang et al. 2017 (DE430)") -> dict:
@@ -221,12 +224,10 @@ def free_modes(model: str = "rigid", start_day: float = -36500.0, span_days: flo
     days = reference.times
     delta = kicked.librations_model - reference.librations_model  # (Δτ, Δρ, ΔIσ), arcsec
     body = kicked.body_difference_arcsec - reference.body_difference_arcsec
-    fits = {}
-    if "longitude" in modes:
-        fits["longitude"] = _fit(days, delta[:, 0])
-    if "latitude" in modes:
-        fits["latitude"] = _fit(*_monthly_mean(days, delta[:, 1] + 1j * delta[:, 2]))
-    if "wobble" in modes:
-        fits["wobble"] = _fit(*_monthly_mean(days, body[:, 0] + 1j * body[:, 1]))
+    signals = {"longitude": (days, delta[:, 0]),
+               "latitude": _monthly_mean(days, delta[:, 1] + 1j * delta[:, 2]),
+               "wobble": _monthly_mean(days, body[:, 0] + 1j * body[:, 1])}
+    signals = {name: signals[name] for name in FREE_MODES if name in modes}
+    fits = {name: _fit(*signal) for name, signal in signals.items()}
     return FreeModes(model=model, start_day=float(start_day), span_days=float(span_days),
-                     step_days=float(step_days), modes=fits, wall_seconds=wall)
+                     step_days=float(step_days), modes=fits, signals=signals, wall_seconds=wall)

@@ -54,7 +54,11 @@ def spans_section():
 def free_modes_section():
     yang = LITERATURE_PERIODS_DAYS["Yang et al. 2017 (DE430)"]
     rambaux = LITERATURE_PERIODS_DAYS["Rambaux & Williams 2011 (DE421)"]
-    rows = [f"| published: Rambaux & Williams 2011 (DE421) | " + " | ".join(f"{rambaux[m]:.1f} d" for m in FREE_MODES)
+    # Rambaux & Williams give 1056 d, 24.2 yr and 74.6 yr: shown as published, with the days.
+    published_text = {"longitude": f"{rambaux['longitude']:.0f} d",
+                      "latitude": f"{rambaux['latitude'] / YEAR_DAYS:.1f} yr ({rambaux['latitude']:.0f} d)",
+                      "wobble": f"{rambaux['wobble'] / YEAR_DAYS:.1f} yr ({rambaux['wobble']:.0f} d)"}
+    rows = [f"| published: Rambaux & Williams 2011 (DE421) | " + " | ".join(published_text[m] for m in FREE_MODES)
             + " | |",
             f"| published: Yang et al. 2017 (DE430) | " + " | ".join(f"{yang[m]:.2f} d" for m in FREE_MODES) + " | |"]
     for model in MOON_MODELS:

@@ -135,7 +135,7 @@ def check_run(model: str, start_day: float, span_days: float, step_days: float) 
             f"start: expected a date between {_iso_tdb(first)} and {_iso_tdb(last)} TDB (DE421's span less "
             f"{RANGE_MARGIN_DAYS:g} d at each end), got {shown}; choose a start inside it.")
     if not (np.isfinite(span_days) and span_days > 0.0):
-        raise ValueError(f"span: expected a positive number of days, got {span_days!r}.")
+        raise ValueError(f"span: expected a positive number of days, got {float(span_days)!r} d.")
     if start_day + span_days > last:
         raise EphemerisRangeError(
             f"span: a run of {span_days:g} d from {_iso_tdb(start_day)} TDB ends at {_iso_tdb(start_day + span_days)}, "
@@ -144,7 +144,7 @@ def check_run(model: str, start_day: float, span_days: float, step_days: float) 
     if not (np.isfinite(step_days) and MIN_STEP_DAYS * (1.0 - 1e-9) <= step_days <= span_days):
         raise OutputStepError(
             f"step: expected an output spacing from 1 min ({MIN_STEP_DAYS:.6g} d) up to the span "
-            f"({span_days:g} d), got {step_days!r} d; the models resolve nothing finer than a minute.")
+            f"({span_days:g} d), got {float(step_days)!r} d; the models resolve nothing finer than a minute.")
 
 
 def moon_figure(moon_mass: float, model: str = "rigid", degree: int = 4) -> np.ndarray:

@@ -9,7 +9,7 @@ signal where it stands alone:
 - **longitude** (≈ 1056 d): Δτ, fitted with a damped sinusoid plus a line;
 - **latitude** (free precession of the pole about its Cassini position, ≈ 24.2 yr): Δρ + i·ΔIσ,
   averaged over a sidereal month (the wobble is monthly in that frame), fitted with a damped
-  complex exponential plus a line;
+  ellipse (both senses of rotation at one frequency) plus a line;
 - **wobble** (≈ 74.6 yr): the kicked run's small rotation from the reference on the mantle's x and
   y axes, averaged over a sidereal month (the latitude mode is monthly in the mantle frame), fitted
   the same way.
@@ -75,7 +75,10 @@ class FreeModeFit:
     damping_days : float
         e-folding time of the amplitude (days; ``inf`` for no measurable damping, negative if it grew).
     amplitude_arcsec : float
-        Amplitude at the start of the signal (arcsec).
+        Amplitude at the start of the signal (arcsec); for the latitude mode and the wobble the
+        semi-major axis of the ellipse the two components trace.
+    minor_amplitude_arcsec : float
+        The ellipse's semi-minor axis (arcsec; 0 for the longitude mode, a line).
     residual_arcsec : float
         RMS of the fit's residual (arcsec), what the damped sinusoid and line leave.
     """
@@ -83,6 +86,7 @@ class FreeModeFit:
     period_days: float
     damping_days: float
     amplitude_arcsec: float
+    minor_amplitude_arcsec: float
     residual_arcsec: float
 
 
@@ -145,7 +149,11 @@ def _monthly_mean(days, values):
 
 
 def _fit(days, signal):
-    """Damped complex (or real) exponential + line, by variable projection; a :class:`FreeModeFit`."""
+    """Damped ellipse (complex signal) or sinusoid (real) + line, by variable projection; a :class:`FreeModeFit`.
+
+    A complex signal gets both senses of rotation at the one frequency, e^{±iωt}: the wobble traces an
+    ellipse (axis ratio ≈ 2.5), which one circular term would leave in the residual.
+    """
     t = days - days[0]
     scale = np.max(np.abs(signal))
     z = signal / scale
@@ -164,7 +172,7 @@ def _fit(days, signal):
         omega, rate = parameters
         wave = np.exp((1j * omega - rate) * t)
         columns = [np.ones_like(t), t]
-        columns += [wave] if is_complex else [wave.real, wave.imag]
+        columns += [wave, np.conj(wave)] if is_complex else [wave.real, wave.imag]
         return np.array(columns, dtype=complex if is_complex else float).T
 
     def residual(parameters):
@@ -177,11 +185,16 @@ def _fit(days, signal):
                              xtol=1e-14, ftol=1e-14, gtol=1e-14)
     omega, rate = solution.x
     coefficients = np.linalg.lstsq(basis(solution.x), z, rcond=None)[0]
-    amplitude = abs(coefficients[2]) if is_complex else float(np.hypot(coefficients[2], coefficients[3]))
+    if is_complex:
+        major = abs(coefficients[2]) + abs(coefficients[3])
+        minor = abs(abs(coefficients[2]) - abs(coefficients[3]))
+    else:
+        major, minor = float(np.hypot(coefficients[2], coefficients[3])), 0.0
     rms = float(np.sqrt(np.mean(residual(solution.x) ** 2)) * scale)
     return FreeModeFit(period_days=float(2.0 * np.pi / abs(omega)),
                        damping_days=float(1.0 / rate) if rate != 0.0 else float("inf"),
-                       amplitude_arcsec=float(amplitude * scale), residual_arcsec=rms)
+                       amplitude_arcsec=float(major * scale), minor_amplitude_arcsec=float(minor * scale),
+                       residual_arcsec=rms)
 
 
 def _run(model, start_day, span_days, step_days, spin_offset):

@@ -37,7 +37,6 @@ from spinorbit.core.integrators.quaternion import integrate_quaternion
 from spinorbit.core.model.lunar_interior import make_interior_block
 from spinorbit.core.model.perturbers import pack_perturbers
 from spinorbit.core.math.rotations import (
-    attitude_to_euler313,
     quat_to_attitude,
     quat_to_attitude_many,
 )
@@ -49,7 +48,7 @@ from spinorbit.ephemeris import (
     moon_libration_angles_raw,
     moon_orientation_raw,
 )
-from spinorbit.lunar_librations import physical_librations
+from spinorbit.lunar_librations import euler313_from_attitudes, physical_librations
 from spinorbit.time import J2000_JD_TDB, tdb_day_and_fraction, time_from_tdb_days
 from spinorbit.coupling.sampling import de421_orbit, sample_from_ephemeris, sample_relative_states
 from spinorbit.coupling.long_run import integrate_to_outputs
@@ -279,7 +278,7 @@ class LibrationComparison:
 
 def _euler313_near(attitudes, reference_angles):
     """3-1-3 angles of ``attitudes`` on the branch of ``reference_angles`` (each within π of it)."""
-    angles = np.array([attitude_to_euler313(r) for r in attitudes])
+    angles = euler313_from_attitudes(attitudes)
     return reference_angles + np.remainder(angles - reference_angles + np.pi, 2.0 * np.pi) - np.pi
 
 

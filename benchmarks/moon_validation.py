@@ -21,7 +21,15 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _report import machine_line, write_section  # noqa: E402
 
-from spinorbit.coupling.lunar_free_modes import FREE_MODES, LITERATURE_PERIODS_DAYS, free_modes  # noqa: E402
+from spinorbit.coupling.lunar_free_modes import (  # noqa: E402
+    DEFAULT_SPAN_DAYS,
+    DEFAULT_START_DAY,
+    DEFAULT_STEP_DAYS,
+    FREE_MODES,
+    LITERATURE_PERIODS_DAYS,
+    free_modes,
+)
+from spinorbit.time import time_from_tdb_days  # noqa: E402
 from spinorbit.coupling.moon import MOON_MODELS, compare_model_with_de421  # noqa: E402
 
 #: (years, output step in days): daily for a year, then coarser so the comparison stays cheap.
@@ -78,7 +86,8 @@ def free_modes_section():
     head = ("| | longitude | latitude | wobble | wobble ellipse (axis ratio) | wall (two runs) |\n"
             "|---|---:|---:|---:|---:|---:|")
     return (f"`python benchmarks/moon_validation.py` ({machine_line()}), each model run twice over "
-            f"200 yr from 1900-01-10 with a 2-d step (percentages against Yang et al. 2017):\n\n{head}\n"
+            f"{DEFAULT_SPAN_DAYS / YEAR_DAYS:g} yr from {time_from_tdb_days(DEFAULT_START_DAY).tdb.iso[:16]} TDB "
+            f"with a {DEFAULT_STEP_DAYS:g}-d step (percentages against Yang et al. 2017):\n\n{head}\n"
             + "\n".join(rows))
 
 

@@ -62,6 +62,11 @@ SIDEREAL_MONTH_DAYS = 27.321662
 #: runs' difference without a kick (zero: same code, same steps).
 KICK_RELATIVE = {"x": 1e-5, "z": 1e-6}
 ARCSEC_PER_RAD = 180.0 * 3600.0 / np.pi
+#: Default run: 200 yr from JD 2415045.0 TDB (1900-01-25 12:00), every 2 days; two cycles and more of
+#: the wobble, eight of the latitude mode, inside DE421 (1899-12-04 .. 2200-02-01).
+DEFAULT_START_DAY = -36500.0
+DEFAULT_SPAN_DAYS = 200 * 365.25
+DEFAULT_STEP_DAYS = 2.0
 
 
 @dataclass(frozen=True)
@@ -204,8 +209,8 @@ def _run(model, start_day, span_days, step_days, spin_offset):
     return compare_with_de421(moon, span_days, step_days)
 
 
-def free_modes(model: str = "rigid", start_day: float = -36500.0, span_days: float = 200 * 365.25,
-               step_days: float = 2.0, modes=FREE_MODES) -> FreeModes:
+def free_modes(model: str = "rigid", start_day: float = DEFAULT_START_DAY, span_days: float = DEFAULT_SPAN_DAYS,
+               step_days: float = DEFAULT_STEP_DAYS, modes=FREE_MODES) -> FreeModes:
     """Measure the free-mode periods of one Moon model (module docstring: what is measured).
 
     Parameters
@@ -213,7 +218,7 @@ def free_modes(model: str = "rigid", start_day: float = -36500.0, span_days: flo
     model : {"de421", "rigid", "core-corrected"}
         The model (:func:`spinorbit.coupling.moon.compare_model_with_de421`).
     start_day, span_days, step_days : float
-        Start (TDB days since J2000; default 1900-01-10), span and output spacing (days). Both runs
+        Start (TDB days since J2000; default 1900-01-25 12:00), span and output spacing (days). Both runs
         must lie inside DE421 (:func:`spinorbit.coupling.moon.check_run`). A mode's period is
         resolved to ≈ 0.1 % once the span holds a few of its cycles: the wobble needs ≥ 150 yr,
         the latitude mode ≥ 80 yr, the longitude mode ≥ 15 yr.

@@ -32,7 +32,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 PAGE = ROOT / "docs" / "tutorials.md"
 #: The pages whose outputs the script regenerates.
-PAGES = (PAGE, ROOT / "docs" / "cli.md")
+PAGES = (PAGE,)  # docs/cli.md: benchmarks/cli_examples.py
 #: A snippet and the output block that follows it (a paragraph starting "prints" in between).
 SNIPPET = re.compile(r"```(?P<language>python|bash)\n(?P<code>(?:(?!```).)*)```\n\nprints[^\n]*\n(?:[^\n]+\n)*\n"
                      r"```text\n(?P<output>(?:(?!```).)*)```", re.S)

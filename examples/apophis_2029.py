@@ -18,6 +18,11 @@ The rotation *phase* at perigee is not known from the published state, and the o
 strongly. ``--phases N`` repeats the run from N phases of the free motion (the published state moved
 along its own torque-free motion by k/N of P_ψ before the run starts) and prints the spread.
 
+This script places the published state at the start of its span (``--days`` before perigee), the
+convention of the numbers it produced for docs/asteroids.md; with the default ``--days 5`` that is
+the state's own epoch, ``APOPHIS_STATE_EPOCH``. ``spinorbit apophis`` and the gallery example
+``plot_apophis_2029_phase.py`` run the state from that epoch whatever the span.
+
 Usage::
 
     python examples/apophis_2029.py                 # ±5 d around perigee, 8 phases (a few seconds)

@@ -2,13 +2,14 @@
 The Moon's physical libration against DE421
 ===========================================
 
-The lunar physical libration from DE421 at J2000, integrated with the orbits, against DE421.
+The lunar physical libration from DE421 at J2000 (or --start), integrated with the orbits, against DE421.
 
 Usage::
 
     python examples/moon_libration.py                 # 1 year, all three models
     python examples/moon_libration.py --years 20 --plot moon20.png
     python examples/moon_libration.py --years 5 --models de421 --ablation
+    python examples/moon_libration.py --start 1920-01-01 --years 100 --step 10
 
 Prints, for each model (de421: DE421's mantle + fluid core + tides on DE421's orbits; rigid: DE421's
 total moments; core-corrected: the fluid core's share of the polar moment removed), the maximum and
@@ -25,6 +26,7 @@ import argparse
 import time
 
 import numpy as np
+from astropy.time import Time
 
 from spinorbit.commands.moon import plot_comparison
 from spinorbit.core.integrators.quaternion import integrate_quaternion
@@ -49,19 +51,20 @@ from spinorbit.coupling.moon import (
     moon_at_de421,
 )
 from spinorbit.ephemeris import moon_orientation_raw
+from spinorbit.time import tdb_day_and_fraction
 
 
-def run_rigid(model, span, step, years):
+def run_rigid(model, span, step, years, epoch):
     start = time.perf_counter()
-    single = moon_at_de421(model=model)
+    single = moon_at_de421(epoch=epoch, model=model)
     single.integrate(single.sim.t + span)  # one call: the integrator's own cost, no output stops
     single_wall = time.perf_counter() - start
-    comparison = compare_with_de421(moon_at_de421(model=model), span, step)
+    comparison = compare_with_de421(moon_at_de421(epoch=epoch, model=model), span, step)
     return comparison, f"wall {single_wall / years:.3f} s/yr in one call, {comparison.wall_seconds / years:.3f} s/yr with output"
 
 
-def run_de421(span, step, years):
-    comparison = compare_interior_with_de421(span, step)
+def run_de421(span, step, years, start_day):
+    comparison = compare_interior_with_de421(span, step, start_day=start_day)
     return comparison, (f"wall {comparison.wall_seconds / years:.3f} s/yr integration, "
                         f"{comparison.sampling_seconds / years:.3f} s/yr sampling DE421's orbits")
 
@@ -95,7 +98,8 @@ def ablation(span, step):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
-    parser.add_argument("--years", type=float, default=1.0, help="span from J2000 in Julian years (default 1)")
+    parser.add_argument("--start", default="2000-01-01T12:00:00", help="start, ISO date TDB (default J2000.0)")
+    parser.add_argument("--years", type=float, default=1.0, help="span from --start in Julian years (default 1)")
     parser.add_argument("--step", type=float, default=None, help="comparison spacing in days (default: 1 d per year of span)")
     parser.add_argument("--models", nargs="+", choices=MOON_MODELS, default=list(MOON_MODELS))
     parser.add_argument("--plot", metavar="FILE.png", help="write the plots (one PNG per model, model name appended)")
@@ -103,9 +107,11 @@ def main():
     args = parser.parse_args()
     span = 365.25 * args.years
     step = args.step if args.step is not None else max(1.0, round(args.years))
+    epoch = Time(args.start, scale="tdb")
+    start_day = float(sum(tdb_day_and_fraction(epoch)))
     for model in args.models:
-        comparison, timing = run_de421(span, step, args.years) if model == "de421" else run_rigid(
-            model, span, step, args.years)
+        comparison, timing = run_de421(span, step, args.years, start_day) if model == "de421" else run_rigid(
+            model, span, step, args.years, epoch)
         print(f"{model:15s} max {comparison.max_difference_arcsec:8.5f} arcsec, "
               f"final {comparison.attitude_difference_arcsec[-1]:8.5f} arcsec over {args.years:g} yr; {timing}")
         if args.plot:

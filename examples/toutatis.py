@@ -6,11 +6,11 @@ Toutatis 1992–2012
 
 Initial state: Takahashi, Busch & Scheeres 2013 (AJ 146, 95, Table 2) at 1992-11-09T17:49:47 UTC
 (:func:`spinorbit.data.asteroids.toutatis_rotation_state`; the Euler-angle reading is documented there).
-Orbit: the documented encounter geometry of the 2004-09-29 flyby (0.01036 au; directions and
-semi-major axis from rounded elements, :mod:`spinorbit.data.asteroids`), integrated backwards to 1992 and
-forwards to 2012 with the Sun, planets, Moon and Pluto from DE421 in REBOUND (IAS15). Torques: Sun
-and Earth (degree 2), one way. The other Earth approaches (1992, 1996, 2000, 2008, 2012) come out
-wherever this approximate orbit puts them — they are printed next to the real ones.
+Orbit: Toutatis's published osculating elements (JPL SBDB, epoch 2008-11-27;
+:func:`spinorbit.data.asteroids.toutatis_orbit`) integrated with the Sun, planets, Moon and Pluto from
+DE421 in REBOUND (IAS15, EIH 1PN, Earth J2); ``--orbit geometry`` takes the older documented
+encounter geometry of the 2004-09-29 flyby instead. Torques: Sun and Earth (degree 2), one way. The
+orbit's Earth approaches are printed next to the real ones.
 
 Periods are the osculating (instantaneous torque-free) P_ψ, P_φ of the integrated state; they are
 compared with Hudson & Ostro 1995 (radar 1992: 5.41 d, 7.35 d) and the Chang'e-2 flyby (2012:
@@ -41,7 +41,7 @@ from astropy.time import Time
 # Run from a checkout without installing (the project does not use editable installs).
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from spinorbit.data.asteroids import TOUTATIS_2004, TOUTATIS_EPOCH, encounter_simulation, toutatis_rotation_state
+from spinorbit.data.asteroids import TOUTATIS_2004, TOUTATIS_EPOCH, toutatis_orbit, toutatis_rotation_state
 from spinorbit.coupling.one_way import propagate_one_way
 from spinorbit.coupling.sampling import sample_from_rebound
 from spinorbit.time import tdb_days
@@ -71,6 +71,8 @@ def main(argv=None):
     parser.add_argument("--phases", type=int, default=0,
                         help="also run the 2004 flyby (±150 d) from N phases of the free motion and print the spread")
     parser.add_argument("--output", default="toutatis.png", help="PNG to write ('' for none)")
+    parser.add_argument("--orbit", choices=("elements", "geometry"), default="elements",
+                        help="published elements (default) or the documented 2004-flyby geometry")
     args = parser.parse_args(argv)
 
     clock = time.perf_counter()
@@ -80,7 +82,7 @@ def main(argv=None):
           f"P_psi = {p_psi.to_value(u.day):.4f} d, P_phi = {p_phi.to_value(u.day):.4f} d (anchors: 5.369 / 7.412)")
 
     flyby = TOUTATIS_2004.time_tdb
-    sim = encounter_simulation(TOUTATIS_2004)
+    sim = toutatis_orbit(args.orbit).simulation
     if args.quick:
         start, end, epoch = flyby - 150 * u.day, flyby + 150 * u.day, None
     else:

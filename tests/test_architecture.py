@@ -30,7 +30,8 @@ CORE_BASE = ("spinorbit.core.jit", "spinorbit.core.errors")
 #: The layer above the core, lowest first (the core below them all).
 UPPER_LAYERS = (
     ("bridge", ("spinorbit.body", "spinorbit.state", "spinorbit.state_table", "spinorbit.time",
-                "spinorbit.frames", "spinorbit.ephemeris", "spinorbit.special", "spinorbit.pole")),
+                "spinorbit.frames", "spinorbit.ephemeris", "spinorbit.lunar_librations", "spinorbit.special",
+                "spinorbit.orbital_elements", "spinorbit.pole")),
     ("runs", ("spinorbit.runs",)),
     ("coupling", ("spinorbit.coupling",)),
     ("scene", ("spinorbit.scene",)),

@@ -339,3 +339,72 @@ def test_scene_commands_bad_input_in_words(capsys, args, words):
     _, err = capsys.readouterr()
     assert status == 2 and words in err and "Traceback" not in err
     assert len(err.strip().splitlines()) == 1
+
+
+# ------------------------------------------------------------------------------------------------
+# spinorbit asteroid: the user's own asteroid from a TOML scene or options.
+
+SCENE_FILE = Path(__file__).resolve().parent.parent / "examples" / "asteroid_scene.toml"
+OWN_ASTEROID = ["asteroid", "--elements", "2.2", "0.15", "4", "80", "30", "10", "--epoch", "2020-01-01",
+                "--moments", "0.6", "0.9", "1", "--euler313", "10", "40", "70", "--omega", "0", "0", "1080"]
+
+
+def test_asteroid_scene_file_plans_with_both_legs(capsys):
+    """The committed example scene: its spin epoch lies inside the outputs, so the plan has a backward
+    and a forward leg, each with its perturber decisions."""
+    status = cli.main(["asteroid", "--scene", str(SCENE_FILE), "--plan"])
+    out, err = capsys.readouterr()
+    assert status == 0, err
+    assert "backward leg" in out and "forward leg" in out and "perturber jupiter" in out
+    assert "osculating elements a = 1.5 AU" in out and "A2 = -2.9e-14" in out
+
+
+def test_asteroid_from_options_writes_ecsv_starting_at_the_spin_epoch(capsys, tmp_path):
+    path = tmp_path / "mine.ecsv"
+    status = cli.main([*OWN_ASTEROID, "--span", "5", "d", "--n-times", "10", "--output", str(path)])
+    out, err = capsys.readouterr()
+    assert status == 0, err
+    table = Table.read(path)
+    assert len(table) == 10 and table.meta["tolerance_met"]
+    start = Time("2020-01-01", scale="tdb")
+    assert abs((Time(table["time"][0]) - start).to_value(u.day) - 0.5) < 1e-6
+    assert abs((Time(table["time"][-1]) - start).to_value(u.day) - 5.0) < 1e-6
+
+
+def test_asteroid_options_win_over_the_scene_file(capsys):
+    status = cli.main(["asteroid", "--scene", str(SCENE_FILE), "--plan", "--perturbers", "sun", "--span", "2", "d"])
+    out, err = capsys.readouterr()
+    assert status == 0, err
+    assert "perturber sun" in out and "perturber jupiter" not in out
+
+
+@pytest.mark.parametrize("change, words", [
+    ({"--elements": ["2.2", "1.2", "4", "80", "30", "10"]}, "e expects an elliptic orbit"),
+    ({"--elements": ["-2.2", "0.1", "4", "80", "30", "10"]}, "positive semi-major axis"),
+    ({"--elements": ["2.2", "0.1", "200", "80", "30", "10"]}, "inc expects an inclination"),
+    ({"--epoch": ["2250-01-01"]}, "DE421's span"),
+    ({"--epoch": ["yesterday"]}, "expects a TDB time"),
+    ({"--epoch": ["2190-01-01"], "--span": ["20", "yr"]}, "DE421's span"),
+])
+def test_asteroid_bad_options_in_words(capsys, change, words):
+    argv = [*OWN_ASTEROID, "--span", "30", "d"]
+    for option, values in change.items():
+        k = argv.index(option)
+        argv[k + 1:k + 1 + len(values)] = values
+    status = cli.main(argv)
+    _, err = capsys.readouterr()
+    assert status == 2 and words in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+def test_asteroid_bad_scene_files_in_words(capsys, tmp_path):
+    typo = tmp_path / "typo.toml"
+    typo.write_text(SCENE_FILE.read_text().replace("mean_anomaly =", "mean_anomally ="))
+    broken = tmp_path / "broken.toml"
+    broken.write_text("[orbit\na = 1")
+    missing = tmp_path / "missing.toml"
+    missing.write_text('[orbit]\nepoch = "2020-01-01"\na = "2 au"\n')
+    for path, words in ((typo, "unknown keys ['mean_anomally']"), (broken, "not valid TOML"),
+                        (missing, "[orbit] e is missing"), (tmp_path / "absent.toml", "cannot read")):
+        status = cli.main(["asteroid", "--scene", str(path), "--plan"])
+        _, err = capsys.readouterr()
+        assert status == 2 and words in err and "Traceback" not in err, (path, err)

@@ -391,7 +391,7 @@ def test_plan_reads_like_explain():
     ({"state": "not a state"}, "RotationState"),
     ({"epoch": "2020-01-01"}, "scalar astropy Time"),
     ({"times": [1.0, 2.0]}, "astropy Time"),
-    ({"times": EPOCH - 1 * u.day}, "after the epoch"),
+    ({"times": EPOCH + [1.0, 1.0] * u.day}, "strictly increasing"),
     ({"times": EPOCH + [2.0, 1.0] * u.day}, "strictly increasing"),
     ({"tolerance": 1e-6}, "angle Quantity"),
     ({"tolerance": 1 * u.m}, "angle Quantity"),
@@ -411,6 +411,19 @@ def test_bad_inputs_raise_scene_error_in_words(change, message):
     kwargs.update(change)
     with pytest.raises(SceneError, match=message):
         Scene(**kwargs)
+
+
+def test_times_before_the_epoch_are_refused_only_where_a_leg_needs_them_after():
+    """A Scene now runs backwards from its epoch (tests/test_scene_epochs.py); the check of one leg's
+    times, ``validate_times`` without ``either_side``, still refuses times not after the epoch."""
+    from spinorbit.scene.inputs import validate_times
+
+    with pytest.raises(SceneError, match="after the epoch"):
+        validate_times(EPOCH, EPOCH - 1 * u.day)
+    with pytest.raises(SceneError, match="after the epoch"):
+        validate_times(EPOCH, EPOCH + [0.0, 1.0] * u.day)
+    epoch_day, output_days, _ = validate_times(EPOCH, EPOCH - 1 * u.day, either_side=True)
+    assert output_days[0] == pytest.approx(epoch_day - 1.0, abs=1e-9)
 
 
 def test_bad_names_raise_the_ephemeris_and_rebound_errors():

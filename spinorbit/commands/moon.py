@@ -1,4 +1,4 @@
-"""``spinorbit moon``: the lunar physical libration from DE421 at J2000, integrated with the orbits."""
+"""``spinorbit moon``: the lunar physical libration from any date in DE421, integrated with the orbits."""
 
 from __future__ import annotations
 
@@ -14,42 +14,48 @@ from spinorbit.commands._common import Progress, atomic_output, check_output_pat
 MOON_MODELS = ("de421", "rigid", "core-corrected")
 
 NAME = "moon"
-SUMMARY = "lunar physical libration from DE421 at J2000, coupled to the orbits, compared with DE421"
+SUMMARY = "lunar physical libration from DE421 at any date, coupled to the orbits, compared with DE421"
 DESCRIPTION = """\
 Integrate the Moon's rotation (quaternion + angular velocity, degree 2-4 lunar gravity field from the
 DE421 constants, torques from the Sun, planets and Earth) together with the orbits (REBOUND's BS,
-point masses + EIH 1PN + Earth J2 + the lunar figure's back-reaction), starting from DE421 at J2000,
-and compare the attitude with DE421's librations at every output time.
+point masses + EIH 1PN + Earth J2 + the lunar figure's back-reaction), starting from DE421 at --start
+(default J2000; any date in DE421's 1899-12-04 .. 2200-02-01, the run ending inside it too), and
+compare the attitude with DE421's librations at every output time.
 
 Models: 'de421' (default) is DE421's own lunar rotation model (mantle with tidal and rotational
 distortion, fluid core, Earth J2 on the lunar figure), driven one-way by DE421's orbits and started
-from DE421's published state (the core carried from DE421's epoch 1969); 'rigid' uses DE421's total
+from DE421's mantle at --start (the core carried there from DE421's epoch 1969); 'rigid' uses DE421's total
 moments; 'core-corrected' removes the fluid core's share of the polar moment (IFAC) from the moments
 the mantle's Euler equations see. The two rigid models run fully coupled in REBOUND
 (docs/coupling.md).
+
+--output writes the Moon table (ECSV): time (TDB), the model's 3-1-3 angles phi, theta, psi (rad)
+and physical librations tau, rho, I_sigma (arcsec), DE421's values of the same suffixed _de421, and
+the attitude difference (docs/conventions.md "Physical librations").
 
 The last line printed is 'max attitude difference vs DE421: <x> arcsec over <span>'."""
 EXAMPLES = """\
 examples:
   spinorbit moon                                   # 1 year, DE421's mantle-and-core model
   spinorbit moon --span 20 yr --model rigid --step 5 d --output moon.ecsv --plot moon.png
+  spinorbit moon --start 1950-01-01 --span 100 yr --step 10 d --output moon1950.ecsv
   spinorbit moon --span 50 yr --checkpoint moon.ckpt --output moon.ecsv   # killed? then:
   spinorbit moon --span 50 yr --resume moon.ckpt --output moon.ecsv
 
 exit status: 0 on success; 2 with a one-line message if the input is wrong or an output file
 cannot be written (nothing is left half-written)."""
 
-#: DE421's librations end in 2050 and (from J2000) the lunar model is meant for decades, not more.
-MAX_SPAN_DAYS = 50 * 365.25
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of ``spinorbit moon``."""
     run = parser.add_argument_group("model and span")
+    run.add_argument("--start", default="2000-01-01T12:00:00", metavar="DATE",
+                     help="first output time, ISO date (TDB) or JD number, inside DE421 (default J2000.0)")
     run.add_argument("--span", nargs="+", default=["1", "yr"], metavar="SPAN",
-                     help="how long to integrate from J2000, e.g. '1 yr' (default), '20 yr', '200 d'")
+                     help="how long to integrate from --start, e.g. '1 yr' (default), '20 yr', '200 d'; "
+                          "the run must end inside DE421 (2200-01-31)")
     run.add_argument("--step", nargs="+", default=["1", "d"], metavar="STEP",
-                     help="spacing of the comparison times (default 1 d)")
+                     help="spacing of the comparison times (default 1 d; at least 1 min)")
     run.add_argument("--model", choices=MOON_MODELS, default="de421",
                      help="de421: mantle + fluid core + tides on DE421's orbits (default); rigid / "
                           "core-corrected: rigid Moon with the whole Moon's / the mantle's moments, in REBOUND")
@@ -57,7 +63,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                      help="rigid models: do not let the lunar figure act back on the orbits "
                           "(default: fully coupled); the de421 model is always one-way")
     files = parser.add_argument_group("output files")
-    files.add_argument("--output", metavar="FILE.ecsv", help="write time, attitude difference and angles as ECSV")
+    files.add_argument("--output", metavar="FILE.ecsv",
+                       help="write the Moon table (time, Euler angles, physical librations, DE421's, difference) as ECSV")
     files.add_argument("--plot", metavar="FILE.png", help="plot the difference and the libration (needs matplotlib)")
     long_runs = parser.add_argument_group("long runs")
     long_runs.add_argument("--checkpoint", metavar="PATH",
@@ -70,40 +77,33 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                                 "PATH unless --checkpoint names another file")
 
 
-def libration_table(comparison, model: str, coupled: bool):
-    """An astropy Table of a :class:`spinorbit.coupling.moon.LibrationComparison` (units attached)."""
-    import astropy.units as u
-    import numpy as np
-    from astropy.table import Table
+def start_day(text: str) -> float:
+    """``--start`` as TDB days since J2000: an ISO date/time (TDB) or a Julian date number."""
+    from astropy.time import Time
 
-    from spinorbit import __version__
+    from spinorbit.time import tdb_day_and_fraction
 
-    table = Table(meta={
-        "software": f"spinorbit {__version__} moon",
-        "model": model,
-        "coupled": coupled,
-        "reference": "DE421 lunar librations (de421 package via jplephem)",
-        "conventions": "angles passive 3-1-3 ICRF -> mantle, R = R3(psi) R1(theta) R3(phi); "
-                       "difference = rotation from the DE421 frame to the model frame, on DE421 mantle axes",
-    })
-    table["time"] = comparison.times * u.day
-    table["time"].description = "TDB days since J2000"
-    table["attitude_difference"] = comparison.attitude_difference_arcsec * u.arcsec
-    for i, axis in enumerate("xyz"):
-        table[f"difference_{axis}"] = comparison.body_difference_arcsec[:, i] * u.arcsec
-    for i, name in enumerate(("phi", "theta", "psi")):
-        table[f"{name}_model"] = comparison.angles_model[:, i] * u.rad
-        table[f"{name}_de421"] = np.asarray(comparison.angles_de421[:, i]) * u.rad
-    return table
+    try:
+        time = Time(float(text), format="jd", scale="tdb") if _is_number(text) else Time(text, scale="tdb")
+    except ValueError:
+        raise CommandError(f"--start expects an ISO date such as '1969-07-20' or a Julian date such as "
+                           f"'2440423.5' (TDB), got '{text}'.") from None
+    day, fraction = tdb_day_and_fraction(time)
+    return float(day) + float(fraction)
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def plot_comparison(comparison, path: str, title: str) -> None:
-    """PNG: attitude difference (top) and libration in longitude and inclination (bottom), arcsec."""
-    import numpy as np
+    """PNG: attitude difference (top) and the physical librations τ, ρ, Iσ (bottom), arcsec."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
-
-    from spinorbit.coupling.moon import ARCSEC_PER_RAD
 
     years = (comparison.times - comparison.times[0]) / 365.25
     figure = Figure(figsize=(9, 7), layout="constrained")
@@ -115,24 +115,30 @@ def plot_comparison(comparison, path: str, title: str) -> None:
     top.set_ylabel("model - DE421 [arcsec]")
     top.set_title(title)
     top.legend(fontsize="small")
-    for label, angles, style in (("DE421", comparison.angles_de421, "-"), ("model", comparison.angles_model, "--")):
-        longitude = np.unwrap(angles[:, 0]) + np.unwrap(angles[:, 2])
-        trend = np.polyval(np.polyfit(years, longitude, 1), years)
-        bottom.plot(years, (longitude - trend) * ARCSEC_PER_RAD, style, label=f"phi+psi - linear fit ({label})")
-        bottom.plot(years, (angles[:, 1] - np.mean(angles[:, 1])) * ARCSEC_PER_RAD, style,
-                    label=f"theta - mean ({label})")
-    bottom.set_ylabel("libration [arcsec]")
-    bottom.set_xlabel("years since J2000 (TDB)")
+    for label, librations, style in (("DE421", comparison.librations_de421, "-"),
+                                     ("model", comparison.librations_model, "--")):
+        for i, name in enumerate(("tau", "rho", "I sigma")):
+            bottom.plot(years, librations[:, i], style, color=f"C{i}", lw=0.8, label=f"{name} ({label})")
+    bottom.set_ylabel("physical libration [arcsec]")
+    bottom.set_xlabel(f"years since {_start_label(comparison.times[0])}")
     bottom.legend(fontsize="small")
     figure.savefig(path, format="png", dpi=120)
 
 
-def _checkpoint_schedule(args, span_days: float, step_days: float):
+def _start_label(day: float) -> str:
+    from spinorbit.time import time_from_tdb_days
+
+    return time_from_tdb_days(float(day)).tdb.iso[:10] + " TDB"
+
+
+def _checkpoint_schedule(args, span_days: float, step_days: float, start: float = 0.0):
     """The checkpoint schedule of ``--checkpoint``/``--resume`` and the settings a resume must match."""
     from spinorbit.runs.checkpoint import CheckpointSchedule
 
     settings = {"command": NAME, "model": args.model, "coupled": not args.one_way, "span_days": span_days,
                 "step_days": step_days}
+    if start != 0.0:  # runs from J2000 keep the settings (and checkpoints) they always had
+        settings["start_day"] = start
     if args.resume is not None and not os.path.isfile(args.resume):
         raise CommandError(f"--resume expects an existing checkpoint file; '{args.resume}' does not exist. "
                            "Give the --checkpoint file of the interrupted run.")
@@ -147,17 +153,25 @@ def _checkpoint_schedule(args, span_days: float, step_days: float):
 
 def run(args) -> int:
     """Run ``spinorbit moon``; return the exit status."""
-    from spinorbit.coupling.moon import compare_model_with_de421
+    from spinorbit.coupling.moon import (
+        EphemerisRangeError,
+        OutputStepError,
+        check_run,
+        compare_model_with_de421,
+        comparison_table,
+    )
 
     check_outputs(args)
     span = quantity("--span", args.span, "d", "time", "1 yr")
     step = quantity("--step", args.step, "d", "time", "1 d").to_value("d")
     span_days = span.to_value("d")
-    if not 0 < span_days <= MAX_SPAN_DAYS:
-        raise CommandError(f"--span expects a positive duration up to 50 yr, got {' '.join(args.span)}.")
-    if not 0 < step <= span_days:
-        raise CommandError(f"--step expects a positive spacing no longer than --span, got {' '.join(args.step)}.")
-    schedule, settings = _checkpoint_schedule(args, span_days, step)
+    start = start_day(args.start)
+    try:
+        check_run(args.model, start, span_days, step)
+    except (EphemerisRangeError, OutputStepError, ValueError) as error:
+        option = str(error).split(":", 1)[0]
+        raise CommandError(f"--{option} {str(error).split(':', 1)[1].strip()}") from None
+    schedule, settings = _checkpoint_schedule(args, span_days, step, start)
     if schedule is not None and args.model == "de421":
         raise CommandError("--checkpoint/--resume apply to the REBOUND-coupled models (--model rigid or "
                            "core-corrected); the de421 model runs at ≈ 0.1 s per simulated year and needs none.")
@@ -172,7 +186,7 @@ def run(args) -> int:
     try:
         comparison = compare_model_with_de421(args.model, span_days, step, coupled=not args.one_way,
                                               progress=advance, schedule=schedule, resume=args.resume,
-                                              settings=settings)
+                                              settings=settings, start_day=start)
     except KeyboardInterrupt:
         if schedule is not None and os.path.exists(schedule.path):
             print(f"{args._prog}: the last checkpoint is '{schedule.path}'; continue with the same options and "
@@ -189,7 +203,7 @@ def run(args) -> int:
         print(f"orbit sampling     {comparison.sampling_seconds:.2f} s (DE421 positions before the run)")
     print(f"final difference   {comparison.attitude_difference_arcsec[-1]:.5f} arcsec")
     if args.output is not None:
-        table = libration_table(comparison, args.model, args.model != "de421" and not args.one_way)
+        table = comparison_table(comparison, args.model, args.model != "de421" and not args.one_way)
         with atomic_output("--output", args.output) as temporary:
             table.write(temporary, format="ascii.ecsv", overwrite=True)
         print(f"wrote              {args.output} ({len(table)} rows)")

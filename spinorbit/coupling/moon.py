@@ -37,16 +37,18 @@ from spinorbit.core.integrators.quaternion import integrate_quaternion
 from spinorbit.core.model.lunar_interior import make_interior_block
 from spinorbit.core.model.perturbers import pack_perturbers
 from spinorbit.core.math.rotations import (
-    attitude_to_euler313,
     quat_to_attitude,
     quat_to_attitude_many,
 )
 from spinorbit.ephemeris import (
+    DE421_SPAN_JD_TDB,
+    EphemerisRangeError,
     de421_constants,
     earth_from_moon_au,
     moon_libration_angles_raw,
     moon_orientation_raw,
 )
+from spinorbit.lunar_librations import euler313_from_attitudes, physical_librations
 from spinorbit.time import J2000_JD_TDB, tdb_day_and_fraction, time_from_tdb_days
 from spinorbit.coupling.sampling import de421_orbit, sample_from_ephemeris, sample_relative_states
 from spinorbit.coupling.long_run import integrate_to_outputs
@@ -59,6 +61,11 @@ __all__ = [
     "MOON_MODELS",
     "RIGID_MODELS",
     "LibrationComparison",
+    "MIN_STEP_DAYS",
+    "OutputStepError",
+    "check_run",
+    "comparison_table",
+    "moon_librations",
     "compare_interior_with_de421",
     "compare_model_with_de421",
     "compare_with_de421",
@@ -79,6 +86,64 @@ DEFAULT_TOLERANCE = 1e-13
 #: Perturbers that see the lunar field's degrees 3–4 by default; for the Sun the degree-3 torque is
 #: (R_Moon/1 au) ~ 1e-5 of its degree-2 torque, for the planets less (measurements: docs/coupling.md).
 FULL_FIELD_PERTURBERS = ("Earth",)
+#: Margin kept from both ends of DE421's span (days): the "de421" model samples DE421's orbits one
+#: day beyond its run on each side (the tidal delay τ_M = 0.096 d looks back; the interpolation
+#: grids need a node past the end).
+RANGE_MARGIN_DAYS = 1.0
+#: Finest output spacing (one minute). Every output time stops REBOUND's BS (natural step ≈ 5 d on
+#: the rigid route); over a minute DE421's librations and the models' differences from them
+#: (≥ 1e-4″) change by < 1e-5″, so a finer spacing multiplies cost and rows and resolves nothing.
+MIN_STEP_DAYS = 1.0 / 1440.0
+
+
+class OutputStepError(ValueError):
+    """An output spacing the Moon models do not support (not positive, finer than a minute, or longer
+    than the span)."""
+
+
+def _iso_tdb(day: float) -> str:
+    return time_from_tdb_days(day).tdb.iso
+
+
+def check_run(model: str, start_day: float, span_days: float, step_days: float) -> None:
+    """Check a Moon run before any work; raise one specific error whose message says what to do.
+
+    Parameters
+    ----------
+    model : str
+        One of :data:`MOON_MODELS`.
+    start_day, span_days, step_days : float
+        Start (TDB days since J2000), span and output spacing (days).
+
+    Raises
+    ------
+    ValueError
+        Unknown model, or a span that is not a positive finite number of days.
+    EphemerisRangeError
+        A start outside DE421's span, or a run that ends past it (both ends are compared with DE421).
+    OutputStepError
+        A spacing that is not positive, finer than :data:`MIN_STEP_DAYS` or longer than the span.
+    """
+    if model not in MOON_MODELS:
+        raise ValueError(f"model: expected one of {MOON_MODELS}, got {model!r}.")
+    first = DE421_SPAN_JD_TDB[0] - J2000_JD_TDB + RANGE_MARGIN_DAYS
+    last = DE421_SPAN_JD_TDB[1] - J2000_JD_TDB - RANGE_MARGIN_DAYS
+    if not (np.isfinite(start_day) and first <= start_day <= last):
+        shown = _iso_tdb(start_day) if np.isfinite(start_day) else repr(start_day)
+        raise EphemerisRangeError(
+            f"start: expected a date between {_iso_tdb(first)} and {_iso_tdb(last)} TDB (DE421's span less "
+            f"{RANGE_MARGIN_DAYS:g} d at each end), got {shown}; choose a start inside it.")
+    if not (np.isfinite(span_days) and span_days > 0.0):
+        raise ValueError(f"span: expected a positive number of days, got {float(span_days)!r} d.")
+    if start_day + span_days > last:
+        raise EphemerisRangeError(
+            f"span: a run of {span_days:g} d from {_iso_tdb(start_day)} TDB ends at {_iso_tdb(start_day + span_days)}, "
+            f"past DE421's last usable date {_iso_tdb(last)} TDB; shorten the span to at most "
+            f"{last - start_day:.1f} d or start earlier.")
+    if not (np.isfinite(step_days) and MIN_STEP_DAYS * (1.0 - 1e-9) <= step_days <= span_days):
+        raise OutputStepError(
+            f"step: expected an output spacing from 1 min ({MIN_STEP_DAYS:.6g} d) up to the span "
+            f"({span_days:g} d), got {float(step_days)!r} d; the models resolve nothing finer than a minute.")
 
 
 def moon_figure(moon_mass: float, model: str = "rigid", degree: int = 4) -> np.ndarray:
@@ -124,7 +189,7 @@ def moon_figure(moon_mass: float, model: str = "rigid", degree: int = 4) -> np.n
 
 def moon_at_de421(epoch=None, model: str = "rigid", degree: int = 4, coupled: bool = True,
                   bodies=DEFAULT_BODIES, perturbers=None, tolerance: float = DEFAULT_TOLERANCE,
-                  full_field_perturbers=FULL_FIELD_PERTURBERS):
+                  full_field_perturbers=FULL_FIELD_PERTURBERS, spin_offset=None):
     """A DE421 simulation with the Moon's rotation attached (BS, EIH + Earth J2 on the orbits).
 
     Parameters
@@ -144,6 +209,9 @@ def moon_at_de421(epoch=None, model: str = "rigid", degree: int = 4, coupled: bo
     full_field_perturbers : sequence of str or None
         Perturbers that see degrees 3..``degree``; the others see degree 2 only. None: all see the
         full field.
+    spin_offset : array_like, shape (3,), optional
+        Added to DE421's mantle angular velocity (rad/day, mantle axes): a small kick that excites
+        the free modes (:mod:`spinorbit.coupling.lunar_free_modes`).
 
     Returns
     -------
@@ -157,6 +225,8 @@ def moon_at_de421(epoch=None, model: str = "rigid", degree: int = 4, coupled: bo
     quaternion, omega = moon_orientation_raw(day, fraction)
     moon = sim.particles["Moon"]
     figure = moon_figure(moon.m, model, degree)
+    if spin_offset is not None:
+        omega = omega + np.asarray(spin_offset, dtype=float)
     state = np.concatenate([quaternion, omega])
     if perturbers is None:
         perturbers = [p.name for p in sim.particles if p.name != "Moon"]
@@ -180,7 +250,11 @@ class LibrationComparison:
     body_difference_arcsec : ndarray, shape (n, 3)
         The same difference as a small rotation vector on the DE421 mantle axes (arcsec).
     angles_model, angles_de421 : ndarray, shape (n, 3)
-        3-1-3 libration angles (φ, θ, ψ), ICRF → mantle (rad; ψ unwrapped).
+        3-1-3 libration angles (φ, θ, ψ), ICRF → mantle (rad). DE421's as its series give them (ψ
+        grows by 2π a sidereal month); the model's on the same branch, each angle within π of
+        DE421's, so ``angles_model - angles_de421`` is the small difference.
+    librations_model, librations_de421 : ndarray, shape (n, 3)
+        Physical librations (τ, ρ, Iσ) in arcsec (:mod:`spinorbit.lunar_librations`).
     wall_seconds : float
         Wall time of the integration only.
     sampling_seconds : float
@@ -192,6 +266,8 @@ class LibrationComparison:
     body_difference_arcsec: np.ndarray
     angles_model: np.ndarray
     angles_de421: np.ndarray
+    librations_model: np.ndarray
+    librations_de421: np.ndarray
     wall_seconds: float
     sampling_seconds: float = 0.0
 
@@ -200,12 +276,10 @@ class LibrationComparison:
         return float(np.max(self.attitude_difference_arcsec))
 
 
-def _euler313_many(quaternions):
-    attitudes = quat_to_attitude_many(np.ascontiguousarray(quaternions))
-    angles = np.array([attitude_to_euler313(r) for r in attitudes])
-    angles[:, 2] = np.unwrap(angles[:, 2])
-    angles[:, 0] = np.unwrap(angles[:, 0])
-    return angles
+def _euler313_near(attitudes, reference_angles):
+    """3-1-3 angles of ``attitudes`` on the branch of ``reference_angles`` (each within π of it)."""
+    angles = euler313_from_attitudes(attitudes)
+    return reference_angles + np.remainder(angles - reference_angles + np.pi, 2.0 * np.pi) - np.pi
 
 
 def compare_with_de421(moon: CoupledRigidBody, span_days: float, step_days: float = 1.0,
@@ -251,12 +325,16 @@ def _comparison(times, quaternions, wall):
     angle = 2.0 * np.arctan2(np.linalg.norm(vec, axis=1), np.abs(w))
     body_vector = 2.0 * vec * np.sign(w)[:, None]
     angles_de421 = moon_libration_angles_raw(days, times - days)[0]
+    attitudes = quat_to_attitude_many(np.ascontiguousarray(quaternions))
+    attitudes_de421 = quat_to_attitude_many(np.ascontiguousarray(reference))
     return LibrationComparison(
         times=times,
         attitude_difference_arcsec=angle * ARCSEC_PER_RAD,
         body_difference_arcsec=body_vector * ARCSEC_PER_RAD,
-        angles_model=_euler313_many(quaternions),
+        angles_model=_euler313_near(attitudes, angles_de421),
         angles_de421=angles_de421,
+        librations_model=physical_librations(times, attitudes) * ARCSEC_PER_RAD,
+        librations_de421=physical_librations(times, attitudes_de421) * ARCSEC_PER_RAD,
         wall_seconds=wall,
     )
 
@@ -371,7 +449,7 @@ def core_angular_velocity(day: float) -> tuple:
 
 
 def compare_interior_with_de421(span_days: float, step_days: float = 1.0, start_day: float = 0.0,
-                                rtol: float = INTERIOR_RTOL, progress=None) -> LibrationComparison:
+                                rtol: float = INTERIOR_RTOL, progress=None, spin_offset=None) -> LibrationComparison:
     """Run DE421's lunar rotation model from ``start_day`` and compare with DE421's librations.
 
     The mantle starts from DE421's librations at ``start_day`` (its header values at JDEPOC), the core
@@ -388,6 +466,9 @@ def compare_interior_with_de421(span_days: float, step_days: float = 1.0, start_
         DOP853 local tolerance.
     progress : callable, optional
         Called once with the number of output times when done (the run is one compiled call).
+    spin_offset : array_like, shape (3,), optional
+        Added to the mantle's starting angular velocity (rad/day, mantle axes), as in
+        :func:`moon_at_de421`.
 
     Returns
     -------
@@ -396,6 +477,8 @@ def compare_interior_with_de421(span_days: float, step_days: float = 1.0, start_
     times = _output_times(float(start_day), span_days, step_days)
     whole = np.round(start_day)
     quaternion, omega = moon_orientation_raw(whole, start_day - whole)
+    if spin_offset is not None:
+        omega = omega + np.asarray(spin_offset, dtype=float)
     state = np.concatenate([quaternion, omega, core_angular_velocity(float(start_day))])
     begin = _time.perf_counter()
     model = interior_model(times[0], times[-1])
@@ -411,19 +494,140 @@ def compare_interior_with_de421(span_days: float, step_days: float = 1.0, start_
 
 
 def compare_model_with_de421(model: str, span_days: float, step_days: float = 1.0, coupled: bool = True,
-                             progress=None, schedule=None, resume=None, settings=None) -> LibrationComparison:
-    """Any of :data:`MOON_MODELS` from J2000 against DE421 (the CLI's and the example's entry point).
+                             progress=None, schedule=None, resume=None, settings=None,
+                             start_day: float = 0.0) -> LibrationComparison:
+    """Any of :data:`MOON_MODELS` from ``start_day`` against DE421 (the CLI's and the example's entry point).
 
-    ``coupled`` applies to the rigid models (REBOUND); "de421" is always driven by DE421's orbits.
-    ``schedule``, ``resume`` and ``settings`` (checkpoints, as in :func:`compare_with_de421`) apply to
-    the rigid models only: the "de421" model runs at ≈ 0.1 s per simulated year and has none.
+    The input is checked first (:func:`check_run`). "de421" starts from DE421's mantle at
+    ``start_day`` and the core carried there (:func:`core_angular_velocity`); the rigid models from
+    DE421's attitude and rates and the orbits at ``start_day``. ``coupled`` applies to the rigid
+    models (REBOUND); "de421" is always driven by DE421's orbits. ``schedule``, ``resume`` and
+    ``settings`` (checkpoints, as in :func:`compare_with_de421`) apply to the rigid models only: the
+    "de421" model runs at ≈ 0.1 s per simulated year and has none.
     """
-    if model not in MOON_MODELS:
-        raise ValueError(f"model: expected one of {MOON_MODELS}, got {model!r}.")
+    check_run(model, float(start_day), float(span_days), float(step_days))
     if model == "de421":
         if schedule is not None or resume is not None:
             raise ValueError("checkpoints apply to the REBOUND-coupled models ('rigid', 'core-corrected'); "
                              "the 'de421' model needs none: drop schedule/resume.")
-        return compare_interior_with_de421(span_days, step_days, progress=progress)
-    return compare_with_de421(moon_at_de421(model=model, coupled=coupled), span_days, step_days, progress=progress,
+        return compare_interior_with_de421(span_days, step_days, start_day=start_day, progress=progress)
+    moon = moon_at_de421(epoch=time_from_tdb_days(float(start_day)), model=model, coupled=coupled)
+    return compare_with_de421(moon, span_days, step_days, progress=progress,
                               schedule=schedule, resume=resume, settings=settings)
+
+
+#: One line per column of :func:`comparison_table` (also written to ``table.meta['columns']``).
+TABLE_COLUMNS = {
+    "time": "TDB epoch of the row",
+    "phi": "model's 3-1-3 angle phi, ICRF -> mantle, R = R3(psi) R1(theta) R3(phi) (rad)",
+    "theta": "model's 3-1-3 angle theta (rad)",
+    "psi": "model's 3-1-3 angle psi, on DE421's branch (within pi of psi_de421) (rad)",
+    "tau": "model's physical libration in longitude, phi + psi - pi - L, ecliptic of date (arcsec)",
+    "rho": "model's physical libration in latitude, theta - I (arcsec)",
+    "I_sigma": "model's physical libration in node, I (phi - Omega - pi) (arcsec)",
+    "attitude_difference": "rotation angle from DE421's mantle frame to the model's (arcsec)",
+    "difference_x": "that rotation as a small vector, component on DE421's mantle x axis (arcsec)",
+    "difference_y": "component on DE421's mantle y axis (arcsec)",
+    "difference_z": "component on DE421's mantle z axis (arcsec)",
+}
+_ANGLE_NAMES = ("phi", "theta", "psi")
+_LIBRATION_NAMES = ("tau", "rho", "I_sigma")
+
+
+def comparison_table(comparison: LibrationComparison, model: str, coupled: bool):
+    """The Moon table of a :class:`LibrationComparison` as an astropy ``QTable`` (the one output schema).
+
+    Columns: ``time`` (``Time``, TDB), the model's ``phi, theta, psi`` (rad) and ``tau, rho, I_sigma``
+    (arcsec), DE421's values of the same six suffixed ``_de421``, then ``attitude_difference`` and
+    ``difference_x/y/z`` (arcsec; :data:`TABLE_COLUMNS` says what each is). ``meta``: ``epoch``
+    (ISO, TDB), ``frame`` ("ICRF"), ``model``, ``coupled``, ``spinorbit_version``, ``reference``,
+    ``conventions``, ``columns``, ``wall_seconds``, ``sampling_seconds``.
+    """
+    import astropy.units as u
+    from astropy.table import QTable
+
+    from spinorbit import __version__
+
+    columns = dict(TABLE_COLUMNS)
+    for name in _ANGLE_NAMES + _LIBRATION_NAMES:
+        columns[f"{name}_de421"] = f"DE421's {name}" + (" (rad)" if name in _ANGLE_NAMES else " (arcsec)")
+    table = QTable(meta={
+        "epoch": _iso_tdb(float(comparison.times[0])),
+        "frame": "ICRF",
+        "model": f"spinorbit moon, model {model}",
+        "coupled": bool(coupled),
+        "spinorbit_version": __version__,
+        "reference": "DE421 lunar librations (de421 package via jplephem)",
+        "conventions": "docs/conventions.md: Euler angles; Physical librations",
+        "wall_seconds": float(comparison.wall_seconds),
+        "sampling_seconds": float(comparison.sampling_seconds),
+    })
+    table["time"] = time_from_tdb_days(comparison.times)
+    for suffix, angles, librations in (("", comparison.angles_model, comparison.librations_model),
+                                       ("_de421", comparison.angles_de421, comparison.librations_de421)):
+        for i, name in enumerate(_ANGLE_NAMES):
+            table[name + suffix] = np.asarray(angles[:, i]) * u.rad
+        for i, name in enumerate(_LIBRATION_NAMES):
+            table[name + suffix] = librations[:, i] * u.arcsec
+    table["attitude_difference"] = comparison.attitude_difference_arcsec * u.arcsec
+    for i, axis in enumerate("xyz"):
+        table[f"difference_{axis}"] = comparison.body_difference_arcsec[:, i] * u.arcsec
+    order = ["time"] + [n + s for s in ("", "_de421") for n in _ANGLE_NAMES + _LIBRATION_NAMES]
+    table = table[order + ["attitude_difference", "difference_x", "difference_y", "difference_z"]]
+    table.meta["columns"] = {name: columns[name] for name in table.colnames}
+    return table
+
+
+def _days_of(value, name: str, default_unit=None) -> float:
+    """A time span Quantity (or plain days) as float days; TypeError naming ``name`` otherwise."""
+    import astropy.units as u
+
+    if isinstance(value, u.Quantity):
+        if value.unit.physical_type != "time" or not value.isscalar:
+            raise TypeError(f"{name}: expected a scalar time Quantity such as 1 * u.yr, got {value!r}.")
+        return float(value.to_value(u.day))
+    if isinstance(value, (int, float, np.floating, np.integer)) and not isinstance(value, bool):
+        return float(value)
+    raise TypeError(f"{name}: expected a time Quantity (e.g. 20 * u.yr) or float days, got {type(value).__name__}.")
+
+
+def moon_librations(model: str = "de421", start=None, span=365.25, step=1.0, coupled: bool = True,
+                    progress=None):
+    """Run one Moon model from any date in DE421's span and return the Moon table (``QTable``).
+
+    Parameters
+    ----------
+    model : {"de421", "rigid", "core-corrected"}
+        See the module docstring.
+    start : astropy.time.Time, optional
+        First row (default J2000.0 TDB); any scale convertible to TDB.
+    span, step : Quantity or float
+        Length of the run and output spacing (time Quantities, or float days).
+    coupled : bool
+        Rigid models: fully coupled (default) or one-way.
+    progress : callable, optional
+        Called with the number of output times done.
+
+    Returns
+    -------
+    astropy.table.QTable
+        :func:`comparison_table`.
+
+    Raises
+    ------
+    TypeError
+        ``start`` not a ``Time``; ``span``/``step`` not time Quantities or numbers.
+    ValueError, EphemerisRangeError, OutputStepError
+        As :func:`check_run`, before any work.
+    """
+    if start is None:
+        start_day = 0.0
+    elif isinstance(start, Time) and start.isscalar:
+        day, fraction = tdb_day_and_fraction(start)
+        start_day = float(day) + float(fraction)
+    else:
+        raise TypeError(f"start: expected a scalar astropy Time, got {type(start).__name__} ({start!r}).")
+    span_days, step_days = _days_of(span, "span"), _days_of(step, "step")
+    comparison = compare_model_with_de421(model, span_days, step_days, coupled=coupled, progress=progress,
+                                          start_day=start_day)
+    return comparison_table(comparison, model, coupled and model != "de421")

@@ -53,8 +53,8 @@ from spinorbit.coupling.rebound import (
     DEFAULT_BODIES,
     body_index,
     install_extra_forces,
-    set_nongravitational,
     simulation_from_de421,
+    small_body_simulation,
 )
 from spinorbit.ephemeris import barycentric_state_au, de421_constants
 from spinorbit.frames import icrf_to_ecliptic_matrix
@@ -80,10 +80,15 @@ __all__ = [
     "closest_approach",
     "apophis_encounter_simulation",
     "apophis_rotation_state",
+    "APOPHIS_STATE_EPOCH",
     "toutatis_rotation_state",
     "sam_state_from_periods",
     "ecliptic_direction",
     "aligning_quaternion",
+    "OsculatingElements",
+    "TOUTATIS_ELEMENT_SETS",
+    "TOUTATIS_APPROACHES",
+    "toutatis_orbit",
 ]
 
 DEG = math.pi / 180.0
@@ -329,18 +334,13 @@ def published_orbit_simulation(state=APOPHIS_HORIZONS, time=None, bodies=DEFAULT
             "non_gravitational=True needs extra_forces=True (the terms live in the same compiled "
             "force); pass non_gravitational=False for a purely Newtonian run."
         )
-    sim = simulation_from_de421(state.epoch, bodies=bodies, integrator=integrator)
-    if extra_forces:
-        install_extra_forces(sim)
-    scale = IAU_AU_KM / de421_constants().au_km
-    position = np.asarray(state.position_au, float) * scale
-    velocity = np.asarray(state.velocity_au_day, float) * scale
-    sun = sim.particles[body_index(sim, "sun")]
-    sim.add(m=0.0, x=sun.x + position[0], y=sun.y + position[1], z=sun.z + position[2],
-            vx=sun.vx + velocity[0], vy=sun.vy + velocity[1], vz=sun.vz + velocity[2], name=state.name)
+    scale = IAU_AU_KM / de421_constants().au_km  # IAU 2012 au (Horizons) → DE421's au
+    terms = None
     if non_gravitational and state.non_gravitational:
-        a = {k: state.non_gravitational.get(k, 0.0) * scale for k in ("A1", "A2", "A3")}  # IAU au → DE421 au
-        set_nongravitational(sim, state.name, a["A1"], a["A2"], a["A3"])
+        terms = {k: v * scale for k, v in state.non_gravitational.items()}
+    sim = small_body_simulation(state.name, state.epoch, np.asarray(state.position_au, float) * scale,
+                                np.asarray(state.velocity_au_day, float) * scale, bodies=bodies,
+                                integrator=integrator, extra_forces=extra_forces, non_gravitational=terms)
     if time is not None:
         day, fraction = tdb_day_and_fraction(time)
         sim.integrate(day + fraction)
@@ -348,10 +348,11 @@ def published_orbit_simulation(state=APOPHIS_HORIZONS, time=None, bodies=DEFAULT
 
 
 def closest_approach(sim, body, near, window_days=1.0, target="earth"):
-    """Closest approach of ``body`` to ``target`` within ``near`` ± ``window_days`` (moves ``sim``).
+    """Closest approach of ``body`` to ``target`` within ``near`` ± ``window_days`` (``sim`` is not moved).
 
-    A 10-minute scan of the window, then Brent's method on the distance (IAS15 with
-    ``exact_finish_time`` runs back and forth; the simulation is left at the closest approach).
+    The smallest minimum of their distance found by :func:`spinorbit.coupling.approaches.approaches`
+    on a copy of the simulation (the root of the range rate, to 1e-9 d); the same finder as
+    :meth:`spinorbit.scene.Orbit.closest_approach`.
 
     Returns
     -------
@@ -361,26 +362,16 @@ def closest_approach(sim, body, near, window_days=1.0, target="earth"):
     speed_km_s : float
         Relative speed at closest approach.
     """
+    from spinorbit.coupling.approaches import approaches, rebound_separation
+
     au_km = de421_constants().au_km
-    i, j = body_index(sim, body), body_index(sim, target)
     day, fraction = tdb_day_and_fraction(near)
     centre = day + fraction
-
-    def distance(t):
-        sim.integrate(t)
-        a, b = sim.particles[i], sim.particles[j]
-        return math.dist((a.x, a.y, a.z), (b.x, b.y, b.z))
-
-    scan = centre + np.arange(-window_days, window_days + 1e-9, 1.0 / 144.0)
-    values = [distance(t) for t in scan]
-    k = int(np.argmin(values))
-    if k in (0, len(scan) - 1):
+    found = approaches(rebound_separation(sim, body, target), centre - window_days, centre + window_days)
+    if not found:
         raise ValueError(f"no closest approach of {body} to {target} inside ±{window_days} d of {near.tdb.iso}.")
-    result = minimize_scalar(distance, bracket=(scan[k - 1], scan[k], scan[k + 1]), tol=1e-12)
-    distance(result.x)
-    a, b = sim.particles[i], sim.particles[j]
-    speed = math.dist((a.vx, a.vy, a.vz), (b.vx, b.vy, b.vz))
-    return time_from_tdb_days(result.x), result.fun * au_km, speed * au_km / 86400.0
+    when, distance, speed = min(found, key=lambda minimum: minimum[1])
+    return time_from_tdb_days(when), distance * au_km, speed * au_km / 86400.0
 
 
 def apophis_encounter_simulation(orbit="published", extra_forces=None):
@@ -402,6 +393,84 @@ def apophis_encounter_simulation(orbit="published", extra_forces=None):
             install_extra_forces(sim)
         return sim
     raise ValueError(f"orbit must be 'published' or 'geometry', got {orbit!r}.")
+
+
+# ------------------------------------------------------------------------------------------------
+# Published osculating elements: orbits of their own (Orbit.from_elements).
+
+
+@dataclass(frozen=True)
+class OsculatingElements:
+    """Heliocentric osculating elements at an epoch, as published (a in au, angles in degrees).
+
+    ``frame`` is the frame name of :mod:`spinorbit.orbital_elements` the angles are referred to.
+    """
+
+    name: str
+    epoch: Time
+    a: float
+    e: float
+    inc: float
+    raan: float
+    argp: float
+    mean_anomaly: float
+    frame: str
+    source: str
+
+    def orbit(self, **options):
+        """:meth:`spinorbit.scene.Orbit.from_elements` of these elements (``options``: non_gravitational,
+        extra_forces)."""
+        from spinorbit.scene import Orbit
+
+        return Orbit.from_elements(self.a * u.au, self.e, self.inc * u.deg, self.raan * u.deg, self.argp * u.deg,
+                                   self.mean_anomaly * u.deg, self.epoch, frame=self.frame, name=self.name, **options)
+
+
+_TOUTATIS_SOURCE = ("JPL Small-Body Database osculating elements (ecliptic and equinox J2000) as quoted in public "
+                    "encyclopedia infoboxes, 4-5 digits (/work/shared/data/toutatis_orbit.json)")
+#: (4179) Toutatis: the two published element sets of the project's reference data
+#: (``../shared/data/toutatis_orbit.json``), keyed by the epoch's year. SBDB's ecliptic is JPL's
+#: (IAU 1976 obliquity): ``frame="ecliptic-jpl"``. The 2008 set, the nearer to 1992–2012, is the default.
+TOUTATIS_ELEMENT_SETS = {
+    "2008": OsculatingElements("Toutatis", Time(2454797.5, format="jd", scale="tdb"), 2.5321, 0.6288, 0.4460,
+                               124.30, 278.75, 5.1220, "ecliptic-jpl", _TOUTATIS_SOURCE + ", epoch 2008-11-27"),
+    "2016": OsculatingElements("Toutatis", Time(2457400.5, format="jd", scale="tdb"), 2.5344, 0.62938, 0.44712,
+                               124.37, 278.73, 281.88, "ecliptic-jpl", _TOUTATIS_SOURCE + ", epoch 2016-01-13"),
+}
+#: Toutatis' Earth approaches of the reference data: (date, distance au, published time of day or None,
+#: how it is known). The checks of ``tests/test_orbits.py`` say what is measured against each.
+TOUTATIS_APPROACHES = (
+    ("1992-12-08", 0.024, None, "widely quoted; recalled, not read from a table"),
+    ("2004-09-29", 0.0104, None, "public infobox text"),
+    ("2008-11-09", 0.0502, "12:23 UTC", "public infobox text"),
+    ("2012-12-12", 0.0463, "06:40 UTC", "'about 18 lunar distances', converted"),
+)
+
+
+def toutatis_orbit(orbit="elements", element_set="2008"):
+    """Toutatis' orbit for a Scene: the published elements (default) or the 2004-flyby geometry.
+
+    Parameters
+    ----------
+    orbit : {"elements", "geometry"}
+        "elements": :data:`TOUTATIS_ELEMENT_SETS` ``[element_set]`` integrated among DE421's planets
+        with EIH 1PN and Earth J2 (:meth:`spinorbit.scene.Orbit.from_elements`); it passes Earth in
+        1992, 1996, 2000, 2004, 2008 and 2012 where the published approaches are (docs/asteroids.md).
+        "geometry": the documented fallback, a hyperbola with the 2004 perigee imposed
+        (:func:`encounter_simulation`); it misses the 1992 and 1996 approaches, so it is kept only to
+        compare with the runs made on it before.
+    element_set : {"2008", "2016"}
+    """
+    from spinorbit.scene import Orbit
+
+    if orbit == "elements":
+        if element_set not in TOUTATIS_ELEMENT_SETS:
+            raise ValueError(f"element_set expects one of {tuple(TOUTATIS_ELEMENT_SETS)}; got {element_set!r}.")
+        return TOUTATIS_ELEMENT_SETS[element_set].orbit()
+    if orbit == "geometry":
+        return Orbit("rebound", "Toutatis", simulation=encounter_simulation(TOUTATIS_2004),
+                     description="documented 2004-flyby encounter geometry (0.01036 au imposed), DE421 planets")
+    raise ValueError(f"orbit expects 'elements' or 'geometry'; got {orbit!r}.")
 
 
 # ------------------------------------------------------------------------------------------------
@@ -470,16 +539,36 @@ APOPHIS_P_PHI = 27.38 * u.hour
 APOPHIS_MOMENTUM_ECLIPTIC_DEG = (250.0, -75.0)
 
 
-def apophis_rotation_state():
+#: Where the Apophis state is placed: 5 days before the 2029 perigee (APOPHIS_2029, TDB). The published
+#: periods and pole (2012-2013 photometry) do not fix the rotation phase 16 years later, so the state
+#: at this epoch is the constructed one moved along its free motion by ``phase`` × P_psi.
+APOPHIS_STATE_EPOCH = APOPHIS_2029.time_tdb - 5 * u.day
+
+
+def apophis_rotation_state(phase=0.0):
     """Apophis (Pravec et al. 2014) as a :class:`RotationState` with the attitude relative to ICRF.
 
     SAM with P_ψ = 263 h, P_φ = 27.38 h, moments 0.61 : 0.965 : 1; angular momentum towards ecliptic
     (λ, β) = (250°, −75°) — a retrograde spin (β < 0). E/E0 then follows from the moments and periods
-    (the examples print it against the published 1.024 ± 0.013). The rotation phase is not published
-    with these numbers: :func:`sam_state_from_periods` picks the smallest rotation.
+    (the examples print it against the published 1.024 ± 0.013). The state belongs to
+    :data:`APOPHIS_STATE_EPOCH` (5 d before the 2029 perigee).
+
+    Parameters
+    ----------
+    phase : float
+        The rotation phase, which the published solution leaves unknown at 2029, in [0, 1): the
+        state is :func:`sam_state_from_periods`' (the smallest rotation putting the momentum on its
+        direction) moved along its own free motion by ``phase`` × P_ψ. 0 (default) is that state
+        itself, the one the examples and docs quote as "phase as constructed".
     """
-    return sam_state_from_periods(APOPHIS_BODY, APOPHIS_P_PSI, APOPHIS_P_PHI,
-                                  ecliptic_direction(*APOPHIS_MOMENTUM_ECLIPTIC_DEG))
+    if not (isinstance(phase, (int, float)) and 0.0 <= phase < 1.0):
+        raise ValueError(f"phase expects a fraction of the rotation period P_psi in [0, 1); got {phase!r}.")
+    state = sam_state_from_periods(APOPHIS_BODY, APOPHIS_P_PSI, APOPHIS_P_PHI,
+                                   ecliptic_direction(*APOPHIS_MOMENTUM_ECLIPTIC_DEG))
+    if phase == 0.0:
+        return state
+    quaternions, omegas = state.propagate_torque_free(phase * APOPHIS_P_PSI)
+    return RotationState(APOPHIS_BODY, quaternions[0], omegas[0])
 
 
 #: Takahashi et al. (2013) Toutatis Euler angles (deg) and body angular velocity (deg/day, x, y, z).

@@ -5,7 +5,9 @@
 
 One module per concept:
 
-- :mod:`~spinorbit.scene.inputs` — :class:`Orbit`, :class:`FixedPerturber`, :class:`EphemerisPerturber`
+- :mod:`~spinorbit.scene.orbit` — :class:`Orbit`: where the body's orbit comes from (DE421, an
+  ephemeris, a REBOUND run, published elements or a state vector) and its close approaches;
+- :mod:`~spinorbit.scene.inputs` — :class:`FixedPerturber`, :class:`EphemerisPerturber`
   and the checks of a scene's arguments (:class:`SceneError`);
 - :mod:`~spinorbit.scene.plan` — :class:`Plan`, :class:`Decision`, :class:`PerturberEstimate` and
   their EXPLAIN-like text (:class:`PlanError`);
@@ -15,6 +17,7 @@ One module per concept:
 - :mod:`~spinorbit.scene.integrator_choice` — Taylor or DOP853 (or the canonical elements);
 - :mod:`~spinorbit.scene.sampling` — the perturbers sampled relative to the body, shared within a call;
 - :mod:`~spinorbit.scene.routes` — the runners of the torque-free, one-way and coupled routes;
+- :mod:`~spinorbit.scene.epochs` — output times before the epoch: the backward leg in mirrored time;
 - :mod:`~spinorbit.scene.many` — several bodies (:class:`ScenePlans`, :class:`SceneResults`);
 - :mod:`~spinorbit.scene.scene` — :class:`Scene` and :class:`SceneResult`.
 """
@@ -26,12 +29,14 @@ from spinorbit.scene.inputs import (
     Orbit,
     SceneError,
 )
+from spinorbit.scene.orbit import ApproachError
 from spinorbit.scene.many import ScenePlans, SceneResults
 from spinorbit.scene.plan import Decision, PerturberEstimate, Plan, PlanError
 from spinorbit.scene.scene import Scene, SceneResult
 
 __all__ = [
     "QUANTITIES",
+    "ApproachError",
     "Decision",
     "EphemerisPerturber",
     "FixedPerturber",

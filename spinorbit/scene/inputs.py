@@ -1,10 +1,11 @@
 """What a scene is given, checked: the orbit, the perturbers, the times, the tolerance and the options.
 
-:class:`Orbit` (where the body's orbit and its perturbers' positions come from),
 :class:`FixedPerturber` and :class:`EphemerisPerturber` (user point masses), and the checks
 :class:`~spinorbit.scene.Scene` runs on its arguments, each raising :class:`SceneError` with what was
 expected and what arrived. The body's mass in the orbit model and the figure's size are read here too
 (:func:`gm_in_orbit_model`, :func:`moments_per_mass`): the back-reaction bound needs them.
+:class:`Orbit` (where the body's orbit and its perturbers' positions come from) lives in
+:mod:`spinorbit.scene.orbit` and is re-exported here.
 """
 
 from __future__ import annotations
@@ -16,12 +17,13 @@ import numpy as np
 from astropy import units as u
 from astropy.time import Time
 
-from spinorbit.core.errors import SpinorbitError
+from spinorbit.scene.errors import SceneError
+from spinorbit.scene.orbit import Orbit
 from spinorbit.state import RotationState
 from spinorbit.time import tdb_days
 
-__all__ = ["INTEGRATORS", "MASS_MISMATCH", "QUANTITIES", "EphemerisPerturber", "FixedPerturber", "Orbit",
-           "SceneError", "as_angle", "check_gm", "gm_in_orbit_model", "moments_per_mass", "resolve_perturbers",
+__all__ = ["INTEGRATORS", "MASS_MISMATCH", "QUANTITIES", "EphemerisPerturber", "FixedPerturber",
+           "as_angle", "check_gm", "gm_in_orbit_model", "moments_per_mass", "resolve_perturbers",
            "tdb_day_array", "validate_options", "validate_perturbers", "validate_state", "validate_times"]
 
 #: Quantities a scene can ask for.
@@ -31,67 +33,6 @@ INTEGRATORS = ("auto", "quaternion", "elements", "taylor")
 #: Largest relative difference allowed between the body's mass (RigidBody.mass) and its mass in the
 #: orbit model (G is known to 2e-5 and DE421's GMs come with their own rounding).
 MASS_MISMATCH = 1e-2
-
-
-class SceneError(SpinorbitError, ValueError):
-    """A scene was described with inputs of the wrong kind or inconsistent with each other."""
-
-
-@dataclass(frozen=True)
-class Orbit:
-    """Where the rotating body's orbit (and its perturbers' positions) come from.
-
-    Build with :meth:`de421`, :meth:`ephemeris` or :meth:`rebound`.
-    """
-
-    kind: str
-    name: str
-    function: object = None
-    simulation: object = None
-
-    @classmethod
-    def de421(cls, name):
-        """A body DE421 carries (e.g. ``"moon"``); perturbers are DE421 bodies."""
-        from spinorbit.ephemeris import resolve_body
-
-        return cls("de421", resolve_body(name))
-
-    @classmethod
-    def ephemeris(cls, function, name="body"):
-        """A user ephemeris ``function(days) -> (positions (n, 3) au, velocities (n, 3) au/day)``,
-        barycentric ICRF at TDB days since J2000; perturbers are DE421 bodies."""
-        if not callable(function):
-            raise SceneError(f"Orbit.ephemeris expects a callable days -> (positions, velocities); got "
-                             f"{type(function).__name__}.")
-        return cls("ephemeris", str(name), function=function)
-
-    @classmethod
-    def circular(cls, radius, name="circular"):
-        """A synthetic user ephemeris: a circle of ``radius`` (length Quantity) about the barycentre in
-        the ICRF xy plane, at the Keplerian rate of DE421's GM_Sun, starting on +x at J2000. For
-        scenes whose geometry should be simple (tests, benchmarks, tutorials)."""
-        from spinorbit.ephemeris import de421_constants
-
-        if not isinstance(radius, u.Quantity) or radius.unit.physical_type != "length" or not radius.value > 0:
-            raise SceneError(f"Orbit.circular expects a positive length Quantity such as 2.5 * u.au; got {radius!r}.")
-        r = float(radius.to_value(u.au))
-        n = math.sqrt(de421_constants().gm["sun"] / r**3)
-
-        def orbit(days):
-            days = np.atleast_1d(np.asarray(days, dtype=float))
-            c, s, zero = np.cos(n * days), np.sin(n * days), np.zeros(days.shape)
-            return r * np.stack([c, s, zero], axis=1), r * n * np.stack([-s, c, zero], axis=1)
-
-        return cls("ephemeris", str(name), function=orbit)
-
-    @classmethod
-    def rebound(cls, simulation, particle):
-        """A particle of a REBOUND simulation (("AU", "day", "Msun") units, t in TDB days since J2000,
-        ICRF); perturbers are particles of the same simulation."""
-        from spinorbit.coupling.rebound import body_index
-
-        body_index(simulation, particle)  # MissingBodyError now, not after a survey
-        return cls("rebound", str(particle), simulation=simulation)
 
 
 def check_gm(kind, name, gm):
@@ -206,8 +147,9 @@ def tdb_day_array(time):
     return np.atleast_1d(np.asarray(whole, dtype=float) + np.asarray(rest, dtype=float))
 
 
-def validate_times(epoch, times):
-    """(epoch_day, output_days, end_only) of a scalar epoch and output times strictly increasing from it on."""
+def validate_times(epoch, times, either_side=False):
+    """(epoch_day, output_days, end_only) of a scalar epoch and output times strictly increasing after it
+    (or, with ``either_side``, on either side of it: :mod:`spinorbit.scene.epochs`)."""
     if not isinstance(epoch, Time) or not epoch.isscalar:
         raise SceneError(f"epoch expects a scalar astropy Time; got {epoch!r}.")
     if not isinstance(times, Time):
@@ -218,8 +160,10 @@ def validate_times(epoch, times):
     output_days = tdb_day_array(times)
     if not np.all(np.diff(output_days) > 0):
         raise SceneError("times expects strictly increasing output times.")
-    if not output_days[0] >= epoch_day:  # the epoch itself may be the first row (the output schema)
-        raise SceneError(f"times expects output times at or after the epoch; the first is "
+    if not np.all(np.isfinite(output_days)):
+        raise SceneError("times expects finite output times.")
+    if not either_side and not output_days[0] > epoch_day:
+        raise SceneError(f"times expects output times after the epoch; the first is "
                          f"{output_days[0] - epoch_day:+.6g} d from it. Give later times or an earlier epoch.")
     return epoch_day, output_days, end_only
 

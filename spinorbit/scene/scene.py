@@ -139,8 +139,10 @@ class Scene:
     epoch : astropy.time.Time
         Time of ``state`` (scalar).
     times : astropy.time.Time
-        Output times, strictly increasing, from ``epoch`` on (the epoch itself may be the first, so
-        that the table starts with the state); a scalar Time means "the end only".
+        Output times, strictly increasing; a scalar Time means "the end only". They may lie before
+        ``epoch`` or on both sides of it: the state belongs to its epoch, and the run goes from there
+        forwards and backwards (:mod:`spinorbit.scene.epochs`), so the state at a given time does not
+        depend on the span asked for.
     perturbers : sequence of str, FixedPerturber or EphemerisPerturber
         DE421 body names (``"sun"``, ``"earth"``, ``"jupiter"``…; particle names for a REBOUND orbit)
         and/or :class:`FixedPerturber` s and :class:`EphemerisPerturber` s. Empty: torque-free.
@@ -180,14 +182,26 @@ class Scene:
                 many.common_times(self.members))
             return
         self.state = inputs.validate_state(state)
-        self.epoch_day, self.output_days, self.end_only = inputs.validate_times(epoch, times)
+        self.epoch_day, self.output_days, self.end_only = inputs.validate_times(epoch, times, either_side=True)
         self.epoch, self.times = epoch, times
         self.tolerance_rad, self.quantities = inputs.validate_options(tolerance, quantities, integrator,
                                                                       sample_tolerance)
         self.integrator, self.sample_tolerance = integrator, sample_tolerance
         self.named, self.fixed, self.moving = inputs.validate_perturbers(perturbers, orbit)
         self.orbit = orbit
+        if orbit is not None:
+            orbit.check_span(self.epoch_day, self.output_days[0], self.output_days[-1])
         self.moments_per_mass = inputs.moments_per_mass(state.body, orbit)
+        self.backward = self.forward = None  # the two legs when times are not all after the epoch
+        self.in_legs = bool(self.output_days[0] <= self.epoch_day)
+        if self.in_legs:
+            from spinorbit.scene import epochs
+
+            def make(leg_state, leg_epoch, leg_times, leg_perturbers, leg_orbit):
+                return Scene(leg_state, leg_epoch, leg_times, leg_perturbers, leg_orbit, tolerance,
+                             tuple(dict.fromkeys(("omega", *self.quantities))), integrator, sample_tolerance)
+
+            epochs.split_legs(self, make, perturbers, orbit)
 
     @property
     def span_days(self):
@@ -270,7 +284,12 @@ class Scene:
         report(0.0)
         self._report_planning = report
         try:
-            plan = plan_scene(self, skip)
+            if self.in_legs:
+                from spinorbit.scene.epochs import plan_legs
+
+                plan = plan_legs(self, skip)
+            else:
+                plan = plan_scene(self, skip)
         finally:
             self._report_planning = None
         report(1.0)
@@ -306,6 +325,11 @@ class Scene:
             from spinorbit.scene.many import run_many
 
             return run_many(self.members, self.plan() if plan is None else plan, progress)
+        if self.in_legs:
+            from spinorbit.scene.epochs import run_legs
+            from spinorbit.scene.routes import result_table
+
+            return run_legs(self, plan, progress, SceneResult, result_table)
         clock = _time.perf_counter()
         plan = self.plan() if plan is None else plan
         if not isinstance(plan, Plan):

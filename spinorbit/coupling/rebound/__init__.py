@@ -11,6 +11,8 @@ checks it); the rest of spinorbit uses the names exported here. Each module hold
   force, installed as a raw C pointer;
 - :mod:`~spinorbit.coupling.rebound.rotation_hooks`: a rigid body's rotation integrated with the
   orbits (BS user ODE and back-reaction; the IAS15 pseudo-particle route);
+- :mod:`~spinorbit.coupling.rebound.small_body`: a massless small body among DE421's planets with
+  the force model of the Apophis orbit (EIH, Earth J2, its own non-gravitational terms);
 - :mod:`~spinorbit.coupling.rebound.snapshot`: copies of a simulation (binary, names, forces in effect);
 - :mod:`~spinorbit.coupling.rebound.interrupts`: Ctrl-C across many ``integrate`` calls.
 
@@ -41,6 +43,7 @@ from spinorbit.coupling.rebound.simulation import (
     perturber_positions,
     simulation_from_de421,
 )
+from spinorbit.coupling.rebound.small_body import CENTRES, small_body_simulation
 from spinorbit.coupling.rebound.snapshot import (
     SimulationSnapshot,
     extra_forces_in_effect,
@@ -71,4 +74,6 @@ __all__ = [
     "simulation_binary",
     "simulation_from_binary",
     "SimulationSnapshot",
+    "CENTRES",
+    "small_body_simulation",
 ]

@@ -10,10 +10,9 @@ catalogued asteroid), integrated in REBOUND among DE421's planets
 precess about the orbit's pole; over 10 years that turns the pole by a measurable angle while the
 obliquity (the angle between spin axis and orbit pole) and the sidereal period stay nearly fixed.
 
-The obliquity and the sidereal period are computed in this example from the result table: the
-obliquity from the angular-momentum direction and the heliocentric r × v of the orbit
-(:meth:`~spinorbit.scene.Orbit.relative_state`), the period as 2π/|ω|. (They become properties of
-:class:`~spinorbit.RotationState` and result columns with the output-schema work of the same issue.)
+The obliquity (to the osculating heliocentric orbit plane), the pole in ecliptic J2000 and the
+sidereal period are columns of the result table (docs/conventions.md, "Output tables") and
+properties of :class:`~spinorbit.RotationState`.
 
 Runs offline in well under a minute.
 """
@@ -34,7 +33,6 @@ from astropy.time import Time
 
 from spinorbit import RigidBody, RotationState
 from spinorbit.data.asteroids import aligning_quaternion, ecliptic_direction
-from spinorbit.frames import icrf_to_ecliptic_matrix
 from spinorbit.scene import Orbit, Scene
 
 epoch = Time("2020-01-01T00:00:00", scale="tdb")

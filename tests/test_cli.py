@@ -367,7 +367,7 @@ def test_asteroid_from_options_writes_ecsv_starting_at_the_spin_epoch(capsys, tm
     table = Table.read(path)
     assert len(table) == 10 and table.meta["tolerance_met"]
     start = Time("2020-01-01", scale="tdb")
-    assert abs((Time(table["time"][0]) - start).to_value(u.day) - 0.5) < 1e-6
+    assert abs((Time(table["time"][0]) - start).to_value(u.day)) < 1e-6  # the first row is the start (the schema)
     assert abs((Time(table["time"][-1]) - start).to_value(u.day) - 5.0) < 1e-6
 
 

@@ -21,6 +21,7 @@ Runs offline in about ten seconds.
 # %%
 # The stated phase and the orbit
 # ------------------------------
+
 # sphinx_gallery_start_ignore
 import sys
 from pathlib import Path

@@ -20,6 +20,7 @@ Runs offline in well under a minute.
 # %%
 # The body, its spin state and its orbit
 # --------------------------------------
+
 # sphinx_gallery_start_ignore
 import sys
 from pathlib import Path

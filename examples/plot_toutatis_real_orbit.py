@@ -18,6 +18,7 @@ Runs offline in about half a minute.
 # %%
 # The orbit from published elements
 # ----------------------------------
+
 # sphinx_gallery_start_ignore
 import sys
 from pathlib import Path

@@ -83,3 +83,15 @@ def test_heliocentric_normals_from_samples_match_de421_states():
     angle = np.degrees(np.arccos(np.clip(np.sum(normals * direct, axis=1), -1, 1)))
     assert angle.max() < 1e-5
     assert angle[0] < 1e-9
+
+
+def test_heliocentric_normals_refuse_times_outside_the_samples():
+    from spinorbit.coupling.one_way import heliocentric_normals
+    from spinorbit.coupling.sampling import de421_orbit, sample_from_ephemeris
+    from spinorbit.time import tdb_days
+
+    start = Time("2010-01-01", scale="tdb")
+    samples = sample_from_ephemeris(de421_orbit("moon"), start, start + 10 * u.day, perturbers=("sun",), tolerance=1e-8)
+    day = float(sum(tdb_days(start)))
+    with pytest.raises(ValueError, match="sample the whole span"):
+        heliocentric_normals(samples, [day - 1.0, day + 1.0])  # np.interp would have clamped silently

@@ -58,10 +58,14 @@ def heliocentric_normals(samples, days):
     """
     if "sun" not in samples.names:  # also scene.sampling.NoSamples, which has no perturbers
         return None
+    days = np.atleast_1d(np.asarray(days, dtype=float))
+    slack = 1e-9 * max(1.0, abs(float(samples.days[-1])))  # TDB days from Times: rounding at the ends
+    if days.min() < samples.days[0] - slack or days.max() > samples.days[-1] + slack:
+        raise ValueError(f"orbit normals asked for TDB days [{days.min():.6f}, {days.max():.6f}] since J2000 but the Sun "
+                         f"is sampled on [{samples.days[0]:.6f}, {samples.days[-1]:.6f}]; sample the whole span.")
     sun = samples.states[:, samples.names.index("sun")]
     knots = np.cross(sun[:, :3], sun[:, 3:])
     knots /= np.linalg.norm(knots, axis=1, keepdims=True)
-    days = np.atleast_1d(np.asarray(days, dtype=float))
     normals = np.stack([np.interp(days, samples.days, knots[:, k]) for k in range(3)], axis=1)
     return normals / np.linalg.norm(normals, axis=1, keepdims=True)
 

@@ -56,14 +56,23 @@ def scene_orbit_normals(scene, plan):
     """
     from spinorbit.coupling.one_way import heliocentric_normals
 
+    from spinorbit.scene.sampling import sample_perturbers
+
     if scene.orbit is None:
         return None, "the scene has no orbit"
-    source = plan.orbit_source if plan.orbit_source not in ("none",) else scene.orbit.kind
+    # the plan's orbit source when it names one ("de421" for a DE421 body given as a REBOUND particle),
+    # else the orbit's own kind
+    source = plan.orbit_source if plan.orbit_source in ("de421", "ephemeris", "rebound") else scene.orbit.kind
+    start = min(scene.epoch_day, float(scene.output_days[0]))
     try:
-        samples = scene.sample_perturbers(source, ("sun",), scene.sample_tolerance)
+        if start == scene.epoch_day:  # the span the run sampled: reuse its samples
+            samples = scene.sample_perturbers(source, ("sun",), scene.sample_tolerance)
+        else:  # output times before the epoch: the Sun over all of them
+            samples = sample_perturbers(scene.orbit, scene.moving, start, float(scene.output_days[-1]), source,
+                                        ("sun",), scene.sample_tolerance)
+        return heliocentric_normals(samples, scene.output_days), None
     except (LookupError, ValueError) as error:  # no "sun" particle (MissingBodyError), outside DE421, …
         return None, f"the Sun could not be sampled on the scene's orbit ({type(error).__name__}: {error})"
-    return heliocentric_normals(samples, scene.output_days), None
 
 
 def run_torque_free(scene, plan):

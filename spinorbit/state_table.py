@@ -105,13 +105,14 @@ def pole_directions(body, quaternions, omegas):
 
 
 def quaternion_array(table):
-    """The (N, 4) scalar-first quaternions of a result table's ``q_w, q_x, q_y, q_z`` columns."""
-    return np.stack([np.asarray(table[name], dtype=float) for name in QUATERNION_COLUMNS], axis=1)
+    """The (N, 4) scalar-first quaternions of a result table's ``q_w, q_x, q_y, q_z`` columns ((1, 4) of a row)."""
+    return np.stack([np.atleast_1d(np.asarray(table[name], dtype=float)) for name in QUATERNION_COLUMNS], axis=1)
 
 
 def omega_array(table):
-    """The (N, 3) body angular velocities (rad/day) of a result table's ``omega_x, omega_y, omega_z`` columns."""
-    return np.stack([u.Quantity(table[name]).to_value(u.rad / u.day) for name in OMEGA_COLUMNS], axis=1)
+    """The (N, 3) body angular velocities (rad/day) of a result table's ``omega_x, omega_y, omega_z`` columns
+    ((1, 3) of a row)."""
+    return np.stack([np.atleast_1d(u.Quantity(table[name]).to_value(u.rad / u.day)) for name in OMEGA_COLUMNS], axis=1)
 
 
 def table_columns(body, quaternions, omegas, omega=True, motion=None, orbit_normals=None):

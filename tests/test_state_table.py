@@ -149,6 +149,8 @@ def test_one_way_table_rows_are_their_rotation_states_and_osculate():
     table = propagate_one_way(state, epoch, times, NoSamples(start, start + 2.0),
                               extra_sources=[fixed_source(1e-3, [0.01, 0.004, 0.002])])
     rows = [RotationState(state.body, q, w) for q, w in zip(quaternion_array(table), omega_array(table))]
+    assert np.array_equal(quaternion_array(table[3]), quaternion_array(table)[3:4])  # a Row gives its (1, 4)
+    assert np.array_equal(omega_array(table[3]), omega_array(table)[3:4])
     assert np.abs(quaternion_array(table) - [s.quaternion for s in rows]).max() <= EPS  # re-normalisation: ≤ 1 ulp
     assert np.abs(table["pole_dec"].to_value(u.deg) - [s.pole_icrf[1].to_value(u.deg) for s in rows]).max() <= POLE_ATOL_DEG
     # the first row is the first time asked (through TDB day floats: ~1e-11 d, so 10 µs)

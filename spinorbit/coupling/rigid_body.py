@@ -232,6 +232,14 @@ class CoupledRigidBody:
         """
         arrays, meta = checkpoint.arrays, checkpoint.meta
         version = meta.get("content_version", 1)
+        if version == CONTENT_VERSION:  # a checksummed file may still have been edited by hand: its schema
+            where = "<coupled-body checkpoint>"
+            for name, dtype, shape in (("simulation", np.uint8, (None,)), ("rotation_state", np.float64, (7,)),
+                                       ("figure", np.float64, (None,)), ("perturber_degrees", np.int64, (None,)),
+                                       ("extra_forces", np.float64, (None,))):
+                checkpoint.array(where, name, dtype, shape)
+            for name, kind in (("body", str), ("perturbers", list), ("coupled", bool), ("particle_names", list)):
+                checkpoint.setting(where, name, kind)
         if version != CONTENT_VERSION:
             why = ("it records only the earth_j2/gr arguments of the constructor, not the forces installed "
                    "with install_extra_forces/set_nongravitational before the body was attached, so a resume "

@@ -178,7 +178,7 @@ CATALOGUE += [
     ("checkpoint missing", lambda: Checkpoint.read("/nonexistent/run.ckpt"), CheckpointError, "No such file"),
     ("checkpoint is a directory", lambda: Checkpoint.read(tempfile.gettempdir()), CheckpointError, "cannot read checkpoint"),
     ("checkpoint truncated", lambda: read_checkpoint_bytes(GOOD_CHECKPOINT[:-3]), CheckpointError, "promises 40 payload bytes, the file holds 37"),
-    ("checkpoint bit flip", lambda: read_checkpoint_bytes(GOOD_CHECKPOINT[:-1] + b"\x01"), CheckpointError, "SHA-256"),
+    ("checkpoint bit flip", lambda: read_checkpoint_bytes(GOOD_CHECKPOINT[:-73] + b"\x01" + GOOD_CHECKPOINT[-72:]), CheckpointError, "SHA-256"),
     ("checkpoint is an npz", lambda: read_checkpoint_bytes(b"PK\x03\x04 zip data"), CheckpointError, "not a spinorbit checkpoint"),
     ("restore a truncated save", lambda: read_checkpoint_bytes(GOOD_CHECKPOINT[:-3], CoupledRigidBody.restore), RestoreError, "truncated"),
     ("resume a checkpoint of another kind", lambda: read_checkpoint_bytes(GOOD_CHECKPOINT, lambda p: integrate_to_outputs(None, [1.0], None, 4, resume=p)), CheckpointError, "'coupled-rigid-body' run; this run needs a 'coupled-run'"),

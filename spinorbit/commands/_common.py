@@ -51,24 +51,83 @@ def unit(option: str, text: str, physical_type: str, example: str):
     return result
 
 
-def check_output_path(option: str, path: str) -> None:
-    """Fail before a long run, not after it, if ``path`` cannot be written."""
+#: What ``--output`` writes, by the file's extension (astropy's format names); anything else is refused.
+TABLE_FORMATS = {".ecsv": "ascii.ecsv", ".csv": "ascii.csv"}
+#: What ``--plot`` writes, by the file's extension (matplotlib's format names); anything else is refused.
+PLOT_FORMATS = {".png": "png", ".pdf": "pdf", ".svg": "svg"}
+#: The options that name files a command writes, and the formats each accepts (None: any name).
+OUTPUT_OPTIONS = {"--output": TABLE_FORMATS, "--plot": PLOT_FORMATS, "--checkpoint": None}
+
+
+def _format_of(option: str, path: str, formats: dict) -> str:
+    suffix = os.path.splitext(path)[1].lower()
+    if suffix not in formats:
+        raise CommandError(
+            f"{option} writes {' or '.join(sorted(formats))} files, chosen by the extension; got '{path}'. "
+            f"Name the file e.g. {os.path.splitext(path)[0] or 'out'}{next(iter(formats))}."
+        )
+    return formats[suffix]
+
+
+def table_format(path: str) -> str:
+    """astropy's format for an ``--output`` file: ECSV for .ecsv, CSV for .csv (else CommandError)."""
+    return _format_of("--output", path, TABLE_FORMATS)
+
+
+def plot_format(path: str) -> str:
+    """matplotlib's format for a ``--plot`` file: png, pdf or svg from the extension (else CommandError)."""
+    return _format_of("--plot", path, PLOT_FORMATS)
+
+
+def check_output_path(option: str, path: str, formats: dict | None = None) -> None:
+    """Fail before a long run, not after it, if ``path`` cannot be written or would destroy something.
+
+    Refused: a directory, a symbolic link (the atomic rename would replace the link, not the file it
+    points to: give the target's own path), an existing file that is not a regular file (a device
+    such as /dev/null, a pipe, a socket), a missing or unwritable directory, and (with ``formats``)
+    an extension the option does not write.
+    """
+    from spinorbit.runs.atomic import refuse_unsafe_target
+
+    try:
+        refuse_unsafe_target(path)
+    except OSError as error:
+        raise CommandError(f"{option}: will not write '{path}': {error.strerror}.") from None
     directory = os.path.dirname(os.path.abspath(path))
-    if os.path.isdir(path):
-        raise CommandError(f"{option} expects a file name; '{path}' is a directory. Give a file path, e.g. {path}/out.")
     if not os.path.isdir(directory):
         raise CommandError(
             f"{option}: the directory '{directory}' does not exist; create it first or choose another path."
         )
     if not os.access(directory, os.W_OK):
         raise CommandError(f"{option}: the directory '{directory}' is not writable; choose another path.")
+    if formats is not None:
+        _format_of(option, path, formats)
+
+
+def check_output_paths(args) -> None:
+    """Every file option of ``args`` (--output, --plot, --checkpoint) can be written, and no two are one file.
+
+    ``--resume`` counts too: no output may overwrite the checkpoint a run resumes from (except
+    ``--checkpoint``, which continues it).
+    """
+    given = [(option, getattr(args, option[2:], None)) for option in OUTPUT_OPTIONS]
+    given = [(option, path) for option, path in given if path is not None]
+    for option, path in given:
+        check_output_path(option, path, OUTPUT_OPTIONS[option])
+    resume = getattr(args, "resume", None)
+    named = given + ([("--resume", resume)] if resume is not None else [])
+    seen = {}
+    for option, path in named:
+        key = os.path.realpath(path)
+        if key in seen and {seen[key], option} != {"--checkpoint", "--resume"}:
+            raise CommandError(f"{seen[key]} and {option} name the same file '{path}'; one would overwrite the "
+                               "other. Give each its own path.")
+        seen.setdefault(key, option)
 
 
 def check_outputs(args) -> None:
-    """Before a run: ``--output`` and ``--plot`` (when given) can be written, and ``--plot`` has matplotlib."""
-    for option, path in (("--output", args.output), ("--plot", args.plot)):
-        if path is not None:
-            check_output_path(option, path)
+    """Before a run: the output files can be written (:func:`check_output_paths`), and ``--plot`` has matplotlib."""
+    check_output_paths(args)
     if args.plot is not None:
         try:
             import matplotlib  # noqa: F401

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from spinorbit.cli import CommandError
-from spinorbit.commands._common import Progress, atomic_output, quantity
+from spinorbit.commands._common import Progress, atomic_output, plot_format, quantity, table_format
 
 #: Most output times a command accepts (each row builds a RotationState for the periods).
 MAX_TIMES = 100_000
@@ -29,8 +29,10 @@ def add_scene_arguments(parser: argparse.ArgumentParser, span_default: str, pert
     run.add_argument("--no-skip", action="store_true",
                      help="run the reference plan: every perturber, the orbits as given, nothing skipped")
     files = parser.add_argument_group("output files")
-    files.add_argument("--output", metavar="FILE.ecsv", help="write time, attitude, spin and periods as ECSV")
-    files.add_argument("--plot", metavar="FILE.png", help="plot the periods and E/E0 (needs matplotlib)")
+    files.add_argument("--output", metavar="FILE.ecsv",
+                       help="write time, attitude, spin and periods as ECSV (FILE.ecsv) or CSV (FILE.csv)")
+    files.add_argument("--plot", metavar="FILE.png",
+                       help="plot the periods and E/E0 (FILE.png, .pdf or .svg; needs matplotlib)")
 
 
 def span_and_times(args, start, max_days: float):
@@ -159,7 +161,7 @@ def write_outputs(args, result, name: str, title: str, period_unit: str) -> None
     if args.output is not None:
         table = ecsv_table(result, name, period_unit)
         with atomic_output("--output", args.output) as temporary:
-            table.write(temporary, format="ascii.ecsv", overwrite=True)
+            table.write(temporary, format=table_format(temporary), overwrite=True)
         print(f"wrote              {args.output} ({len(table)} rows)")
     if args.plot is not None:
         with atomic_output("--plot", args.plot) as temporary:
@@ -186,4 +188,4 @@ def plot(result, path: str, title: str, period_unit: str) -> None:
     axes[2].set_ylabel("E/E0")
     axes[2].set_xlabel(f"days from {table['time'][0].tdb.iso[:16]} TDB")
     axes[0].set_title(title)
-    figure.savefig(path, format="png", dpi=100)
+    figure.savefig(path, format=plot_format(path), dpi=100)

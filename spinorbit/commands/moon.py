@@ -8,7 +8,8 @@ import os
 import sys
 
 from spinorbit.cli import CommandError
-from spinorbit.commands._common import Progress, atomic_output, check_output_path, check_outputs, quantity
+from spinorbit.commands._common import (Progress, atomic_output, check_output_path, check_outputs, plot_format,
+                                        quantity, table_format)
 
 #: The models (spinorbit.coupling.moon.MOON_MODELS, repeated so that --help does not import REBOUND).
 MOON_MODELS = ("de421", "rigid", "core-corrected")
@@ -57,8 +58,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                      help="rigid models: do not let the lunar figure act back on the orbits "
                           "(default: fully coupled); the de421 model is always one-way")
     files = parser.add_argument_group("output files")
-    files.add_argument("--output", metavar="FILE.ecsv", help="write time, attitude difference and angles as ECSV")
-    files.add_argument("--plot", metavar="FILE.png", help="plot the difference and the libration (needs matplotlib)")
+    files.add_argument("--output", metavar="FILE.ecsv",
+                       help="write time, attitude difference and angles as ECSV (FILE.ecsv) or CSV (FILE.csv)")
+    files.add_argument("--plot", metavar="FILE.png",
+                       help="plot the difference and the libration (FILE.png, .pdf or .svg; needs matplotlib)")
     long_runs = parser.add_argument_group("long runs")
     long_runs.add_argument("--checkpoint", metavar="PATH",
                            help="write a checkpoint (orbits + rotation + results so far) to PATH during the run")
@@ -124,7 +127,7 @@ def plot_comparison(comparison, path: str, title: str) -> None:
     bottom.set_ylabel("libration [arcsec]")
     bottom.set_xlabel("years since J2000 (TDB)")
     bottom.legend(fontsize="small")
-    figure.savefig(path, format="png", dpi=120)
+    figure.savefig(path, format=plot_format(path), dpi=120)
 
 
 def _checkpoint_schedule(args, span_days: float, step_days: float):
@@ -191,7 +194,7 @@ def run(args) -> int:
     if args.output is not None:
         table = libration_table(comparison, args.model, args.model != "de421" and not args.one_way)
         with atomic_output("--output", args.output) as temporary:
-            table.write(temporary, format="ascii.ecsv", overwrite=True)
+            table.write(temporary, format=table_format(temporary), overwrite=True)
         print(f"wrote              {args.output} ({len(table)} rows)")
     if args.plot is not None:
         with atomic_output("--plot", args.plot) as temporary:

@@ -6,7 +6,8 @@ import argparse
 import math
 
 from spinorbit.cli import CommandError
-from spinorbit.commands._common import Progress, atomic_output, check_output_path, quantity, unit
+from spinorbit.commands._common import (Progress, atomic_output, check_output_paths, plot_format, quantity,
+                                        table_format, unit)
 
 NAME = "torque-free"
 SUMMARY = "exact torque-free rotation for given moments of inertia and spin"
@@ -87,8 +88,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     spacing.add_argument("--step", nargs="+", metavar="STEP", help="spacing of output times, e.g. '1 d' (default 1 d)")
     spacing.add_argument("--n-times", type=_count, metavar="N", help="number of evenly spaced output times instead")
     files = parser.add_argument_group("output files")
-    files.add_argument("--output", metavar="FILE.ecsv", help="write the table (time, quaternion, omega) as ECSV")
-    files.add_argument("--plot", metavar="FILE.png", help="plot quaternion and omega against time (needs matplotlib)")
+    files.add_argument("--output", metavar="FILE.ecsv",
+                       help="write the table (time, quaternion, omega) as ECSV (FILE.ecsv) or CSV (FILE.csv)")
+    files.add_argument("--plot", metavar="FILE.png",
+                       help="plot quaternion and omega against time (FILE.png, .pdf or .svg; needs matplotlib)")
 
 
 def _offsets(args):
@@ -219,7 +222,7 @@ def _plot(table, path):
     top.set_title(f"torque-free rotation: {table.meta['mode']} {table.meta['sense']}")
     for axes in (top, bottom):
         axes.legend(loc="upper right", fontsize="small")
-    figure.savefig(path, format="png", dpi=120)
+    figure.savefig(path, format=plot_format(path), dpi=120)
 
 
 def _require_matplotlib():
@@ -233,9 +236,7 @@ def _require_matplotlib():
 
 def run(args) -> int:
     """Run ``spinorbit torque-free``; return the exit status."""
-    for option, path in (("--output", args.output), ("--plot", args.plot)):
-        if path is not None:
-            check_output_path(option, path)
+    check_output_paths(args)
     if args.plot is not None:
         _require_matplotlib()
     offsets = _offsets(args)
@@ -247,7 +248,7 @@ def run(args) -> int:
     span = f"{offsets[-1]:g} d"
     if args.output is not None:
         with atomic_output("--output", args.output) as temporary:
-            table.write(temporary, format="ascii.ecsv", overwrite=True)
+            table.write(temporary, format=table_format(temporary), overwrite=True)
         print(f"wrote              {args.output} ({len(table)} rows over {span})")
     if args.plot is not None:
         with atomic_output("--plot", args.plot) as temporary:

@@ -14,6 +14,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from astropy import units as u
 
+from spinorbit.quantities import value_in
+
 __all__ = ["RigidBody", "InvalidBodyError"]
 
 # Relative slack for the triangle inequality A + B ≥ C: a flat plate has A + B = C exactly, and
@@ -28,10 +30,7 @@ class InvalidBodyError(ValueError):
 def _as_moments(moments) -> tuple[np.ndarray, u.Unit]:
     if isinstance(moments, u.Quantity):
         if moments.unit.physical_type not in ("moment of inertia", "dimensionless"):
-            raise u.UnitTypeError(
-                f"moments of inertia need a unit like kg m² (or none, for ratios); got {moments.unit!s}. "
-                "Convert them, e.g. moments.to(u.kg * u.m**2)."
-            )
+            value_in("moments", moments, u.kg * u.m**2, "[1, 2, 2.5] kg m² (or plain ratios)")  # raises, naming both
         values, unit = np.asarray(moments.value, dtype=float), moments.unit
     else:
         try:
@@ -116,12 +115,16 @@ class RigidBody:
                 f"({float(big_a)!r} + {float(big_b)!r} < {float(big_c)!r}); no mass distribution has them. Check the "
                 "values and their axes, or pass physical=False for a mathematical test problem."
             )
-        if self.mass is not None and (not isinstance(self.mass, u.Quantity) or self.mass.unit.physical_type != "mass"):
-            raise u.UnitTypeError(f"mass must be a Quantity in a mass unit (e.g. 6e10 * u.kg); got {self.mass!r}.")
-        if self.radius is not None and (
-            not isinstance(self.radius, u.Quantity) or self.radius.unit.physical_type != "length"
-        ):
-            raise u.UnitTypeError(f"radius must be a Quantity in a length unit (e.g. 0.2 * u.km); got {self.radius!r}.")
+        for name, value, expected_unit, example in (("mass", self.mass, u.kg, "6e10 * u.kg"),
+                                                    ("radius", self.radius, u.km, "0.2 * u.km")):
+            if value is None:
+                continue
+            try:
+                magnitude = value_in(name, value, expected_unit, example, shape=())
+            except ValueError as error:  # NaN, inf or an array
+                raise InvalidBodyError(str(error)) from None
+            if not magnitude > 0:
+                raise InvalidBodyError(f"{name} must be positive, such as {example}; got {value!s}.")
         values = values.copy()  # the body's own: np.asarray may have returned the caller's array
         to_principal = _principal_permutation(values)
         values.flags.writeable = False  # shared with the states built on this body: never changed

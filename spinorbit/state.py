@@ -14,6 +14,7 @@ import numpy as np
 from astropy import units as u
 
 from spinorbit.body import RigidBody
+from spinorbit.quantities import value_in
 from spinorbit.core.elements import andoyer as _andoyer
 from spinorbit.core.elements import canonical as _canonical
 from spinorbit.core.free_motion import summary as _summary
@@ -101,17 +102,10 @@ def _as_rotation_matrix(matrix) -> np.ndarray:
     return m
 
 
-def _as_angular_velocity(omega) -> np.ndarray:
-    if isinstance(omega, u.Quantity):
-        try:
-            values = omega.to_value(RAD_PER_DAY, equivalencies=u.dimensionless_angles())
-        except u.UnitConversionError:
-            raise u.UnitTypeError(
-                f"angular velocity needs an angle per time unit (rad/s, deg/day); got {omega.unit!s}."
-            ) from None
-    else:
-        values = omega
-    values = np.asarray(values, dtype=float)
+def _as_angular_velocity(omega, name="angular_velocity") -> np.ndarray:
+    # a Quantity of an angle per time (frequencies refused: docs/conventions.md, "Units"); floats are rad/day
+    values = np.asarray(value_in(name, omega, RAD_PER_DAY, "[0.1, 0, 0.3] * u.rad / u.s", plain_unit=RAD_PER_DAY,
+                                 finite=False), dtype=float)
     if values.shape != (3,):
         raise InvalidStateError(f"the angular velocity is a 3-vector in body axes; got shape {values.shape}.")
     if not np.all(np.isfinite(values)):
@@ -173,16 +167,18 @@ class RotationState:
     @classmethod
     def from_euler313(cls, body, phi, theta, psi, angular_velocity):
         """From passive 3-1-3 Euler angles (Quantities or radians): R = R3(ψ) R1(θ) R3(φ)."""
-        angles = [a.to_value(u.rad) if isinstance(a, u.Quantity) else float(a) for a in (phi, theta, psi)]
+        angles = [value_in(name, a, u.rad, "30 * u.deg", plain_unit=u.rad, shape=(), finite=False)
+                  for name, a in (("phi", phi), ("theta", theta), ("psi", psi))]
+        if not all(math.isfinite(a) for a in angles):
+            raise InvalidStateError(f"Euler angles must be finite; got phi, theta, psi = {angles}.")
         return cls.from_matrix(body, _rotations.euler313_to_attitude(*angles), angular_velocity)
 
     @classmethod
     def from_angular_momentum(cls, body, quaternion, angular_momentum):
         """From the body angular momentum (user axes) instead of the angular velocity: ω = I⁻¹ M."""
-        if isinstance(angular_momentum, u.Quantity):
-            values = angular_momentum.to_value(body.moment_unit * RAD_PER_DAY, equivalencies=u.dimensionless_angles())
-        else:
-            values = np.asarray(angular_momentum, dtype=float)
+        values = value_in("angular_momentum", angular_momentum, body.moment_unit * RAD_PER_DAY,
+                          f"[0.1, 0, 0.3] * {body.moment_unit * RAD_PER_DAY!r}", plain_unit=body.moment_unit * RAD_PER_DAY,
+                          finite=False)
         return cls(body, quaternion, np.asarray(values, dtype=float) / body.moment_values)
 
     # -- what users read -----------------------------------------------------------------------
@@ -393,7 +389,7 @@ class RotationState:
         angular_velocity : Quantity, shape (N, 3)
             Body angular velocity in user axes (rad/day).
         """
-        times = dt.to_value(u.day) if isinstance(dt, u.Quantity) else np.asarray(dt, dtype=float)
+        times = value_in("dt", dt, u.day, "[0, 1, 2] * u.day", plain_unit=u.day, finite=False)
         times = np.atleast_1d(np.asarray(times, dtype=float))
         if times.ndim != 1 or not np.all(np.isfinite(times)):
             raise ValueError("dt must be a finite scalar or 1-D array of time offsets.")

@@ -18,37 +18,32 @@ PROGRESS_REDRAW_S = 0.2
 def quantity(option: str, words, default_unit: str, physical_type: str, example: str):
     """Read ``--span 100 d`` / ``--span "100 d"`` / ``--span 100`` (default unit) as a Quantity.
 
-    Raises :class:`~spinorbit.cli.CommandError` naming the option, the expected kind of quantity and
-    what arrived.
+    The checks are :func:`spinorbit.quantities.parse_quantity`'s, the API's own: one finite number
+    and a unit of ``physical_type`` (that of ``default_unit``). Raises
+    :class:`~spinorbit.cli.CommandError` naming the option, the expected kind of quantity and what
+    arrived.
     """
-    import astropy.units as u
+    from spinorbit.quantities import QuantityInputError, parse_quantity
 
-    text = " ".join(words) if isinstance(words, (list, tuple)) else str(words)
     try:
-        value = u.Quantity(text)
-    except (TypeError, ValueError):
-        value = None
-    if value is not None and value.unit == u.dimensionless_unscaled:
-        value = value.value * u.Unit(default_unit)
-    if value is None or value.isscalar is False or value.unit.physical_type != physical_type:
-        raise CommandError(
-            f"{option} expects a {physical_type} such as '{example}' (a number alone means {default_unit}); "
-            f"got '{text}'."
-        )
-    return value
+        return parse_quantity(option, words, default_unit, example)
+    except QuantityInputError as error:
+        raise CommandError(str(error)) from None
 
 
 def unit(option: str, text: str, physical_type: str, example: str):
-    """An astropy unit of the given physical type, or a :class:`~spinorbit.cli.CommandError`."""
-    import astropy.units as u
+    """An astropy unit of the given physical type, or a :class:`~spinorbit.cli.CommandError`.
 
+    ``physical_type`` is "angular velocity", "time" or "angle"; a frequency given for an angular
+    velocity gets the advice of :mod:`spinorbit.quantities` (write ``cycle/d``).
+    """
+    from spinorbit.quantities import QuantityInputError, parse_unit
+
+    reference = {"angular velocity": "rad/d", "time": "d", "angle": "rad"}[physical_type]
     try:
-        result = u.Unit(text)
-    except (TypeError, ValueError):
-        result = None
-    if result is None or result.physical_type != physical_type:
-        raise CommandError(f"{option} expects a unit of {physical_type} such as {example}; got '{text}'.")
-    return result
+        return parse_unit(option, text, reference, example)
+    except QuantityInputError as error:
+        raise CommandError(str(error)) from None
 
 
 #: What ``--output`` writes, by the file's extension (astropy's format names); anything else is refused.

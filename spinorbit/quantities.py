@@ -50,7 +50,7 @@ def _arrived(value) -> str:
 def _frequency_advice(name: str, value, unit: u.UnitBase) -> str:
     time_unit = (u.rad / unit).to_string()  # the time unit of the expected rate: d for rad / d
     return (
-        f"{name}: got {value!s}, a frequency, where a rotation rate (an angle per time) is needed. A frequency "
+        f"{name}: got {value!s}, a frequency, where an angular velocity (an angle per time, {unit}) is needed. A frequency "
         "is ambiguous for a rotation (1 Hz = 1 rad/s by astropy's dimensionless conversion, but one turn per second is "
         f"2π rad/s), so spinorbit refuses it. Write turns per time with u.cycle (e.g. cycle / {time_unit}, converted "
         f"with 2π) or an angle per time (rad / {time_unit}, deg / {time_unit})."

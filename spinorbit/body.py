@@ -14,17 +14,22 @@ from dataclasses import dataclass, field
 import numpy as np
 from astropy import units as u
 
+from spinorbit.core.errors import NonFiniteError, SpinorbitError
 from spinorbit.quantities import value_in
 
-__all__ = ["RigidBody", "InvalidBodyError"]
+__all__ = ["RigidBody", "InvalidBodyError", "NonFiniteBodyError"]
 
 # Relative slack for the triangle inequality A + B ≥ C: a flat plate has A + B = C exactly, and
 # moments computed from a shape model carry rounding of a few ulp.
 TRIANGLE_SLACK = 1e-12
 
 
-class InvalidBodyError(ValueError):
-    """The moments of inertia cannot belong to a rigid body."""
+class InvalidBodyError(SpinorbitError, ValueError):
+    """The moments of inertia, mass or radius cannot belong to a rigid body."""
+
+
+class NonFiniteBodyError(InvalidBodyError, NonFiniteError):
+    """NaN or ±inf in the moments, the mass or the radius."""
 
 
 def _as_moments(moments) -> tuple[np.ndarray, u.Unit]:
@@ -42,7 +47,7 @@ def _as_moments(moments) -> tuple[np.ndarray, u.Unit]:
             f"a rigid body needs exactly three principal moments (about its x, y, z axes); got shape {values.shape}."
         )
     if not np.all(np.isfinite(values)):
-        raise InvalidBodyError(f"principal moments must be finite; got {values.tolist()}.")
+        raise NonFiniteBodyError(f"principal moments must be finite; got {values.tolist()}.")
     if np.any(values <= 0):
         raise InvalidBodyError(
             f"principal moments must be positive; got {values.tolist()}. A moment of inertia is a sum of m r² ≥ 0, "
@@ -122,7 +127,7 @@ class RigidBody:
             try:
                 magnitude = value_in(name, value, expected_unit, example, shape=())
             except ValueError as error:  # NaN, inf or an array
-                raise InvalidBodyError(str(error)) from None
+                raise (NonFiniteBodyError if "finite" in str(error) else InvalidBodyError)(str(error)) from None
             if not magnitude > 0:
                 raise InvalidBodyError(f"{name} must be positive, such as {example}; got {value!s}.")
         values = values.copy()  # the body's own: np.asarray may have returned the caller's array

@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 
+from spinorbit.core.errors import require_finite
+
 from spinorbit.core.dynamics.equations import MODEL_PERTURBERS, STATE_SIZE
 from spinorbit.core.model.perturbers import sampled_span
 
@@ -28,6 +30,8 @@ def validate_output_times(t0, t_out):
     t_out = np.atleast_1d(np.asarray(t_out, dtype=float))
     if t_out.ndim != 1 or t_out.size == 0:
         raise ValueError(f"t_out: expected a non-empty 1-d array of output times, got shape {t_out.shape}.")
+    require_finite("t0", float(t0), "a finite start time")
+    require_finite("t_out", t_out, "finite output times")
     if not (np.isfinite(t0) and np.all(np.isfinite(t_out))):
         raise ValueError("t0/t_out: expected finite times, got NaN or inf.")
     span = np.concatenate([[t0], t_out])
@@ -72,6 +76,7 @@ def validate_state(y0, size=STATE_SIZE):
     if y0.shape != (size,):
         what = "(q0, q1, q2, q3, ωx, ωy, ωz)" if size == STATE_SIZE else "(q0..q3, ωx, ωy, ωz, ω_cx, ω_cy, ω_cz)"
         raise ValueError(f"y0: expected {size} numbers {what}, got shape {y0.shape}.")
+    require_finite("y0", y0, f"{size} finite numbers (q, ω)")
     if not np.all(np.isfinite(y0)):
         raise ValueError(f"y0: expected finite numbers, got {y0.tolist()}; check the initial state for NaN/inf.")
     norm = math.sqrt(float(np.dot(y0[:4], y0[:4])))

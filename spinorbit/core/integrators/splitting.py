@@ -60,6 +60,7 @@ import math
 
 import numpy as np
 
+from spinorbit.core.errors import require_finite
 from spinorbit.core.jit import jit
 from spinorbit.core.dynamics.equations import MODEL_PERTURBERS, STATE_SIZE, force_function_and_torque_xyz
 from spinorbit.core.dynamics.validation import validate_sampled_span, validate_state
@@ -431,6 +432,7 @@ def integrate_splitting(y0, t0, t_out, model, step, scheme="saba2", free_flow_se
         step = float(step)
     except (TypeError, ValueError):
         raise ValueError(f"step: expected a positive number (time unit of the model), got {step!r}.") from None
+    require_finite("step", step, "a finite step > 0 (time unit of the model)")
     if not (math.isfinite(step) and step > 0.0):
         raise ValueError(
             f"step: expected a finite step > 0 (time unit of the model), got {step!r}; "

@@ -9,6 +9,8 @@ from spinorbit.commands._common import Progress, atomic_output, plot_format, qua
 
 #: Most output times a command accepts (each row builds a RotationState for the periods).
 MAX_TIMES = 100_000
+#: Closest output times accepted (days): a float of TDB days since J2000 resolves ~1e-12 d in 1992-2029.
+MIN_SPACING_DAYS = 1e-9
 
 
 def add_scene_arguments(parser: argparse.ArgumentParser, span_default: str, perturbers_default) -> None:
@@ -46,6 +48,10 @@ def span_and_times(args, start, max_days: float):
         raise CommandError(f"--span expects a positive duration up to {max_days:g} d; got {' '.join(args.span)}.")
     if not 2 <= args.n_times <= MAX_TIMES:
         raise CommandError(f"--n-times expects between 2 and {MAX_TIMES} output times; got {args.n_times}.")
+    if days / args.n_times < MIN_SPACING_DAYS:
+        raise CommandError(f"--span {' '.join(args.span)} with --n-times {args.n_times} spaces the output times by "
+                           f"{days / args.n_times:.3g} d, below the {MIN_SPACING_DAYS:g} d that TDB days since J2000 resolve; "
+                           "give a longer --span or fewer --n-times.")
     if args.end_only:
         return span, start + days * u.day
     return span, start + np.linspace(days / args.n_times, days, args.n_times) * u.day

@@ -42,6 +42,9 @@ cannot be written (nothing is left half-written)."""
 
 #: DE421's librations end in 2050 and (from J2000) the lunar model is meant for decades, not more.
 MAX_SPAN_DAYS = 50 * 365.25
+#: Most comparison times (rows) a run may have: 50 yr at a 0.1 d step. Each is an integration stop and a
+#: DE421 evaluation; more is refused before the run (with the count and the knob, --step).
+MAX_COMPARISON_TIMES = 200_000
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -160,11 +163,14 @@ def run(args) -> int:
         raise CommandError(f"--span expects a positive duration up to 50 yr, got {' '.join(args.span)}.")
     if not 0 < step <= span_days:
         raise CommandError(f"--step expects a positive spacing no longer than --span, got {' '.join(args.step)}.")
+    count = int(span_days / step + 1e-9) + 1
+    if count > MAX_COMPARISON_TIMES:
+        raise CommandError(f"--span/--step give {count:.3g} comparison times, more than {MAX_COMPARISON_TIMES}; "
+                           f"use a larger --step (at least {span_days / (MAX_COMPARISON_TIMES - 1):.3g} d) or a shorter --span.")
     schedule, settings = _checkpoint_schedule(args, span_days, step)
     if schedule is not None and args.model == "de421":
         raise CommandError("--checkpoint/--resume apply to the REBOUND-coupled models (--model rigid or "
                            "core-corrected); the de421 model runs at ≈ 0.1 s per simulated year and needs none.")
-    count = int(span_days / step + 1e-9) + 1
     progress = Progress(count, "integrating")
     done = [0]
 

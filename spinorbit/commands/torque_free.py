@@ -109,7 +109,7 @@ def _offsets(args):
     count = math.floor(abs(span) / step + 1e-9) + 1
     if count > MAX_TIMES:
         raise CommandError(
-            f"--span/--step give {count} output times, more than {MAX_TIMES}; use a larger --step or --n-times."
+            f"--span/--step give {float(count):.3g} output times, more than {MAX_TIMES}; use a larger --step or --n-times."
         )
     return math.copysign(step, span) * np.arange(count)
 

@@ -20,6 +20,10 @@ class NonFiniteError(SpinorbitError, ValueError):
     """
 
 
+class WorkLimitError(SpinorbitError, ValueError):
+    """A run whose estimated work (steps, output rows) exceeds its documented cap, refused before it starts."""
+
+
 def require_finite(name, values, expected="finite numbers"):
     """Raise :class:`NonFiniteError` naming ``name`` if any of ``values`` (a number or a sequence) is NaN/inf."""
     flat = values.ravel().tolist() if hasattr(values, "ravel") else values

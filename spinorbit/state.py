@@ -169,6 +169,13 @@ class RotationState:
         self._body = body
         self._q = _as_quaternion(quaternion)
         self._omega = _as_angular_velocity(angular_velocity)
+        with np.errstate(over="ignore"):
+            momentum = body.moment_values * self._omega
+        if not np.all(np.isfinite(momentum)):
+            raise InvalidStateError(
+                f"the angular momentum I ω overflows float64 (moments {body.moment_values.tolist()} × spin "
+                f"{self._omega.tolist()} rad/day); give the moments and the spin in units nearer 1."
+            )
 
     # -- constructors --------------------------------------------------------------------------
     @classmethod
@@ -429,8 +436,8 @@ class RotationState:
         if times.ndim != 1:
             raise ValueError(f"dt must be a scalar or 1-D array of time offsets; got shape {times.shape}.")
         if not np.all(np.isfinite(times)):
-            raise NonFiniteStateError(f"dt must hold finite time offsets; got {times[~np.isfinite(times)][0]!r} among "
-                                      f"{times.size} values.")
+            first = float(times[~np.isfinite(times)][0])
+            raise NonFiniteStateError(f"dt must hold finite time offsets; got {first!r} among {times.size} values.")
         attitude, momentum = self.principal_attitude_and_momentum()
         if np.any(momentum):  # at rest the flow is the constant state (exact); else check magnitude and phase
             momentum = self._rotating_momentum()

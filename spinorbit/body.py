@@ -51,7 +51,7 @@ def _as_moments(moments) -> tuple[np.ndarray, u.Unit]:
     if np.any(values <= 0):
         raise InvalidBodyError(
             f"principal moments must be positive; got {values.tolist()}. A moment of inertia is a sum of m r² ≥ 0, "
-            "and zero only for a body on a line."
+            "and zero only for a body on a line; give three positive moments (kg m² or ratios)."
         )
     return values, unit
 

@@ -147,7 +147,7 @@ def parse_unit(option: str, text: str, unit, example: str) -> u.UnitBase:
         value_in(option, 1.0 * result, unit, example)
     except QuantityInputError:
         if _kind(unit) == "angular velocity" and _kind(result) == "frequency":
-            raise  # the advice on how to write a rotation rate
+            raise QuantityInputError(_frequency_advice(option, f"'{text}'", u.Unit(unit))) from None
         raise QuantityInputError(f"{option} expects a unit of {_kind(unit)} such as {example}; got '{text}' "
                                  f"(physical type {_kind(result)}).") from None
     return result
@@ -177,7 +177,7 @@ def parse_quantity(option: str, words, unit, example: str, default_unit=None) ->
         value_in(option, magnitude * quantity_unit, unit, f"'{example}'")
     except QuantityInputError as error:
         if _kind(unit) == "angular velocity" and _kind(quantity_unit) == "frequency":
-            raise  # the advice on how to write a rotation rate
+            raise QuantityInputError(_frequency_advice(option, f"'{text}'", u.Unit(unit))) from error
         raise QuantityInputError(f"{option} expects {hint}; got '{text}' (physical type {_kind(quantity_unit)})."
                                  ) from error
     return magnitude * quantity_unit

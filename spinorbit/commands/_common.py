@@ -15,6 +15,23 @@ PROGRESS_DELAY_S = 2.0
 PROGRESS_REDRAW_S = 0.2
 
 
+def number(text: str) -> float:
+    """An argparse ``type``: a finite float that float64 holds as typed (no overflow to inf, no underflow to 0)."""
+    import argparse
+    import math
+
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got '{text}'") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got '{text}'")
+    mantissa = text.strip().lower().split("e")[0]
+    if value == 0.0 and any(digit in mantissa for digit in "123456789"):
+        raise argparse.ArgumentTypeError(f"expected a number float64 can hold, got '{text}', which underflows to 0")
+    return value
+
+
 def quantity(option: str, words, default_unit: str, physical_type: str, example: str):
     """Read ``--span 100 d`` / ``--span "100 d"`` / ``--span 100`` (default unit) as a Quantity.
 
@@ -91,10 +108,12 @@ def check_output_path(option: str, path: str, formats: dict | None = None) -> No
     directory = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(directory):
         raise CommandError(
-            f"{option}: the directory '{directory}' does not exist; create it first or choose another path."
+            f"{option}: cannot write '{path}': the directory '{directory}' does not exist; create it first or "
+            "choose another path."
         )
     if not os.access(directory, os.W_OK):
-        raise CommandError(f"{option}: the directory '{directory}' is not writable; choose another path.")
+        raise CommandError(f"{option}: cannot write '{path}': the directory '{directory}' is not writable; choose "
+                           "another path.")
     if formats is not None:
         _format_of(option, path, formats)
 

@@ -42,6 +42,7 @@ def span_and_times(args, start, max_days: float):
     import astropy.units as u
     import numpy as np
 
+    tolerance(args)  # before the orbit is built: a wrong tolerance costs no N-body run
     span = quantity("--span", args.span, "d", "time", "4 d")
     days = span.to_value(u.day)
     if not 0 < days <= max_days:
@@ -58,8 +59,16 @@ def span_and_times(args, start, max_days: float):
 
 
 def tolerance(args):
-    """The --tolerance angle."""
-    return quantity("--tolerance", args.tolerance, "arcsec", "angle", "1 arcsec")
+    """The --tolerance angle, in the range the Scene accepts (checked here, before the orbit is built)."""
+    from spinorbit.scene.inputs import SceneError, as_angle
+
+    value = quantity("--tolerance", args.tolerance, "arcsec", "angle", "1 arcsec")
+    try:
+        as_angle(value)
+    except SceneError:
+        raise CommandError(f"--tolerance expects an attitude angle between 1e-12 rad and 0.1 rad (2e-7 to 2e4 "
+                           f"arcsec); got '{' '.join(args.tolerance)}'.") from None
+    return value
 
 
 def run_scene(scene, args):

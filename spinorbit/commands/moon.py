@@ -8,7 +8,7 @@ import os
 import sys
 
 from spinorbit.cli import CommandError
-from spinorbit.commands._common import (Progress, atomic_output, check_output_path, check_outputs, plot_format,
+from spinorbit.commands._common import (Progress, atomic_output, check_output_path, check_outputs, number, plot_format,
                                         quantity, table_format)
 
 #: The models (spinorbit.coupling.moon.MOON_MODELS, repeated so that --help does not import REBOUND).
@@ -68,7 +68,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     long_runs = parser.add_argument_group("long runs")
     long_runs.add_argument("--checkpoint", metavar="PATH",
                            help="write a checkpoint (orbits + rotation + results so far) to PATH during the run")
-    long_runs.add_argument("--checkpoint-every", type=float, default=60.0, metavar="SECONDS",
+    long_runs.add_argument("--checkpoint-every", type=number, default=60.0, metavar="SECONDS",
                            help="wall-clock seconds between checkpoints (default 60)")
     long_runs.add_argument("--resume", metavar="PATH",
                            help="continue the interrupted run whose checkpoint is PATH (same options); it "
@@ -142,18 +142,19 @@ def _checkpoint_schedule(args, span_days: float, step_days: float):
     if args.resume is not None and not os.path.isfile(args.resume):
         raise CommandError(f"--resume expects an existing checkpoint file; '{args.resume}' does not exist. "
                            "Give the --checkpoint file of the interrupted run.")
+    if not (math.isfinite(args.checkpoint_every) and args.checkpoint_every > 0):  # checked even when unused
+        raise CommandError(f"--checkpoint-every expects a positive number of seconds, got {args.checkpoint_every!r}.")
     path = args.checkpoint if args.checkpoint is not None else args.resume
     if path is None:
         return None, settings
     check_output_path("--checkpoint", path)
-    if not (math.isfinite(args.checkpoint_every) and args.checkpoint_every > 0):
-        raise CommandError(f"--checkpoint-every expects a positive number of seconds, got {args.checkpoint_every!r}.")
     return CheckpointSchedule(path, every_seconds=args.checkpoint_every), settings
 
 
 def run(args) -> int:
     """Run ``spinorbit moon``; return the exit status."""
     from spinorbit.coupling.moon import compare_model_with_de421
+    from spinorbit.runs.checkpoint import CheckpointError
 
     check_outputs(args)
     span = quantity("--span", args.span, "d", "time", "1 yr")
@@ -165,7 +166,8 @@ def run(args) -> int:
         raise CommandError(f"--step expects a positive spacing no longer than --span, got {' '.join(args.step)}.")
     count = int(span_days / step + 1e-9) + 1
     if count > MAX_COMPARISON_TIMES:
-        raise CommandError(f"--span/--step give {count:.3g} comparison times, more than {MAX_COMPARISON_TIMES}; "
+        raise CommandError(f"--span {' '.join(args.span)} with --step {' '.join(args.step)} gives {count:.3g} "
+                           f"comparison times, more than {MAX_COMPARISON_TIMES}; "
                            f"use a larger --step (at least {span_days / (MAX_COMPARISON_TIMES - 1):.3g} d) or a shorter --span.")
     schedule, settings = _checkpoint_schedule(args, span_days, step)
     if schedule is not None and args.model == "de421":
@@ -182,6 +184,9 @@ def run(args) -> int:
         comparison = compare_model_with_de421(args.model, span_days, step, coupled=not args.one_way,
                                               progress=advance, schedule=schedule, resume=args.resume,
                                               settings=settings)
+    except CheckpointError as error:  # name the option whose file it is
+        option = "--checkpoint" if str(error).startswith("cannot write") else "--resume"
+        raise CommandError(f"{option}: {error}") from None
     except KeyboardInterrupt:
         if schedule is not None and os.path.exists(schedule.path):
             print(f"{args._prog}: the last checkpoint is '{schedule.path}'; continue with the same options and "

@@ -6,7 +6,7 @@ import argparse
 import math
 
 from spinorbit.cli import CommandError
-from spinorbit.commands._common import (Progress, atomic_output, check_output_paths, plot_format, quantity,
+from spinorbit.commands._common import (Progress, atomic_output, check_output_paths, number, plot_format, quantity,
                                         table_format, unit)
 
 NAME = "torque-free"
@@ -39,16 +39,6 @@ CHUNK = 20_000
 MAX_TIMES = 10_000_000
 
 
-def _number(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got '{text}'") from None
-    if not math.isfinite(value):
-        raise argparse.ArgumentTypeError(f"expected a finite number, got '{text}'")
-    return value
-
-
 def _count(text: str) -> int:
     try:
         value = int(text)
@@ -63,11 +53,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of ``spinorbit torque-free``."""
     body = parser.add_argument_group("body and initial state")
     body.add_argument(
-        "--moments", nargs=3, type=_number, required=True, metavar=("IX", "IY", "IZ"),
+        "--moments", nargs=3, type=number, required=True, metavar=("IX", "IY", "IZ"),
         help="principal moments of inertia about the body x, y, z axes (kg m^2 or ratios; any order)",
     )
     body.add_argument(
-        "--omega", nargs=3, type=_number, required=True, metavar=("WX", "WY", "WZ"),
+        "--omega", nargs=3, type=number, required=True, metavar=("WX", "WY", "WZ"),
         help="body angular velocity components along x, y, z (unit: --omega-unit)",
     )
     body.add_argument(
@@ -75,7 +65,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="unit of --omega, any astropy angular-velocity unit: deg/day (default), rad/s, deg/h, ...",
     )
     body.add_argument(
-        "--euler313", nargs=3, type=_number, default=(0.0, 0.0, 0.0), metavar=("PHI", "THETA", "PSI"),
+        "--euler313", nargs=3, type=number, default=(0.0, 0.0, 0.0), metavar=("PHI", "THETA", "PSI"),
         help="initial attitude, passive 3-1-3 Euler angles in degrees (default: 0 0 0, body = inertial axes)",
     )
     times = parser.add_argument_group("output times")
@@ -109,7 +99,8 @@ def _offsets(args):
     count = math.floor(abs(span) / step + 1e-9) + 1
     if count > MAX_TIMES:
         raise CommandError(
-            f"--span/--step give {float(count):.3g} output times, more than {MAX_TIMES}; use a larger --step or --n-times."
+            f"--span {' '.join(args.span)} with --step {' '.join(args.step or ['1', 'd'])} gives {float(count):.3g} output times, "
+            f"more than {MAX_TIMES}; use a larger --step or --n-times."
         )
     return math.copysign(step, span) * np.arange(count)
 

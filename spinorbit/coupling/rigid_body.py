@@ -18,6 +18,7 @@ from spinorbit.core.dynamics.equations import (
 from spinorbit.core.model.gravity_field import figure_force_function_and_gradient
 from spinorbit.coupling.rebound import (
     ExtraForces,
+    MissingBodyError,
     RotationHooks,
     attach_rotation_hooks,
     body_index,
@@ -256,8 +257,12 @@ class CoupledRigidBody:
         first_or_last_step = sim.integrator.first_or_last_step  # the binary's; attaching resets it
         if arrays["extra_forces"].size:
             reinstall_extra_forces(sim, ExtraForces.from_parameters(arrays["extra_forces"]))
-        body = cls(sim, meta["body"], arrays["figure"], arrays["rotation_state"], perturbers=meta["perturbers"],
-                   coupled=meta["coupled"], perturber_degrees=[int(d) for d in arrays["perturber_degrees"]])
+        try:
+            body = cls(sim, meta["body"], arrays["figure"], arrays["rotation_state"], perturbers=meta["perturbers"],
+                       coupled=meta["coupled"], perturber_degrees=[int(d) for d in arrays["perturber_degrees"]])
+        except MissingBodyError as error:  # names in the checkpoint that its own simulation lacks: edited or foreign
+            raise RestoreError(f"the coupled-body checkpoint names a body its simulation does not hold ({error}); "
+                               "the file was edited or belongs to another run. Start the run again.") from None
         body.hooks.resume_bs_controller(sim, first_or_last_step)
         return body
 

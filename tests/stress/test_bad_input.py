@@ -203,7 +203,7 @@ MOON_CASES = [
     ("step longer than span", ["--span", "2", "d", "--step", "3", "d"], "no longer than --span"),
     ("unknown model", ["--model", "jelly"], "invalid choice: 'jelly'"),
     ("checkpoint every 0 s", ["--checkpoint", "{tmp}/run.ckpt", "--checkpoint-every", "0"], "positive number of seconds"),
-    ("checkpoint every word", ["--checkpoint-every", "often"], "invalid float value: 'often'"),
+    ("checkpoint every word", ["--checkpoint-every", "often"], "expected a number, got 'often'"),
     ("checkpoint into a missing directory", ["--checkpoint", "{tmp}/no/run.ckpt"], "does not exist"),
     ("resume a missing file", ["--resume", "{tmp}/none.ckpt"], "expects an existing checkpoint file"),
     ("resume a truncated file", ["--resume", "{tmp}/bad.ckpt"], "is truncated"),

@@ -140,7 +140,8 @@ def _checkpoint_schedule(args, span_days: float, step_days: float):
     settings = {"command": NAME, "model": args.model, "coupled": not args.one_way, "span_days": span_days,
                 "step_days": step_days}
     if args.resume is not None and not os.path.isfile(args.resume):
-        raise CommandError(f"--resume expects an existing checkpoint file; '{args.resume}' does not exist. "
+        what = "is not a regular file" if os.path.exists(args.resume) else "does not exist"
+        raise CommandError(f"--resume expects an existing checkpoint file; '{args.resume}' {what}. "
                            "Give the --checkpoint file of the interrupted run.")
     if not (math.isfinite(args.checkpoint_every) and args.checkpoint_every > 0):  # checked even when unused
         raise CommandError(f"--checkpoint-every expects a positive number of seconds, got {args.checkpoint_every!r}.")

@@ -8,8 +8,6 @@ a lower bound of the steps actually taken, so no run that fits is refused. The c
 their row caps with the count and the option to change.
 """
 
-import contextlib
-import io
 import math
 import time
 
@@ -18,7 +16,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from spinorbit import cli
 from spinorbit.core.dynamics.equations import make_model
 from spinorbit.core.dynamics.validation import MAX_OUTPUT_ROWS, rotation_turns
 from spinorbit.core.errors import WorkLimitError
@@ -27,6 +24,10 @@ from spinorbit.core.integrators.elements import integrate_elements_fixed_step
 from spinorbit.core.integrators.quaternion import integrate_fixed_step, integrate_quaternion, minimum_steps
 from spinorbit.core.integrators.splitting import integrate_splitting
 from spinorbit.core.integrators.taylor import TAYLOR_STEPS_PER_TURN, integrate_taylor, integrate_taylor_fixed_step
+
+from tests.stress._cli import run_cli
+
+
 
 EXAMPLES = 40
 MOMENTS = (1.0, 2.0, 2.5)
@@ -108,16 +109,6 @@ def test_more_output_rows_than_the_cap_are_refused_before_allocating():
 
 
 # ------------------------------------------------------------------------------- commands
-def run_cli(argv):
-    err = io.StringIO()
-    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
-        try:
-            status = cli.main(argv)
-        except SystemExit as exit_info:
-            status = exit_info.code
-    return status, err.getvalue().strip()
-
-
 @settings(max_examples=EXAMPLES)
 @given(st.floats(-12.0, -5.0))
 def test_commands_refuse_row_counts_over_their_caps_with_the_knob(log_step):

@@ -8,8 +8,6 @@ names the option, shows what arrived and says what is expected or what to do —
 a raw numpy/numba/astropy message.
 """
 
-import contextlib
-import io
 import os
 import tempfile
 from pathlib import Path
@@ -18,7 +16,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from spinorbit import cli
+from tests.stress._cli import run_cli
+
 
 EXAMPLES = 120
 NUMBER_BAD = ["abc", "nan", "inf", "-inf", "1e400", "[1,2]", "1,2", "", "∞", "0x10", "one"]
@@ -61,16 +60,6 @@ CASES = [
     (TOUTATIS, "--perturbers", 1, ["vulcan", "[1]", "", "nan", "sun,earth"]),
     (TOUTATIS, "--output", 1, ["x.txt", "{dir}", "/dev/null"]),
 ]
-
-
-def run_cli(argv):
-    err = io.StringIO()
-    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
-        try:
-            status = cli.main(argv)
-        except SystemExit as exit_info:
-            status = exit_info.code
-    return status, err.getvalue()
 
 
 def check_one_line_error(base, option, values, directory, culprit):
@@ -126,6 +115,7 @@ def test_unknown_body_in_a_coupled_checkpoint_is_one_line(tmp_path):
     base = ["moon", "--model", "core-corrected", "--step", "1", "d", "--span", "3", "d"]
     assert run_cli([*base, "--checkpoint", str(checkpoint), "--checkpoint-every", "1e-9"])[0] == 0
     from spinorbit.runs.checkpoint import Checkpoint
+
 
     saved = Checkpoint.read(checkpoint)
     saved.meta["body"]["body"] = "Vulcan"

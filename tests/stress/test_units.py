@@ -8,8 +8,6 @@ argument, the expected unit and what arrived; or both accept with the same numbe
 is checked against the unit's definition written out here (1 cycle = 2π rad, 1 deg = π/180 rad).
 """
 
-import contextlib
-import io
 import math
 import tempfile
 from pathlib import Path
@@ -21,8 +19,11 @@ from astropy.table import Table
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from spinorbit import RigidBody, RotationState, cli
+from spinorbit import RigidBody, RotationState
 from spinorbit.quantities import QuantityInputError
+
+from tests.stress._cli import run_cli
+
 
 BODY = RigidBody([1.0, 2.0, 2.5])
 IDENTITY = [1.0, 0.0, 0.0, 0.0]
@@ -35,16 +36,6 @@ WRONG = ["m", "kg", "m/s", "d", "rad", "deg", "", "kg m2", "rad/m"]
 #: days per unit, from the definitions, for time offsets.
 DAYS = {"d": 1.0, "h": 1 / 24, "s": 1 / 86400, "yr": 365.25, "min": 1 / 1440}
 EXAMPLES = 60
-
-
-def run_cli(argv):
-    err = io.StringIO()
-    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
-        try:
-            status = cli.main(argv)
-        except SystemExit as exit_info:
-            status = exit_info.code
-    return status, err.getvalue().strip()
 
 
 def assert_refusal_names(message, name, expected, arrived):

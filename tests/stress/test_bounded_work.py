@@ -126,3 +126,14 @@ def test_commands_refuse_row_counts_over_their_caps_with_the_knob(log_step):
 def test_scene_commands_cap_their_output_times():
     status, err = run_cli(["toutatis", "--n-times", "100001", "--plan"])
     assert status == 2 and "--n-times expects between 2 and 100000" in err
+
+
+def test_the_averaged_propagator_refuses_an_absurd_run_at_once():
+    from spinorbit.core.averaging.propagate import propagate_averaged
+    from spinorbit.core.model.perturbers import kepler_source
+
+    model = make_model(MOMENTS, [kepler_source(1.0, 20.0, 0.1, 0.3, 0.0, 0.0, 0.0)])
+    clock = time.perf_counter()
+    with pytest.raises(WorkLimitError, match=r"propagate_averaged: this run needs about 1e\+12 steps.*max_steps = 1000"):
+        propagate_averaged(state((0.1, 0.2, 1.0), 1.0), 0.0, [1e10], model, max_step=0.01, max_steps=1000)
+    assert time.perf_counter() - clock < REFUSAL_SECONDS + 2.0  # the osculating-to-mean set-up runs first

@@ -30,6 +30,7 @@ from spinorbit.core.math.rotations import rotation_angle_between_many
 from spinorbit.core.model.perturbers import fixed_source, kepler_source
 from spinorbit.core.free_motion.flow import torque_free_states
 from spinorbit.runs.resumable import integrate_resumable
+from spinorbit.scene.inputs import FixedPerturber
 from spinorbit.state import MAX_FLOW_PHASE
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
@@ -147,6 +148,9 @@ ENTRY_POINTS = {
     "perturber gm (fixed)": lambda b, i: fixed_source(b, [1.0, 0.0, 0.0]),
     "perturber elements": lambda b, i: kepler_source(1.0, *with_bad([4.0, 0.3, 0.4, 0.1, 0.2, 0.0], i % 6, b)),
     "perturber position": lambda b, i: fixed_source(1.0, with_bad([1.0, 0.0, 0.0], i % 3, b)),
+    "Scene perturber gm": lambda b, i: FixedPerturber("p", b * u.m**3 / u.s**2, [1.0, 0.0, 0.0] * u.au),
+    "Scene perturber position": lambda b, i: FixedPerturber("p", 1.0 * u.m**3 / u.s**2,
+                                                            with_bad([1.0, 0.0, 0.0], i % 3, b) * u.au),
 }
 
 

@@ -35,6 +35,7 @@ TORQUE_FREE = ["torque-free", "--moments", "1", "2", "2.5", "--omega", "1", "2",
                "--n-times", "3"]
 MOON = ["moon", "--model", "core-corrected", "--span", "2", "d"]
 TOUTATIS = ["toutatis", "--span", "1", "d", "--plan"]
+APOPHIS = ["apophis", "--span", "1", "d", "--plan"]
 
 #: (command base, option, values the option gets, the bad values) — every value below is wrong.
 CASES = [
@@ -59,6 +60,10 @@ CASES = [
     (TOUTATIS, "--tolerance", 1, QUANTITY_BAD + ["0", "-1 arcsec", "1e300 rad", "1 m"]),
     (TOUTATIS, "--perturbers", 1, ["vulcan", "[1]", "", "nan", "sun,earth"]),
     (TOUTATIS, "--output", 1, ["x.txt", "{dir}", "/dev/null"]),
+    (APOPHIS, "--span", 1, QUANTITY_BAD + ["0", "-1 d", "3 yr"]),
+    (APOPHIS, "--orbit", 1, ["jelly", "", "PUBLISHED"]),
+    (APOPHIS, "--tolerance", 1, ["nan arcsec", "1 kg", "0", "1 rad"]),
+    (APOPHIS, "--plot", 1, ["x.gif", "{dir}", "/dev/null"]),
 ]
 
 

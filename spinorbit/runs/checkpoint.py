@@ -232,7 +232,10 @@ class Checkpoint:
         path = os.fspath(path)
         try:
             with open(path, "rb") as stream:
-                data = stream.read()
+                # a foreign file (an image, a 50 GB log) is refused from its first bytes, not read whole
+                data = stream.read(len(MAGIC))
+                if data == MAGIC:
+                    data += stream.read()
         except OSError as error:
             raise CheckpointError(
                 f"cannot read checkpoint '{path}' ({error.strerror}); check the path, or start the run "

@@ -237,3 +237,15 @@ def test_cli_resume_of_damaged_checkpoints_is_one_line_exit_2(tmp_path, capsys):
         err = capsys.readouterr().err
         assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
         assert err.startswith("spinorbit moon: error: ") and "run.ckpt" in err
+
+
+def test_a_huge_foreign_file_is_refused_from_its_first_bytes(tmp_path):
+    import time
+
+    path = tmp_path / "huge.ckpt"
+    with open(path, "wb") as stream:  # 8 GiB of zeros, sparse: nothing is written to disk
+        stream.truncate(8 << 30)
+    clock = time.perf_counter()
+    with pytest.raises(CheckpointError, match="not a spinorbit checkpoint"):
+        Checkpoint.read(path)
+    assert time.perf_counter() - clock < 1.0  # not read whole

@@ -489,6 +489,13 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
     t_out = validate_output_times(t0, t_out)
     model = np.ascontiguousarray(model, dtype=float)
     validate_sampled_span(model, t0, t_out)
+    span = abs(t_out[-1] - t0)
+    if max_step is None:
+        max_step = span / 64.0 if orbit_averaged else span
+    if not (math.isfinite(max_step) and max_step > 0.0):
+        raise ValueError(f"max_step: expected a finite step > 0 (time unit of the model), got {max_step!r}.")
+    # a lower bound (the orbital rate only shortens the steps), known before the first step
+    check_step_budget("propagate_averaged", span / max_step, max_steps, "raise max_step or shorten the span")
     moments = moments_of(model)
     ic = inertia_constants(*moments)
     if frame is None:
@@ -505,13 +512,6 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
         mean = osculating_to_mean(t0, elements_of_state(y0, model, frame), model, frame, ic)
     else:
         mean = np.array(mean0, dtype=float)
-    span = abs(t_out[-1] - t0)
-    if max_step is None:
-        max_step = span / 64.0 if orbit_averaged else span
-    if not (math.isfinite(max_step) and max_step > 0.0):
-        raise ValueError(f"max_step: expected a finite step > 0 (time unit of the model), got {max_step!r}.")
-    # a lower bound (the orbital rate only shortens the steps), known before the first step
-    check_step_budget("propagate_averaged", span / max_step, max_steps, "raise max_step or shorten the span")
     possible = steps_in_anomaly(model, kind)
     if anomaly and not possible:
         raise ValueError("anomaly=True needs one perturber on an elliptic Kepler orbit and the degree-2 closed "

@@ -140,7 +140,7 @@ CLASSES = {
         ("splitting, 1e12 steps", lambda: integrate_splitting(STATE, 0.0, [1e10], make_model((1.0, 2.0, 2.5)), 0.01)),
         ("fixed-step DOP853, n_steps 1e9 > max_steps 1e6",
          lambda: integrate_fixed_step(STATE, 0.0, 1.0, 10**9, make_model((1.0, 2.0, 2.5)), max_steps=10**6)),
-        ("`spinorbit moon --step 1e-6 d`", _cli("moon", "--span", "1", "yr", "--step", "1e-6", "d")),
+        ("`spinorbit moon --span 50 yr --step 0.01 d`", _cli("moon", "--span", "50", "yr", "--step", "0.01", "d")),
         ("`spinorbit torque-free --step 1e-9 d`", _cli("torque-free", "--moments", "1", "2", "2.5", "--omega", "1",
                                                        "0", "0", "--step", "1e-9", "d")),
     ],

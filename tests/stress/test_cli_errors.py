@@ -26,6 +26,7 @@ QUANTITY_BAD = ["abc", "nan d", "inf d", "1 2 d", "[1,2] d", "1 kg", "1 Hz", "-i
 COUNT_BAD = ["abc", "1.5", "nan", "1e3", "-5", "0", "1", "10000000000", ""]
 #: Words that show the message says what is expected or what to do.
 GUIDANCE = ("expect", "give", "use ", "choose", "run '", "create", "start", "resume", "install", "write ", "add ",
+            "shorten",
             "name the file")
 #: Text that would mean a raw library message reached the user unexplained.
 RAW = ("Traceback", "could not convert", "invalid literal", "UnitConversionError", "numba", "TypingError",
@@ -48,7 +49,7 @@ CASES = [
     (TORQUE_FREE[:-2], "--n-times", 1, COUNT_BAD),
     (TORQUE_FREE, "--output", 1, ["x.txt", "x.fits", "{dir}", "/dev/null", "{dir}/missing/x.ecsv", "{link}"]),
     (TORQUE_FREE, "--plot", 1, ["x.jpg", "x", "{dir}", "/dev/null", "{dir}/missing/x.png"]),
-    (MOON, "--span", 1, QUANTITY_BAD + ["0", "-1 yr", "60 yr"]),
+    (MOON, "--span", 1, QUANTITY_BAD + ["0", "-1 yr", "300 yr"]),  # 300 yr: past DE421 from J2000
     (MOON, "--step", 1, QUANTITY_BAD + ["0", "-1 d", "3 d", "1e-9 d"]),
     (MOON, "--model", 1, ["jelly", "", "RIGID"]),
     (MOON, "--checkpoint-every", 1, NUMBER_BAD + ["0", "-1"]),
@@ -65,6 +66,17 @@ CASES = [
     (APOPHIS, "--tolerance", 1, ["nan arcsec", "1 kg", "0", "1 rad"]),
     (APOPHIS, "--plot", 1, ["x.gif", "{dir}", "/dev/null"]),
 ]
+
+
+def in_days(text):
+    """A time as a message may show it after converting to days (repr and %g), else nothing."""
+    from astropy import units as u
+
+    try:
+        days = float(u.Quantity(text if text.strip()[-1].isalpha() else f"{text} d").to_value(u.day))
+    except (TypeError, ValueError, IndexError, u.UnitsError):
+        return set()
+    return {repr(float(days)), f"{days:g}"}
 
 
 def check_one_line_error(base, option, values, directory, culprit):
@@ -88,7 +100,7 @@ def check_one_line_error(base, option, values, directory, culprit):
     shown = option if option != "--step" or "--span" not in line else "--span/--step"
     assert shown.split("/")[0] in line or option.lstrip("-") in line, (argv, line)
     # what arrived: the bad value as typed (argparse shows a float as typed, a path may be shown as its directory)
-    shown_values = {culprit, culprit.replace(" ", ""), os.path.dirname(culprit)} - {""}
+    shown_values = {culprit, culprit.replace(" ", ""), os.path.dirname(culprit), *in_days(culprit)} - {""}
     assert not culprit.strip() or any(v in line for v in shown_values) or "expected 3 arguments" in line, (argv, line)
     assert any(g in line.lower() for g in GUIDANCE), (argv, line)
     assert sorted(p.name for p in directory.iterdir()) == before  # nothing written, nothing left behind

@@ -69,9 +69,9 @@ def free_modes_section():
     published_text = {"longitude": f"{rambaux['longitude']:.0f} d",
                       "latitude": f"{rambaux['latitude'] / YEAR_DAYS:.1f} yr ({rambaux['latitude']:.0f} d)",
                       "wobble": f"{rambaux['wobble'] / YEAR_DAYS:.1f} yr ({rambaux['wobble']:.0f} d)"}
-    rows = [f"| published: Rambaux & Williams 2011 (DE421) | " + " | ".join(published_text[m] for m in FREE_MODES)
+    rows = ["| published: Rambaux & Williams 2011 (DE421) | " + " | ".join(published_text[m] for m in FREE_MODES)
             + " | | |",
-            f"| published: Yang et al. 2017 (DE430) | " + " | ".join(f"{yang[m]:.2f} d" for m in FREE_MODES)
+            "| published: Yang et al. 2017 (DE430) | " + " | ".join(f"{yang[m]:.2f} d" for m in FREE_MODES)
             + f" | {YANG_WOBBLE_ARCSEC[0]}″ × {YANG_WOBBLE_ARCSEC[1]}″ "
               f"({YANG_WOBBLE_ARCSEC[0] / YANG_WOBBLE_ARCSEC[1]:.3f}) | |"]
     for model in MOON_MODELS:

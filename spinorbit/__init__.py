@@ -29,6 +29,7 @@ _PUBLIC = {
     "Scene": ".scene",
     "Orbit": ".scene",
     "SpinorbitError": ".core.errors",
+    "NonFiniteError": ".core.errors",
 }
 
 __all__ = [*_PUBLIC, "__version__"]

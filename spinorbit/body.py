@@ -14,24 +14,28 @@ from dataclasses import dataclass, field
 import numpy as np
 from astropy import units as u
 
-__all__ = ["RigidBody", "InvalidBodyError"]
+from spinorbit.core.errors import NonFiniteError, SpinorbitError
+from spinorbit.quantities import value_in
+
+__all__ = ["RigidBody", "InvalidBodyError", "NonFiniteBodyError"]
 
 # Relative slack for the triangle inequality A + B ≥ C: a flat plate has A + B = C exactly, and
 # moments computed from a shape model carry rounding of a few ulp.
 TRIANGLE_SLACK = 1e-12
 
 
-class InvalidBodyError(ValueError):
-    """The moments of inertia cannot belong to a rigid body."""
+class InvalidBodyError(SpinorbitError, ValueError):
+    """The moments of inertia, mass or radius cannot belong to a rigid body."""
+
+
+class NonFiniteBodyError(InvalidBodyError, NonFiniteError):
+    """NaN or ±inf in the moments, the mass or the radius."""
 
 
 def _as_moments(moments) -> tuple[np.ndarray, u.Unit]:
     if isinstance(moments, u.Quantity):
         if moments.unit.physical_type not in ("moment of inertia", "dimensionless"):
-            raise u.UnitTypeError(
-                f"moments of inertia need a unit like kg m² (or none, for ratios); got {moments.unit!s}. "
-                "Convert them, e.g. moments.to(u.kg * u.m**2)."
-            )
+            value_in("moments", moments, u.kg * u.m**2, "[1, 2, 2.5] kg m² (or plain ratios)")  # raises, naming both
         values, unit = np.asarray(moments.value, dtype=float), moments.unit
     else:
         try:
@@ -43,11 +47,11 @@ def _as_moments(moments) -> tuple[np.ndarray, u.Unit]:
             f"a rigid body needs exactly three principal moments (about its x, y, z axes); got shape {values.shape}."
         )
     if not np.all(np.isfinite(values)):
-        raise InvalidBodyError(f"principal moments must be finite; got {values.tolist()}.")
+        raise NonFiniteBodyError(f"principal moments must be finite; got {values.tolist()}.")
     if np.any(values <= 0):
         raise InvalidBodyError(
             f"principal moments must be positive; got {values.tolist()}. A moment of inertia is a sum of m r² ≥ 0, "
-            "and zero only for a body on a line."
+            "and zero only for a body on a line; give three positive moments (kg m² or ratios)."
         )
     return values, unit
 
@@ -116,12 +120,16 @@ class RigidBody:
                 f"({float(big_a)!r} + {float(big_b)!r} < {float(big_c)!r}); no mass distribution has them. Check the "
                 "values and their axes, or pass physical=False for a mathematical test problem."
             )
-        if self.mass is not None and (not isinstance(self.mass, u.Quantity) or self.mass.unit.physical_type != "mass"):
-            raise u.UnitTypeError(f"mass must be a Quantity in a mass unit (e.g. 6e10 * u.kg); got {self.mass!r}.")
-        if self.radius is not None and (
-            not isinstance(self.radius, u.Quantity) or self.radius.unit.physical_type != "length"
-        ):
-            raise u.UnitTypeError(f"radius must be a Quantity in a length unit (e.g. 0.2 * u.km); got {self.radius!r}.")
+        for name, value, expected_unit, example in (("mass", self.mass, u.kg, "6e10 * u.kg"),
+                                                    ("radius", self.radius, u.km, "0.2 * u.km")):
+            if value is None:
+                continue
+            try:
+                magnitude = value_in(name, value, expected_unit, example, shape=())
+            except ValueError as error:  # NaN, inf or an array
+                raise (NonFiniteBodyError if "finite" in str(error) else InvalidBodyError)(str(error)) from None
+            if not magnitude > 0:
+                raise InvalidBodyError(f"{name} must be positive, such as {example}; got {value!s}.")
         values = values.copy()  # the body's own: np.asarray may have returned the caller's array
         to_principal = _principal_permutation(values)
         values.flags.writeable = False  # shared with the states built on this body: never changed

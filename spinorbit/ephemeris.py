@@ -34,6 +34,7 @@ import types
 import astropy.units as u
 import numpy as np
 
+from spinorbit.core.errors import SpinorbitError
 from spinorbit.core.math.rotations import attitude_to_quat_many, euler313_rates_to_omega, euler313_to_attitude
 from spinorbit.time import J2000_JD_TDB, tdb_day_and_fraction
 
@@ -89,11 +90,11 @@ _SERIES = {
 }
 
 
-class UnknownBodyError(ValueError):
+class UnknownBodyError(SpinorbitError, ValueError):
     """A body name DE421 (as exposed here) does not have."""
 
 
-class EphemerisRangeError(ValueError):
+class EphemerisRangeError(SpinorbitError, ValueError):
     """A time outside the span covered by the DE421 data."""
 
 

@@ -18,14 +18,14 @@ own converter.
 
 Frames
 ------
-``"ecliptic"`` is the ecliptic and equinox of J2000 of :mod:`spinorbit.frames`: the IAU 2006
-obliquity 84381.406″ with the IAU 2006 frame bias, astropy's ``BarycentricMeanEcliptic``. JPL's
-Small-Body Database and Horizons refer their elements to an ecliptic with the IAU 1976 obliquity
-84381.448″ and no frame bias: ``"ecliptic-jpl"`` is that one (JPL#218's Apophis elements give
-Horizons' ICRF state to 0.7 m through it, and 31 km off through ``"ecliptic"``:
-``tests/test_orbits.py``). The difference, ≈ 0.05″, is far below what few-digit elements carry but
-not below what a close approach resolves: give JPL's elements with ``"ecliptic-jpl"``. ``"icrf"``
-takes the elements as referred to the ICRF equator.
+``"ecliptic"`` (the default) is the ecliptic and equinox of J2000 that published element catalogues
+use: JPL's Small-Body Database and Horizons (and the MPC) refer their elements to an ecliptic with the
+IAU 1976 obliquity 84381.448″ and no frame bias. JPL#218's Apophis elements give Horizons' ICRF state
+to 0.7 m through it (``tests/test_orbits.py``). ``"ecliptic-iau2006"`` is the ecliptic of
+:mod:`spinorbit.frames` and astropy's ``BarycentricMeanEcliptic``: IAU 2006 obliquity 84381.406″
+with the frame bias; the same elements land 31 km off through it. The two differ by ≈ 0.05″, far
+below what few-digit elements carry but not below what a close approach resolves, so the default is
+the catalogues' frame. ``"icrf"`` takes the elements as referred to the ICRF equator.
 """
 
 from __future__ import annotations
@@ -43,7 +43,7 @@ __all__ = ["ELEMENT_FRAMES", "JPL_OBLIQUITY_J2000", "OrbitElementsError", "check
            "frame_to_icrf_matrix", "solve_kepler"]
 
 #: Frames the elements (or a state vector) may be referred to (module docstring).
-ELEMENT_FRAMES = ("ecliptic", "ecliptic-jpl", "icrf")
+ELEMENT_FRAMES = ("ecliptic", "ecliptic-iau2006", "icrf")
 #: IAU 1976 obliquity of J2000, the one of JPL's ecliptic elements (Lieske et al. 1977).
 JPL_OBLIQUITY_J2000 = 84381.448 * u.arcsec
 
@@ -57,12 +57,12 @@ def frame_to_icrf_matrix(frame):
     if frame == "icrf":
         return np.eye(3)
     if frame == "ecliptic":
-        return icrf_to_ecliptic_matrix().T
-    if frame == "ecliptic-jpl":
         return rot1(JPL_OBLIQUITY_J2000.to_value(u.rad)).T
+    if frame == "ecliptic-iau2006":
+        return icrf_to_ecliptic_matrix().T
     raise OrbitElementsError(
-        f"frame expects one of {ELEMENT_FRAMES} ('ecliptic': ecliptic and equinox J2000 as astropy's, IAU 2006; "
-        f"'ecliptic-jpl': the IAU 1976 ecliptic of JPL's SBDB and Horizons elements); got {frame!r}."
+        f"frame expects one of {ELEMENT_FRAMES} ('ecliptic': ecliptic and equinox J2000 of JPL's SBDB, Horizons "
+        f"and the MPC, IAU 1976 obliquity; 'ecliptic-iau2006': astropy's BarycentricMeanEcliptic); got {frame!r}."
     )
 
 
@@ -144,7 +144,7 @@ def elements_to_state(a, e, inc, raan, argp, mean_anomaly, gm, frame="ecliptic")
     gm : float
         G·M of the central body, in (length unit)³/(time unit)²; the velocity comes out in
         length unit / time unit.
-    frame : {"ecliptic", "ecliptic-jpl", "icrf"}
+    frame : {"ecliptic", "ecliptic-iau2006", "icrf"}
         The frame the elements are referred to (module docstring).
 
     Returns

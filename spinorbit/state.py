@@ -15,14 +15,15 @@ from astropy import units as u
 
 from spinorbit import pole as _pole
 from spinorbit.body import RigidBody
+from spinorbit.quantities import value_in
 from spinorbit.core.elements import andoyer as _andoyer
 from spinorbit.core.elements import canonical as _canonical
 from spinorbit.core.free_motion import summary as _summary
 from spinorbit.core.math import rotations as _rotations
 from spinorbit.core.free_motion import flow as _torque_free
-from spinorbit.core.errors import SingularElementsError
+from spinorbit.core.errors import NonFiniteError, SingularElementsError, SpinorbitError
 
-__all__ = ["RotationState", "CanonicalElements", "InvalidStateError"]
+__all__ = ["RotationState", "CanonicalElements", "InvalidStateError", "NonFiniteStateError", "MAX_FLOW_PHASE"]
 
 RAD_PER_DAY = u.rad / u.day
 # A quaternion further than this from unit norm is refused rather than silently normalized: it is
@@ -49,8 +50,20 @@ MODE_NAMES = {
 ANDOYER_G_RANGE = (1e-150, 1e150)
 
 
-class InvalidStateError(ValueError):
-    """The attitude or spin given cannot describe a rotation state."""
+#: Largest phase (rad) of the free flow that :meth:`RotationState.propagate_torque_free` evaluates: the
+#: fastest angular rate of the motion, G/A, times the largest |dt|. Below it the flow is exact for the
+#: double inputs (≤ 4e-16 rad against mpmath at 40+ digits up to 6.6e15 rad, tests/stress/test_degenerate.py);
+#: at 6.6e17 rad the double-double reduction by the period rounds and the attitude is O(1) wrong. Past
+#: 1e15 rad one ulp of dt already moves the attitude by ≥ 0.1 rad, so nothing of value is refused.
+MAX_FLOW_PHASE = 1e15
+
+
+class InvalidStateError(SpinorbitError, ValueError):
+    """The attitude or spin given cannot describe a rotation state, or this state has no such property."""
+
+
+class NonFiniteStateError(InvalidStateError, NonFiniteError):
+    """NaN or ±inf in the attitude, the spin, the Euler angles or the time offsets."""
 
 
 def _unresolved_gap_message(big_s, big_z, moments, what):
@@ -71,7 +84,7 @@ def _as_quaternion(q) -> np.ndarray:
     if q.shape != (4,):
         raise InvalidStateError(f"a quaternion has 4 components (w, x, y, z), scalar first; got shape {q.shape}.")
     if not np.all(np.isfinite(q)):
-        raise InvalidStateError(f"quaternion components must be finite; got {q.tolist()}.")
+        raise NonFiniteStateError(f"quaternion components must be finite; got {q.tolist()}.")
     # |q| of components beyond ~1e154 would overflow (a warning, then inf): such q are refused anyway.
     norm = float(np.linalg.norm(q)) if np.abs(q).max() <= 2.0 else float(np.abs(q).max())
     if abs(norm - 1.0) > QUATERNION_NORM_TOLERANCE:
@@ -87,7 +100,7 @@ def _as_rotation_matrix(matrix) -> np.ndarray:
     if m.shape != (3, 3):
         raise InvalidStateError(f"an attitude matrix is 3×3; got shape {m.shape}.")
     if not np.all(np.isfinite(m)):
-        raise InvalidStateError("attitude matrix entries must be finite.")
+        raise NonFiniteStateError(f"attitude matrix entries must be finite; got {m.tolist()}.")
     if np.abs(m).max() > 2.0:  # a rotation's entries are ≤ 1; R Rᵀ of huge entries would overflow
         raise InvalidStateError(
             f"the attitude matrix is not a rotation (largest entry {np.abs(m).max():.6g}, a rotation's are ≤ 1); "
@@ -102,21 +115,14 @@ def _as_rotation_matrix(matrix) -> np.ndarray:
     return m
 
 
-def _as_angular_velocity(omega) -> np.ndarray:
-    if isinstance(omega, u.Quantity):
-        try:
-            values = omega.to_value(RAD_PER_DAY, equivalencies=u.dimensionless_angles())
-        except u.UnitConversionError:
-            raise u.UnitTypeError(
-                f"angular velocity needs an angle per time unit (rad/s, deg/day); got {omega.unit!s}."
-            ) from None
-    else:
-        values = omega
-    values = np.asarray(values, dtype=float)
+def _as_angular_velocity(omega, name="angular_velocity") -> np.ndarray:
+    # a Quantity of an angle per time (frequencies refused: docs/conventions.md, "Units"); floats are rad/day
+    values = np.asarray(value_in(name, omega, RAD_PER_DAY, "[0.1, 0, 0.3] * u.rad / u.s", plain_unit=RAD_PER_DAY,
+                                 finite=False), dtype=float)
     if values.shape != (3,):
         raise InvalidStateError(f"the angular velocity is a 3-vector in body axes; got shape {values.shape}.")
     if not np.all(np.isfinite(values)):
-        raise InvalidStateError(f"angular velocity components must be finite; got {values.tolist()}.")
+        raise NonFiniteStateError(f"angular velocity components must be finite; got {values.tolist()}.")
     return values
 
 
@@ -164,6 +170,13 @@ class RotationState:
         self._body = body
         self._q = _as_quaternion(quaternion)
         self._omega = _as_angular_velocity(angular_velocity)
+        with np.errstate(over="ignore"):
+            momentum = body.moment_values * self._omega
+        if not np.all(np.isfinite(momentum)):
+            raise InvalidStateError(
+                f"the angular momentum I ω overflows float64 (moments {body.moment_values.tolist()} × spin "
+                f"{self._omega.tolist()} rad/day); give the moments and the spin in units nearer 1."
+            )
 
     # -- constructors --------------------------------------------------------------------------
     @classmethod
@@ -174,16 +187,18 @@ class RotationState:
     @classmethod
     def from_euler313(cls, body, phi, theta, psi, angular_velocity):
         """From passive 3-1-3 Euler angles (Quantities or radians): R = R3(ψ) R1(θ) R3(φ)."""
-        angles = [a.to_value(u.rad) if isinstance(a, u.Quantity) else float(a) for a in (phi, theta, psi)]
+        angles = [value_in(name, a, u.rad, "30 * u.deg", plain_unit=u.rad, shape=(), finite=False)
+                  for name, a in (("phi", phi), ("theta", theta), ("psi", psi))]
+        if not all(math.isfinite(a) for a in angles):
+            raise NonFiniteStateError(f"Euler angles must be finite; got phi, theta, psi = {angles}.")
         return cls.from_matrix(body, _rotations.euler313_to_attitude(*angles), angular_velocity)
 
     @classmethod
     def from_angular_momentum(cls, body, quaternion, angular_momentum):
         """From the body angular momentum (user axes) instead of the angular velocity: ω = I⁻¹ M."""
-        if isinstance(angular_momentum, u.Quantity):
-            values = angular_momentum.to_value(body.moment_unit * RAD_PER_DAY, equivalencies=u.dimensionless_angles())
-        else:
-            values = np.asarray(angular_momentum, dtype=float)
+        values = value_in("angular_momentum", angular_momentum, body.moment_unit * RAD_PER_DAY,
+                          f"[0.1, 0, 0.3] * {body.moment_unit * RAD_PER_DAY!r}", plain_unit=body.moment_unit * RAD_PER_DAY,
+                          finite=False)
         return cls(body, quaternion, np.asarray(values, dtype=float) / body.moment_values)
 
     # -- what users read -----------------------------------------------------------------------
@@ -214,6 +229,7 @@ class RotationState:
     @property
     def angular_momentum_direction(self) -> np.ndarray:
         """Unit vector of the angular momentum in the inertial frame (fixed in free rotation)."""
+        self._rotating_momentum()
         inertial = self.attitude_matrix.T @ (self._body.moment_values * self._omega)
         return inertial / np.linalg.norm(inertial)
 
@@ -237,12 +253,30 @@ class RotationState:
         attitude = p @ self.attitude_matrix
         return np.concatenate([_rotations.attitude_to_quat(np.ascontiguousarray(attitude)), p @ self._omega])
 
+    def _rotating_momentum(self) -> np.ndarray:
+        """The principal-axis momentum, checked once for every property that describes the rotation.
+
+        Raises InvalidStateError for zero spin (no mode, periods, E/E0, direction or elements) and for
+        G = |M| outside :data:`ANDOYER_G_RANGE`, where the squares of the momentum in the maps under-
+        or overflow (the properties would be NaN).
+        """
+        _, momentum = self.principal_attitude_and_momentum()
+        if not np.any(momentum):
+            raise InvalidStateError("the body is not rotating (zero spin): it has no rotation mode, periods, E/E0, "
+                                    "momentum direction or elements. Give a non-zero angular velocity.")
+        big_g = float(np.sqrt(np.sum((momentum / np.abs(momentum).max()) ** 2)) * np.abs(momentum).max())
+        if not ANDOYER_G_RANGE[0] <= big_g <= ANDOYER_G_RANGE[1]:
+            raise InvalidStateError(
+                f"the angular momentum |I ω| = {big_g!r} (moment unit × rad/day) is outside [{ANDOYER_G_RANGE[0]:g}, "
+                f"{ANDOYER_G_RANGE[1]:g}], where its square under- or overflows in float64; give the moments and the "
+                "spin in units that bring it nearer 1 (e.g. moment ratios, rad/day)."
+            )
+        return momentum
+
     def _motion(self):
         big_a, big_b, big_c = self._body.principal_moments
         ic = _canonical.inertia_constants(big_a, big_b, big_c)
-        _, momentum = self.principal_attitude_and_momentum()
-        if not np.any(momentum):
-            raise InvalidStateError("the body is not rotating (zero spin): it has no rotation mode or elements.")
+        momentum = self._rotating_momentum()
         mo, flip = _canonical.motion_from_momentum(momentum[0], momentum[1], momentum[2], ic)
         return mo, flip, momentum, (big_a, big_b, big_c)
 
@@ -267,7 +301,7 @@ class RotationState:
 
         1 for principal-axis rotation about C; C/A for rotation about A; C/B on the separatrix.
         """
-        _, momentum = self.principal_attitude_and_momentum()
+        momentum = self._rotating_momentum()
         return float(_summary.energy_ratio(*momentum, *self._body.principal_moments))
 
     @property
@@ -287,6 +321,9 @@ class RotationState:
         """
         mo, _, momentum, moments = self._motion()
         rotation, precession = _summary.periods(mo, *momentum, *moments)  # the one definition (core)
+        if math.isnan(rotation) or math.isnan(precession):  # inf is a period (separatrix); NaN never is
+            raise InvalidStateError(f"the periods of this state are not computable in float64 (G = "
+                                    f"{float(mo[_canonical.MO_G])!r}); express the moments and spin nearer 1.")
         return rotation * u.day, precession * u.day
 
     @property
@@ -346,6 +383,7 @@ class RotationState:
         :meth:`canonical_elements`. At J = 0 (spin exactly about C) only l + g is defined; the split
         follows ``spinorbit.core.elements.andoyer.andoyer_from_attitude``.
         """
+        self._rotating_momentum()
         frame = self._reference_frame(reference)
         attitude, momentum = self.principal_attitude_and_momentum()
         return tuple(float(x) for x in _andoyer.andoyer_from_attitude(attitude @ frame.T, momentum))
@@ -437,11 +475,23 @@ class RotationState:
         angular_velocity : Quantity, shape (N, 3)
             Body angular velocity in user axes (rad/day).
         """
-        times = dt.to_value(u.day) if isinstance(dt, u.Quantity) else np.asarray(dt, dtype=float)
+        times = value_in("dt", dt, u.day, "[0, 1, 2] * u.day", plain_unit=u.day, finite=False)
         times = np.atleast_1d(np.asarray(times, dtype=float))
-        if times.ndim != 1 or not np.all(np.isfinite(times)):
-            raise ValueError("dt must be a finite scalar or 1-D array of time offsets.")
+        if times.ndim != 1:
+            raise ValueError(f"dt must be a scalar or 1-D array of time offsets; got shape {times.shape}.")
+        if not np.all(np.isfinite(times)):
+            first = float(times[~np.isfinite(times)][0])
+            raise NonFiniteStateError(f"dt must hold finite time offsets; got {first!r} among {times.size} values.")
         attitude, momentum = self.principal_attitude_and_momentum()
+        if np.any(momentum):  # at rest the flow is the constant state (exact); else check magnitude and phase
+            momentum = self._rotating_momentum()
+            phase = float(np.linalg.norm(momentum)) / self._body.principal_moments[0] * float(np.abs(times).max())
+            if not phase <= MAX_FLOW_PHASE:
+                raise InvalidStateError(
+                    f"dt up to {float(np.abs(times).max())!r} d is beyond the free flow's domain: the fastest angle "
+                    f"of this motion turns by {phase:.3g} rad > {MAX_FLOW_PHASE:g} rad, where one ulp of dt already "
+                    "moves the attitude by more than 0.1 rad. Propagate from a later state, or shorten dt."
+                )
         p = self._body.to_principal
         principal_q, principal_m = _torque_free.torque_free_states(
             _rotations.attitude_to_quat(attitude), momentum, *self._body.principal_moments, times,

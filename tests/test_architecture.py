@@ -29,7 +29,7 @@ CORE_BASE = ("spinorbit.core.jit", "spinorbit.core.errors")
 
 #: The layer above the core, lowest first (the core below them all).
 UPPER_LAYERS = (
-    ("bridge", ("spinorbit.body", "spinorbit.state", "spinorbit.state_table", "spinorbit.time",
+    ("bridge", ("spinorbit.quantities", "spinorbit.body", "spinorbit.state", "spinorbit.state_table", "spinorbit.time",
                 "spinorbit.frames", "spinorbit.ephemeris", "spinorbit.lunar_librations", "spinorbit.special",
                 "spinorbit.orbital_elements", "spinorbit.pole")),
     ("runs", ("spinorbit.runs",)),

@@ -52,12 +52,14 @@ def test_checkpoint_round_trip_keeps_bits_and_settings(tmp_path):
 @pytest.mark.parametrize("damage, pattern", [
     (lambda b: b[:-7], "truncated: the header promises"),
     (lambda b: b[:30], "truncated inside its header"),
-    (lambda b: b[:-1] + bytes([b[-1] ^ 1]), "corrupted: the SHA-256"),
+    (lambda b: b[:-73] + bytes([b[-73] ^ 1]) + b[-72:], "corrupted: the SHA-256"),  # last payload byte
+    (lambda b: b[:-1] + bytes([b[-1] ^ 1]), "no valid checksum line"),
     (lambda b: b + b"x", "longer than written"),
     (lambda b: b"", "empty file"),
     (lambda b: b"PK\x03\x04" + b[4:], "not a spinorbit checkpoint"),
-    (lambda b: b.replace(b'"format_version": 1', b'"format_version": 9'), "format version 9"),
-    (lambda b: b.replace(b'"sha256"', b'"sha257"'), "corrupted header"),
+    (lambda b: b.replace(b'"format_version": 2', b'"format_version": 9'), "format version 9"),
+    # the checksum covers the header too (format version 2): an edited key is caught by it
+    (lambda b: b.replace(b'"payload_bytes"', b'"payload_bytez"'), "corrupted: the SHA-256"),
 ])
 def test_damaged_checkpoints_raise_checkpoint_error_saying_what(tmp_path, damage, pattern):
     path = tmp_path / "a.ckpt"

@@ -330,7 +330,7 @@ def test_toutatis_torque_free_when_the_tolerance_allows(capsys):
 @pytest.mark.parametrize("args, words", [
     (["apophis", "--span", "-1", "d"], "--span expects a positive duration"),
     (["apophis", "--span", "1", "kg"], "--span expects a time"),
-    (["toutatis", "--tolerance", "1", "m"], "--tolerance expects a angle"),
+    (["toutatis", "--tolerance", "1", "m"], "--tolerance expects an angle"),
     (["toutatis", "--perturbers", "vulcan"], "vulcan"),
     (["toutatis", "--n-times", "1"], "--n-times expects between 2"),
 ])

@@ -5,6 +5,8 @@ import math
 import numpy as np
 import pytest
 
+from spinorbit.core.errors import WorkLimitError
+
 from spinorbit.core.dynamics.equations import inertial_angular_momentum, make_model, rhs, total_energy
 from spinorbit.core.integrators.quaternion import IntegrationError, integrate_quaternion
 from spinorbit.core.integrators.taylor import (
@@ -244,8 +246,12 @@ def test_sampled_perturber_outside_its_span_is_refused():
 
 
 def test_step_cap_raises_integration_error():
-    with pytest.raises(IntegrationError, match="max_steps"):
+    # Over the cap by the estimate made before starting (issue 14): refused up front, naming max_steps.
+    with pytest.raises(WorkLimitError, match="max_steps = 3"):
         integrate_taylor(Y0, 0.0, [100.0], make_model(TRIAXIAL), max_steps=3)
+    # Within the estimate (a lower bound, 41 steps here) but over the cap in fact: the kernel stops.
+    with pytest.raises(IntegrationError, match="max_steps"):
+        integrate_taylor(Y0, 0.0, [100.0], make_model(TRIAXIAL), max_steps=60)
 
 
 @pytest.mark.parametrize("kwargs, match", [(dict(n_steps=0), "n_steps"), (dict(order=0), "order"),

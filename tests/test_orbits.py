@@ -88,25 +88,25 @@ def test_elements_to_state_matches_rebounds_converter(e, mean_anomaly):
 
 
 def test_jpl_elements_give_horizons_icrf_state_in_jpls_ecliptic():
-    """JPL#218 prints its osculating elements with the ICRF state. Through "ecliptic-jpl" (IAU 1976
-    obliquity, no frame bias) they give the state to 0.7 m (measured; 5 m allowed: the elements'
-    16 digits); through astropy's ecliptic ("ecliptic", IAU 2006 + frame bias) 31 km off — the frame
-    matters at close-approach precision, and the test fails if the two frames are mixed up."""
+    """JPL#218 prints its osculating elements with the ICRF state. Through "ecliptic" (the default:
+    IAU 1976 obliquity, no frame bias) they give the state to 0.7 m (measured; 5 m allowed: the
+    elements' 16 digits); through astropy's ecliptic ("ecliptic-iau2006", IAU 2006 + frame bias) 31 km
+    off — the frame matters at close-approach precision, and the test fails if the two are mixed up."""
     el = APOPHIS_HORIZONS.elements
     args = (el["A"], el["EC"], *(math.radians(el[k]) for k in ("IN", "OM", "W", "MA")), 0.01720209895**2)
-    r_jpl, _ = elements_to_state(*args, frame="ecliptic-jpl")
-    r_iau, _ = elements_to_state(*args, frame="ecliptic")
+    r_jpl, _ = elements_to_state(*args, frame="ecliptic")
+    r_iau, _ = elements_to_state(*args, frame="ecliptic-iau2006")
     published = np.array(APOPHIS_HORIZONS.position_au)
     assert np.linalg.norm(r_jpl - published) * IAU_AU_KM < 5e-3
     assert 20.0 < np.linalg.norm(r_iau - published) * IAU_AU_KM < 50.0
 
 
 def test_ecliptic_elements_agree_with_astropys_ecliptic():
-    """The "ecliptic" frame is astropy's BarycentricMeanEcliptic(J2000): the ecliptic vector of the
+    """The "ecliptic-iau2006" frame is astropy's BarycentricMeanEcliptic(J2000): the ecliptic vector of the
     elements, turned to ICRS by astropy, is the state's position to 1e-15 relative (rounding)."""
     args = (2.53, 0.63, math.radians(0.45), math.radians(124.3), math.radians(278.7), 0.09, 2.96e-4)
     r_ecliptic, _ = elements_to_state(*args, frame="icrf")  # "icrf" applies no frame turn
-    r_icrf, _ = elements_to_state(*args, frame="ecliptic")
+    r_icrf, _ = elements_to_state(*args, frame="ecliptic-iau2006")
     coord = SkyCoord(CartesianRepresentation(*r_ecliptic * u.au), frame=BarycentricMeanEcliptic(equinox="J2000"))
     by_astropy = coord.transform_to(ICRS()).cartesian.xyz.to_value(u.au)
     assert np.linalg.norm(by_astropy - r_icrf) < 1e-15 * np.linalg.norm(r_icrf) * 4
@@ -191,7 +191,7 @@ def test_apophis_from_the_published_state_and_from_its_elements_meet_the_2029_en
                              name="Apophis", non_gravitational=nongrav)
     el = APOPHIS_HORIZONS.elements
     elements = Orbit.from_elements(el["A"] * u.au, el["EC"], el["IN"] * u.deg, el["OM"] * u.deg, el["W"] * u.deg,
-                                   el["MA"] * u.deg, APOPHIS_HORIZONS.epoch, frame="ecliptic-jpl", name="Apophis",
+                                   el["MA"] * u.deg, APOPHIS_HORIZONS.epoch, frame="ecliptic", name="Apophis",
                                    non_gravitational=nongrav)
     window = (APOPHIS_2029.time_tdb - 1 * u.day, APOPHIS_2029.time_tdb + 1 * u.day)
     t_state, d_state = state.closest_approach("earth", *window)

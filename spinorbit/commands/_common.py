@@ -15,60 +15,133 @@ PROGRESS_DELAY_S = 2.0
 PROGRESS_REDRAW_S = 0.2
 
 
-def quantity(option: str, words, default_unit: str, physical_type: str, example: str):
-    """Read ``--span 100 d`` / ``--span "100 d"`` / ``--span 100`` (default unit) as a Quantity.
+def number(text: str) -> float:
+    """An argparse ``type``: a finite float that float64 holds as typed (no overflow to inf, no underflow to 0)."""
+    import argparse
+    import math
 
-    Raises :class:`~spinorbit.cli.CommandError` naming the option, the expected kind of quantity and
-    what arrived.
-    """
-    import astropy.units as u
-
-    text = " ".join(words) if isinstance(words, (list, tuple)) else str(words)
     try:
-        value = u.Quantity(text)
-    except (TypeError, ValueError):
-        value = None
-    if value is not None and value.unit == u.dimensionless_unscaled:
-        value = value.value * u.Unit(default_unit)
-    if value is None or value.isscalar is False or value.unit.physical_type != physical_type:
-        raise CommandError(
-            f"{option} expects a {physical_type} such as '{example}' (a number alone means {default_unit}); "
-            f"got '{text}'."
-        )
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got '{text}'") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got '{text}'")
+    mantissa = text.strip().lower().split("e")[0]
+    if value == 0.0 and any(digit in mantissa for digit in "123456789"):
+        raise argparse.ArgumentTypeError(f"expected a number float64 can hold, got '{text}', which underflows to 0")
     return value
 
 
-def unit(option: str, text: str, physical_type: str, example: str):
-    """An astropy unit of the given physical type, or a :class:`~spinorbit.cli.CommandError`."""
-    import astropy.units as u
+def quantity(option: str, words, default_unit: str, physical_type: str, example: str):
+    """Read ``--span 100 d`` / ``--span "100 d"`` / ``--span 100`` (default unit) as a Quantity.
+
+    The checks are :func:`spinorbit.quantities.parse_quantity`'s, the API's own: one finite number
+    and a unit of ``physical_type`` (that of ``default_unit``). Raises
+    :class:`~spinorbit.cli.CommandError` naming the option, the expected kind of quantity and what
+    arrived.
+    """
+    from spinorbit.quantities import QuantityInputError, parse_quantity
 
     try:
-        result = u.Unit(text)
-    except (TypeError, ValueError):
-        result = None
-    if result is None or result.physical_type != physical_type:
-        raise CommandError(f"{option} expects a unit of {physical_type} such as {example}; got '{text}'.")
-    return result
+        return parse_quantity(option, words, default_unit, example)
+    except QuantityInputError as error:
+        raise CommandError(str(error)) from None
 
 
-def check_output_path(option: str, path: str) -> None:
-    """Fail before a long run, not after it, if ``path`` cannot be written."""
+def unit(option: str, text: str, physical_type: str, example: str):
+    """An astropy unit of the given physical type, or a :class:`~spinorbit.cli.CommandError`.
+
+    ``physical_type`` is "angular velocity", "time" or "angle"; a frequency given for an angular
+    velocity gets the advice of :mod:`spinorbit.quantities` (write ``cycle/d``).
+    """
+    from spinorbit.quantities import QuantityInputError, parse_unit
+
+    reference = {"angular velocity": "rad/d", "time": "d", "angle": "rad"}[physical_type]
+    try:
+        return parse_unit(option, text, reference, example)
+    except QuantityInputError as error:
+        raise CommandError(str(error)) from None
+
+
+#: What ``--output`` writes, by the file's extension (astropy's format names); anything else is refused.
+TABLE_FORMATS = {".ecsv": "ascii.ecsv", ".csv": "ascii.csv"}
+#: What ``--plot`` writes, by the file's extension (matplotlib's format names); anything else is refused.
+PLOT_FORMATS = {".png": "png", ".pdf": "pdf", ".svg": "svg"}
+#: The options that name files a command writes, and the formats each accepts (None: any name).
+OUTPUT_OPTIONS = {"--output": TABLE_FORMATS, "--plot": PLOT_FORMATS, "--checkpoint": None}
+
+
+def _format_of(option: str, path: str, formats: dict) -> str:
+    suffix = os.path.splitext(path)[1].lower()
+    if suffix not in formats:
+        raise CommandError(
+            f"{option} writes {' or '.join(sorted(formats))} files, chosen by the extension; got '{path}'. "
+            f"Name the file e.g. {os.path.splitext(path)[0] or 'out'}{next(iter(formats))}."
+        )
+    return formats[suffix]
+
+
+def table_format(path: str) -> str:
+    """astropy's format for an ``--output`` file: ECSV for .ecsv, CSV for .csv (else CommandError)."""
+    return _format_of("--output", path, TABLE_FORMATS)
+
+
+def plot_format(path: str) -> str:
+    """matplotlib's format for a ``--plot`` file: png, pdf or svg from the extension (else CommandError)."""
+    return _format_of("--plot", path, PLOT_FORMATS)
+
+
+def check_output_path(option: str, path: str, formats: dict | None = None) -> None:
+    """Fail before a long run, not after it, if ``path`` cannot be written or would destroy something.
+
+    Refused: a directory, a symbolic link (the atomic rename would replace the link, not the file it
+    points to: give the target's own path), an existing file that is not a regular file (a device
+    such as /dev/null, a pipe, a socket), a missing or unwritable directory, and (with ``formats``)
+    an extension the option does not write.
+    """
+    from spinorbit.runs.atomic import refuse_unsafe_target
+
+    try:
+        refuse_unsafe_target(path)
+    except OSError as error:
+        raise CommandError(f"{option}: will not write '{path}': {error.strerror}.") from None
     directory = os.path.dirname(os.path.abspath(path))
-    if os.path.isdir(path):
-        raise CommandError(f"{option} expects a file name; '{path}' is a directory. Give a file path, e.g. {path}/out.")
     if not os.path.isdir(directory):
         raise CommandError(
-            f"{option}: the directory '{directory}' does not exist; create it first or choose another path."
+            f"{option}: cannot write '{path}': the directory '{directory}' does not exist; create it first or "
+            "choose another path."
         )
     if not os.access(directory, os.W_OK):
-        raise CommandError(f"{option}: the directory '{directory}' is not writable; choose another path.")
+        raise CommandError(f"{option}: cannot write '{path}': the directory '{directory}' is not writable; choose "
+                           "another path.")
+    if formats is not None:
+        _format_of(option, path, formats)
+
+
+def check_output_paths(args) -> None:
+    """Every file option of ``args`` (--output, --plot, --checkpoint) can be written, and no two are one file.
+
+    ``--resume`` counts too: no output may overwrite the checkpoint a run resumes from (except
+    ``--checkpoint``, which continues it).
+    """
+    given = [(option, getattr(args, option[2:], None)) for option in OUTPUT_OPTIONS]
+    given = [(option, path) for option, path in given if path is not None]
+    for option, path in given:
+        check_output_path(option, path, OUTPUT_OPTIONS[option])
+    resume = getattr(args, "resume", None)
+    named = given + ([("--resume", resume)] if resume is not None else [])
+    seen = {}
+    for option, path in named:
+        key = os.path.realpath(path)
+        if key in seen and {seen[key], option} != {"--checkpoint", "--resume"}:
+            raise CommandError(f"{seen[key]} and {option} name the same file '{path}'; one would overwrite the "
+                               "other. Give each its own path.")
+        seen.setdefault(key, option)
 
 
 def check_outputs(args) -> None:
-    """Before a run: ``--output`` and ``--plot`` (when given) can be written, and ``--plot`` has matplotlib."""
-    for option, path in (("--output", args.output), ("--plot", args.plot)):
-        if path is not None:
-            check_output_path(option, path)
+    """Before a run: the output files can be written (:func:`check_output_paths`), and ``--plot`` has matplotlib."""
+    check_output_paths(args)
     if args.plot is not None:
         try:
             import matplotlib  # noqa: F401

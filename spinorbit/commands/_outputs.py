@@ -100,11 +100,3 @@ def _values(column, unit):
     import numpy as np
 
     return np.asarray(column.to_value(unit) if hasattr(column, "to_value") else column, dtype=float)
-
-
-def plot_format(path):
-    """The matplotlib format of ``path`` from its extension (png, pdf, svg; png otherwise)."""
-    import os
-
-    extension = os.path.splitext(path)[1].lower().lstrip(".")
-    return extension if extension in ("png", "pdf", "svg") else "png"

@@ -7,12 +7,14 @@ import contextlib
 import threading
 
 from spinorbit.cli import CommandError
-from spinorbit.commands._common import Progress, atomic_output, quantity
+from spinorbit.commands._common import Progress, atomic_output, plot_format, quantity, table_format
 
 #: Seconds of planning before its progress bar shows (issue 15: plans of long runs take tens of seconds).
 PLAN_PROGRESS_DELAY_S = 1.0
 #: Most output times a command accepts (each row builds a RotationState for the periods).
 MAX_TIMES = 100_000
+#: Closest output times accepted (days): a float of TDB days since J2000 resolves ~1e-12 d in 1992-2029.
+MIN_SPACING_DAYS = 1e-9
 
 
 def add_scene_arguments(parser: argparse.ArgumentParser, span_default: str, perturbers_default) -> None:
@@ -34,7 +36,7 @@ def add_scene_arguments(parser: argparse.ArgumentParser, span_default: str, pert
                      help="run the reference plan: every perturber, the orbits as given, nothing skipped")
     files = parser.add_argument_group("output files")
     files.add_argument("--output", metavar="FILE.ecsv", help="write the result table (time, attitude, spin, pole, "
-                       "obliquity, periods; docs/conventions.md 'Output tables') as ECSV")
+                       "obliquity, periods; docs/conventions.md 'Output tables') as ECSV (FILE.ecsv) or CSV (FILE.csv)")
     files.add_argument("--plot", metavar="FILE.png", help="plot periods, pole, obliquity and mode against the date, "
                        "encounters marked (needs matplotlib; .png, .pdf or .svg)")
 
@@ -44,12 +46,17 @@ def span_and_times(args, start, max_days: float):
     import astropy.units as u
     import numpy as np
 
+    tolerance(args)  # before the orbit is built: a wrong tolerance costs no N-body run
     span = quantity("--span", args.span, "d", "time", "4 d")
     days = span.to_value(u.day)
     if not 0 < days <= max_days:
         raise CommandError(f"--span expects a positive duration up to {max_days:g} d; got {' '.join(args.span)}.")
     if not 2 <= args.n_times <= MAX_TIMES:
         raise CommandError(f"--n-times expects between 2 and {MAX_TIMES} output times; got {args.n_times}.")
+    if days / args.n_times < MIN_SPACING_DAYS:
+        raise CommandError(f"--span {' '.join(args.span)} with --n-times {args.n_times} spaces the output times by "
+                           f"{days / args.n_times:.3g} d, below the {MIN_SPACING_DAYS:g} d that TDB days since J2000 resolve; "
+                           "give a longer --span or fewer --n-times.")
     if args.end_only:
         return span, start + days * u.day
     # the first row is the start itself (the output schema), then evenly to the end
@@ -57,8 +64,16 @@ def span_and_times(args, start, max_days: float):
 
 
 def tolerance(args):
-    """The --tolerance angle."""
-    return quantity("--tolerance", args.tolerance, "arcsec", "angle", "1 arcsec")
+    """The --tolerance angle, in the range the Scene accepts (checked here, before the orbit is built)."""
+    from spinorbit.scene.inputs import SceneError, as_angle
+
+    value = quantity("--tolerance", args.tolerance, "arcsec", "angle", "1 arcsec")
+    try:
+        as_angle(value)
+    except SceneError:
+        raise CommandError(f"--tolerance expects an attitude angle between 1e-12 rad and 0.1 rad (2e-7 to 2e4 "
+                           f"arcsec); got '{' '.join(args.tolerance)}'.") from None
+    return value
 
 
 def run_scene(scene, args):
@@ -183,7 +198,7 @@ def write_outputs(args, result, name: str, title: str, period_unit: str) -> None
     if args.output is not None:
         table = ecsv_table(result, name, period_unit)
         with atomic_output("--output", args.output) as temporary:
-            table.write(temporary, format="ascii.ecsv", overwrite=True)
+            table.write(temporary, format=table_format(temporary), overwrite=True)
         print(f"wrote              {args.output} ({len(table)} rows)")
     if args.plot is not None:
         with atomic_output("--plot", args.plot) as temporary:
@@ -193,7 +208,7 @@ def write_outputs(args, result, name: str, title: str, period_unit: str) -> None
 
 def plot(result, path: str, title: str, period_unit: str = "h", name: str | None = None) -> None:
     """Periods, pole, obliquity and mode against the date, the run's closest approaches marked."""
-    from spinorbit.commands._outputs import plot_format, plot_rotation
+    from spinorbit.commands._outputs import plot_rotation
 
     plot_rotation(result.table, path, title, plot_format(name or path),
                   encounters=result.table.meta.get("closest_approaches"))

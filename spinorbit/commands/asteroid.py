@@ -59,8 +59,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     orbit.add_argument("--elements", nargs=6, type=float, metavar=("A_AU", "E", "INC", "RAAN", "ARGP", "M"),
                        help="a (au), e, and i, node, argument of perihelion, mean anomaly (deg)")
     orbit.add_argument("--epoch", metavar="TIME", help="the elements' epoch, TDB (ISO, e.g. 2020-01-01T00:00)")
-    orbit.add_argument("--frame", choices=("ecliptic", "ecliptic-jpl", "icrf"),
-                       help="what the elements' angles refer to (default ecliptic; ecliptic-jpl for JPL SBDB)")
+    orbit.add_argument("--frame", choices=("ecliptic", "ecliptic-iau2006", "icrf"),
+                       help="what the elements' angles refer to (default ecliptic: J2000 as JPL SBDB and the MPC give elements; ecliptic-iau2006: astropy's)")
     spin = parser.add_argument_group("body and spin state")
     spin.add_argument("--moments", nargs=3, type=float, metavar=("A", "B", "C"), help="principal moments (ratios)")
     spin.add_argument("--euler313", nargs=3, type=float, metavar=("PHI", "THETA", "PSI"),

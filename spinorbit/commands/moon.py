@@ -8,7 +8,8 @@ import os
 import sys
 
 from spinorbit.cli import CommandError
-from spinorbit.commands._common import Progress, atomic_output, check_output_path, check_outputs, quantity
+from spinorbit.commands._common import (Progress, atomic_output, check_output_path, check_outputs, number, plot_format,
+                                        quantity, table_format)
 
 #: The models (spinorbit.coupling.moon.MOON_MODELS, repeated so that --help does not import REBOUND).
 MOON_MODELS = ("de421", "rigid", "core-corrected")
@@ -45,6 +46,10 @@ examples:
 exit status: 0 on success; 2 with a one-line message if the input is wrong or an output file
 cannot be written (nothing is left half-written)."""
 
+#: Most comparison times (rows) a run may have (50 yr at a 0.1 d step). Each is an integration stop
+#: and a DE421 evaluation; more is refused before the run (with the count and the knob, --step).
+MAX_COMPARISON_TIMES = 200_000
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of ``spinorbit moon``."""
@@ -64,12 +69,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                           "(default: fully coupled); the de421 model is always one-way")
     files = parser.add_argument_group("output files")
     files.add_argument("--output", metavar="FILE.ecsv",
-                       help="write the Moon table (time, Euler angles, physical librations, DE421's, difference) as ECSV")
-    files.add_argument("--plot", metavar="FILE.png", help="plot the difference and the libration (needs matplotlib)")
+                       help="write the Moon table (time, Euler angles, physical librations, DE421's, difference) as ECSV (FILE.ecsv) or CSV (FILE.csv)")
+    files.add_argument("--plot", metavar="FILE.png", help="plot the difference and the libration (FILE.png, .pdf or .svg; needs matplotlib)")
     long_runs = parser.add_argument_group("long runs")
     long_runs.add_argument("--checkpoint", metavar="PATH",
                            help="write a checkpoint (orbits + rotation + results so far) to PATH during the run")
-    long_runs.add_argument("--checkpoint-every", type=float, default=60.0, metavar="SECONDS",
+    long_runs.add_argument("--checkpoint-every", type=number, default=60.0, metavar="SECONDS",
                            help="wall-clock seconds between checkpoints (default 60)")
     long_runs.add_argument("--resume", metavar="PATH",
                            help="continue the interrupted run whose checkpoint is PATH (same options); it "
@@ -122,7 +127,7 @@ def plot_comparison(comparison, path: str, title: str) -> None:
     bottom.set_ylabel("physical libration [arcsec]")
     bottom.set_xlabel(f"years since {_start_label(comparison.times[0])}")
     bottom.legend(fontsize="small")
-    figure.savefig(path, format="png", dpi=120)
+    figure.savefig(path, format=plot_format(path), dpi=120)
 
 
 def _start_label(day: float) -> str:
@@ -140,14 +145,15 @@ def _checkpoint_schedule(args, span_days: float, step_days: float, start: float 
     if start != 0.0:  # runs from J2000 keep the settings (and checkpoints) they always had
         settings["start_day"] = start
     if args.resume is not None and not os.path.isfile(args.resume):
-        raise CommandError(f"--resume expects an existing checkpoint file; '{args.resume}' does not exist. "
+        what = "is not a regular file" if os.path.exists(args.resume) else "does not exist"
+        raise CommandError(f"--resume expects an existing checkpoint file; '{args.resume}' {what}. "
                            "Give the --checkpoint file of the interrupted run.")
+    if not (math.isfinite(args.checkpoint_every) and args.checkpoint_every > 0):  # checked even when unused
+        raise CommandError(f"--checkpoint-every expects a positive number of seconds, got {args.checkpoint_every!r}.")
     path = args.checkpoint if args.checkpoint is not None else args.resume
     if path is None:
         return None, settings
     check_output_path("--checkpoint", path)
-    if not (math.isfinite(args.checkpoint_every) and args.checkpoint_every > 0):
-        raise CommandError(f"--checkpoint-every expects a positive number of seconds, got {args.checkpoint_every!r}.")
     return CheckpointSchedule(path, every_seconds=args.checkpoint_every), settings
 
 
@@ -160,6 +166,7 @@ def run(args) -> int:
         compare_model_with_de421,
         comparison_table,
     )
+    from spinorbit.runs.checkpoint import CheckpointError
 
     check_outputs(args)
     span = quantity("--span", args.span, "d", "time", "1 yr")
@@ -171,11 +178,15 @@ def run(args) -> int:
     except (EphemerisRangeError, OutputStepError, ValueError) as error:
         option = str(error).split(":", 1)[0]
         raise CommandError(f"--{option} {str(error).split(':', 1)[1].strip()}") from None
+    count = int(span_days / step + 1e-9) + 1
+    if count > MAX_COMPARISON_TIMES:
+        raise CommandError(f"--span {' '.join(args.span)} with --step {' '.join(args.step)} gives {count:.3g} "
+                           f"comparison times, more than {MAX_COMPARISON_TIMES}; "
+                           f"use a larger --step (at least {span_days / (MAX_COMPARISON_TIMES - 1):.3g} d) or a shorter --span.")
     schedule, settings = _checkpoint_schedule(args, span_days, step, start)
     if schedule is not None and args.model == "de421":
         raise CommandError("--checkpoint/--resume apply to the REBOUND-coupled models (--model rigid or "
                            "core-corrected); the de421 model runs at ≈ 0.1 s per simulated year and needs none.")
-    count = int(span_days / step + 1e-9) + 1
     progress = Progress(count, "integrating")
     done = [0]
 
@@ -187,6 +198,9 @@ def run(args) -> int:
         comparison = compare_model_with_de421(args.model, span_days, step, coupled=not args.one_way,
                                               progress=advance, schedule=schedule, resume=args.resume,
                                               settings=settings, start_day=start)
+    except CheckpointError as error:  # name the option whose file it is
+        option = "--checkpoint" if str(error).startswith("cannot write") else "--resume"
+        raise CommandError(f"{option}: {error}") from None
     except KeyboardInterrupt:
         if schedule is not None and os.path.exists(schedule.path):
             print(f"{args._prog}: the last checkpoint is '{schedule.path}'; continue with the same options and "
@@ -205,7 +219,7 @@ def run(args) -> int:
     if args.output is not None:
         table = comparison_table(comparison, args.model, args.model != "de421" and not args.one_way)
         with atomic_output("--output", args.output) as temporary:
-            table.write(temporary, format="ascii.ecsv", overwrite=True)
+            table.write(temporary, format=table_format(temporary), overwrite=True)
         print(f"wrote              {args.output} ({len(table)} rows)")
     if args.plot is not None:
         with atomic_output("--plot", args.plot) as temporary:

@@ -6,7 +6,8 @@ import argparse
 import math
 
 from spinorbit.cli import CommandError
-from spinorbit.commands._common import Progress, atomic_output, check_output_path, quantity, unit
+from spinorbit.commands._common import (Progress, atomic_output, check_output_paths, number, plot_format, quantity,
+                                        table_format, unit)
 
 NAME = "torque-free"
 SUMMARY = "exact torque-free rotation for given moments of inertia and spin"
@@ -38,16 +39,6 @@ CHUNK = 20_000
 MAX_TIMES = 10_000_000
 
 
-def _number(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got '{text}'") from None
-    if not math.isfinite(value):
-        raise argparse.ArgumentTypeError(f"expected a finite number, got '{text}'")
-    return value
-
-
 def _count(text: str) -> int:
     try:
         value = int(text)
@@ -62,11 +53,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of ``spinorbit torque-free``."""
     body = parser.add_argument_group("body and initial state")
     body.add_argument(
-        "--moments", nargs=3, type=_number, required=True, metavar=("IX", "IY", "IZ"),
+        "--moments", nargs=3, type=number, required=True, metavar=("IX", "IY", "IZ"),
         help="principal moments of inertia about the body x, y, z axes (kg m^2 or ratios; any order)",
     )
     body.add_argument(
-        "--omega", nargs=3, type=_number, required=True, metavar=("WX", "WY", "WZ"),
+        "--omega", nargs=3, type=number, required=True, metavar=("WX", "WY", "WZ"),
         help="body angular velocity components along x, y, z (unit: --omega-unit)",
     )
     body.add_argument(
@@ -74,7 +65,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="unit of --omega, any astropy angular-velocity unit: deg/day (default), rad/s, deg/h, ...",
     )
     body.add_argument(
-        "--euler313", nargs=3, type=_number, default=(0.0, 0.0, 0.0), metavar=("PHI", "THETA", "PSI"),
+        "--euler313", nargs=3, type=number, default=(0.0, 0.0, 0.0), metavar=("PHI", "THETA", "PSI"),
         help="initial attitude, passive 3-1-3 Euler angles in degrees (default: 0 0 0, body = inertial axes)",
     )
     times = parser.add_argument_group("output times")
@@ -92,7 +83,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     spacing.add_argument("--n-times", type=_count, metavar="N", help="number of evenly spaced output times instead")
     files = parser.add_argument_group("output files")
     files.add_argument("--output", metavar="FILE.ecsv", help="write the table (time, attitude, spin, pole, periods; "
-                       "docs/conventions.md 'Output tables') as ECSV")
+                       "docs/conventions.md 'Output tables') as ECSV (FILE.ecsv) or CSV (FILE.csv)")
     files.add_argument("--plot", metavar="FILE.png", help="plot periods, pole and mode against the date "
                        "(needs matplotlib; .png, .pdf or .svg)")
 
@@ -112,7 +103,8 @@ def _offsets(args):
     count = math.floor(abs(span) / step + 1e-9) + 1
     if count > MAX_TIMES:
         raise CommandError(
-            f"--span/--step give {count} output times, more than {MAX_TIMES}; use a larger --step or --n-times."
+            f"--span {' '.join(args.span)} with --step {' '.join(args.step or ['1', 'd'])} gives {float(count):.3g} output times, "
+            f"more than {MAX_TIMES}; use a larger --step or --n-times."
         )
     return math.copysign(step, span) * np.arange(count)
 
@@ -219,7 +211,7 @@ def _table(args, state, epoch, offsets, quaternions, omegas, omega_unit):
 
 
 def _plot(table, path, name):
-    from spinorbit.commands._outputs import plot_format, plot_rotation
+    from spinorbit.commands._outputs import plot_rotation
 
     plot_rotation(table, path, f"torque-free rotation: {table.meta['mode']} {table.meta['sense']}", plot_format(name))
 
@@ -235,9 +227,7 @@ def _require_matplotlib():
 
 def run(args) -> int:
     """Run ``spinorbit torque-free``; return the exit status."""
-    for option, path in (("--output", args.output), ("--plot", args.plot)):
-        if path is not None:
-            check_output_path(option, path)
+    check_output_paths(args)
     if args.plot is not None:
         _require_matplotlib()
     offsets = _offsets(args)
@@ -250,7 +240,7 @@ def run(args) -> int:
     span = f"{offsets[-1]:g} d"
     if args.output is not None:
         with atomic_output("--output", args.output) as temporary:
-            table.write(temporary, format="ascii.ecsv", overwrite=True)
+            table.write(temporary, format=table_format(temporary), overwrite=True)
         print(f"wrote              {args.output} ({len(table)} rows over {span})")
     if args.plot is not None:
         with atomic_output("--plot", args.plot) as temporary:

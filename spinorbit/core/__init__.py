@@ -16,7 +16,7 @@ The stable entry points, importable from here (scripts written against them keep
   :func:`kepler_source`, :func:`sampled_source`, :func:`sampled_source_from_callable`;
 - each integrator: :func:`integrate_quaternion`, :func:`integrate_elements`, :func:`integrate_taylor`,
   :func:`integrate_splitting`, :func:`integrate_with_handover`, :func:`propagate_averaged`;
-- the errors :class:`SpinorbitError` and :class:`SingularElementsError`.
+- the errors :class:`SpinorbitError`, :class:`SingularElementsError` and :class:`NonFiniteError`.
 
 They load on first use (PEP 562), so importing one integrator does not import the others.
 """
@@ -41,6 +41,7 @@ _ENTRY_POINTS = {
     "propagate_averaged": "spinorbit.core.averaging.propagate",
     "SpinorbitError": "spinorbit.core.errors",
     "SingularElementsError": "spinorbit.core.errors",
+    "NonFiniteError": "spinorbit.core.errors",
 }
 
 __all__ = list(_ENTRY_POINTS)

@@ -82,15 +82,17 @@ def integrate_to_outputs(body, times, record, row_size: int, schedule: Checkpoin
     done, wall = 0, 0.0
     if resume is not None:
         checkpoint = Checkpoint.read(resume, kind=CHUNKED_RUN_KIND)
-        checkpoint.expect(resume, "settings", checkpoint.meta["settings"], settings)
-        if checkpoint.meta["times"] != times_id:  # the summary may coincide; the fingerprint decides
+        checkpoint.expect(resume, "settings", checkpoint.setting(resume, "settings", dict), settings)
+        if checkpoint.setting(resume, "times", str) != times_id:  # the summary may coincide; the fingerprint decides
             checkpoint.expect(resume, "output times", f"{checkpoint.meta['times_summary']} (SHA-256 "
                               f"{checkpoint.meta['times'][:12]}…)", f"{_summary(times)} (SHA-256 {times_id[:12]}…)")
         body_part = Checkpoint(kind="", arrays={k.removeprefix("body."): v for k, v in checkpoint.arrays.items()
                                                 if k.startswith("body.")}, meta=checkpoint.meta["body"])
         body = CoupledRigidBody.from_checkpoint(body_part)
-        done, wall = int(checkpoint.meta["done"]), float(checkpoint.meta["wall_seconds"])
-        rows[:done] = checkpoint.arrays["rows"]
+        done, wall = checkpoint.setting(resume, "done", int), checkpoint.setting(resume, "wall_seconds", float)
+        if not 0 < done < times.size:
+            checkpoint.expect(resume, "number of output times done", done, f"1 to {times.size - 1}")
+        rows[:done] = checkpoint.array(resume, "rows", np.float64, (done, rows.shape[1]))
         if progress is not None:
             progress(done)
     for i in range(done, times.size):

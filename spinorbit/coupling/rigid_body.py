@@ -18,6 +18,7 @@ from spinorbit.core.dynamics.equations import (
 from spinorbit.core.model.gravity_field import figure_force_function_and_gradient
 from spinorbit.coupling.rebound import (
     ExtraForces,
+    MissingBodyError,
     RotationHooks,
     attach_rotation_hooks,
     body_index,
@@ -232,6 +233,14 @@ class CoupledRigidBody:
         """
         arrays, meta = checkpoint.arrays, checkpoint.meta
         version = meta.get("content_version", 1)
+        if version == CONTENT_VERSION:  # a checksummed file may still have been edited by hand: its schema
+            where = "<coupled-body checkpoint>"
+            for name, dtype, shape in (("simulation", np.uint8, (None,)), ("rotation_state", np.float64, (7,)),
+                                       ("figure", np.float64, (None,)), ("perturber_degrees", np.int64, (None,)),
+                                       ("extra_forces", np.float64, (None,))):
+                checkpoint.array(where, name, dtype, shape)
+            for name, kind in (("body", str), ("perturbers", list), ("coupled", bool), ("particle_names", list)):
+                checkpoint.setting(where, name, kind)
         if version != CONTENT_VERSION:
             why = ("it records only the earth_j2/gr arguments of the constructor, not the forces installed "
                    "with install_extra_forces/set_nongravitational before the body was attached, so a resume "
@@ -248,8 +257,12 @@ class CoupledRigidBody:
         first_or_last_step = sim.integrator.first_or_last_step  # the binary's; attaching resets it
         if arrays["extra_forces"].size:
             reinstall_extra_forces(sim, ExtraForces.from_parameters(arrays["extra_forces"]))
-        body = cls(sim, meta["body"], arrays["figure"], arrays["rotation_state"], perturbers=meta["perturbers"],
-                   coupled=meta["coupled"], perturber_degrees=[int(d) for d in arrays["perturber_degrees"]])
+        try:
+            body = cls(sim, meta["body"], arrays["figure"], arrays["rotation_state"], perturbers=meta["perturbers"],
+                       coupled=meta["coupled"], perturber_degrees=[int(d) for d in arrays["perturber_degrees"]])
+        except MissingBodyError as error:  # names in the checkpoint that its own simulation lacks: edited or foreign
+            raise RestoreError(f"the coupled-body checkpoint names a body its simulation does not hold ({error}); "
+                               "the file was edited or belongs to another run. Start the run again.") from None
         body.hooks.resume_bs_controller(sim, first_or_last_step)
         return body
 

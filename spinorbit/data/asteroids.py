@@ -430,12 +430,12 @@ _TOUTATIS_SOURCE = ("JPL Small-Body Database osculating elements (ecliptic and e
                     "encyclopedia infoboxes, 4-5 digits (/work/shared/data/toutatis_orbit.json)")
 #: (4179) Toutatis: the two published element sets of the project's reference data
 #: (``../shared/data/toutatis_orbit.json``), keyed by the epoch's year. SBDB's ecliptic is JPL's
-#: (IAU 1976 obliquity): ``frame="ecliptic-jpl"``. The 2008 set, the nearer to 1992–2012, is the default.
+#: (IAU 1976 obliquity): ``frame="ecliptic"``. The 2008 set, the nearer to 1992–2012, is the default.
 TOUTATIS_ELEMENT_SETS = {
     "2008": OsculatingElements("Toutatis", Time(2454797.5, format="jd", scale="tdb"), 2.5321, 0.6288, 0.4460,
-                               124.30, 278.75, 5.1220, "ecliptic-jpl", _TOUTATIS_SOURCE + ", epoch 2008-11-27"),
+                               124.30, 278.75, 5.1220, "ecliptic", _TOUTATIS_SOURCE + ", epoch 2008-11-27"),
     "2016": OsculatingElements("Toutatis", Time(2457400.5, format="jd", scale="tdb"), 2.5344, 0.62938, 0.44712,
-                               124.37, 278.73, 281.88, "ecliptic-jpl", _TOUTATIS_SOURCE + ", epoch 2016-01-13"),
+                               124.37, 278.73, 281.88, "ecliptic", _TOUTATIS_SOURCE + ", epoch 2016-01-13"),
 }
 #: Toutatis' Earth approaches of the reference data: (date, distance au, published time of day or None,
 #: how it is known). The checks of ``tests/test_orbits.py`` say what is measured against each.

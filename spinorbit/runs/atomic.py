@@ -11,11 +11,12 @@ file is removed (after a kill, a hidden ``.<name>.*.tmp`` file may remain; it is
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import stat
 import tempfile
 
-__all__ = ["atomic_path", "write_bytes_atomically"]
+__all__ = ["atomic_path", "refuse_unsafe_target", "write_bytes_atomically"]
 
 
 def _default_mode(path: str) -> int:
@@ -49,6 +50,23 @@ def _fsync_path(path: str, directory: bool = False) -> None:
         os.close(handle)
 
 
+def refuse_unsafe_target(path: str) -> None:
+    """Raise ``OSError`` if replacing ``path`` would destroy something other than a regular file.
+
+    A rename over a symbolic link replaces the link (not the file it points to), over a device
+    such as ``/dev/null`` it removes the device node (as root), and over a directory it fails late.
+    These are refused before anything is written; the ``strerror`` says what to do.
+    """
+    if os.path.islink(path):
+        raise OSError(errno.ELOOP, "it is a symbolic link, which an atomic write would replace; give the target's "
+                      "own path or another name", path)
+    if os.path.isdir(path):
+        raise IsADirectoryError(errno.EISDIR, "it is a directory; give a file path", path)
+    if os.path.exists(path) and not stat.S_ISREG(os.stat(path).st_mode):
+        raise OSError(errno.EINVAL, "it exists and is not a regular file (a device, pipe or socket); give the path "
+                      "of a regular file", path)
+
+
 @contextlib.contextmanager
 def atomic_path(path):
     """Yield a temporary path next to ``path``; when the block succeeds, move it into place.
@@ -67,7 +85,8 @@ def atomic_path(path):
     Raises
     ------
     OSError
-        The directory cannot hold the temporary file, or the rename fails (the target is unchanged).
+        The target is a symbolic link, a directory or not a regular file (:func:`refuse_unsafe_target`),
+        the directory cannot hold the temporary file, or the rename fails (the target is unchanged).
 
     Notes
     -----
@@ -75,6 +94,7 @@ def atomic_path(path):
     crash the name points to complete data (POSIX rename semantics).
     """
     path = os.fspath(path)
+    refuse_unsafe_target(path)
     directory = os.path.dirname(os.path.abspath(path))
     name = os.path.basename(path)
     suffix = os.path.splitext(name)[1]

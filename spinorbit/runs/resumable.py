@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from spinorbit.runs.checkpoint import Checkpoint, CheckpointSchedule, fingerprint
+from spinorbit.runs.checkpoint import Checkpoint, CheckpointError, CheckpointSchedule, fingerprint
 from spinorbit.core.dynamics.validation import validate_state
 from spinorbit.core.integrators.elements import integrate_elements
 from spinorbit.core.integrators.quaternion import default_atol, integrate_quaternion
@@ -109,11 +109,17 @@ def integrate_resumable(method: str, y0, t0, t_out, model, chunk: float, schedul
     if resume is not None:
         checkpoint = Checkpoint.read(resume, kind=RESUMABLE_KIND)
         checkpoint.expect(resume, "inputs (fingerprint of y0, t0, t_out, model, method, options)",
-                          checkpoint.meta["run"], run_id)
-        done = int(checkpoint.meta["chunks_done"])
-        y = checkpoint.arrays["y"]
-        start = float(checkpoint.arrays["t"][0])
-        ys = checkpoint.arrays["ys"]
+                          checkpoint.setting(resume, "run", str), run_id)
+        done = checkpoint.setting(resume, "chunks_done", int)
+        if not 0 < done < boundaries.size:
+            raise CheckpointError(f"checkpoint '{resume}': chunks_done = {done}, this run has chunks 1 to "
+                                  f"{boundaries.size - 1}; the file was edited. Start the run again.")
+        y = checkpoint.array(resume, "y", np.float64, (y0.size,))
+        start = float(checkpoint.array(resume, "t", np.float64, (1,))[0])
+        ys = checkpoint.array(resume, "ys", np.float64, ys.shape)
+        if start != boundaries[done - 1] or not np.all(np.isfinite(y)):
+            raise CheckpointError(f"checkpoint '{resume}': its state at t = {start!r} is not this run's state at "
+                                  f"chunk {done} (t = {boundaries[done - 1]!r}); the file was edited. Start again.")
     for k in range(done, boundaries.size):
         end = boundaries[k]
         first = np.searchsorted(direction * t_out, direction * start, side="left" if k == 0 else "right")

@@ -17,6 +17,7 @@ import numpy as np
 from astropy import units as u
 from astropy.time import Time
 
+from spinorbit.core.errors import require_finite
 from spinorbit.scene.errors import SceneError
 from spinorbit.scene.orbit import Orbit
 from spinorbit.state import RotationState
@@ -40,7 +41,11 @@ def check_gm(kind, name, gm):
     if not isinstance(gm, u.Quantity) or gm.unit.physical_type != (u.m**3 / u.s**2).physical_type:
         raise SceneError(f"{kind} {name!r}: gm expects a Quantity in length³/time² such as 3.986e14 m3/s2; "
                          f"got {gm!r}.")
-    return float(gm.to_value(u.au**3 / u.day**2))
+    value = gm.to_value(u.au**3 / u.day**2)
+    require_finite(f"{kind} {name!r}: gm", value, "a finite G·M > 0 such as 3.986e14 m3/s2")
+    if np.ndim(value) != 0 or not value > 0:
+        raise SceneError(f"{kind} {name!r}: gm expects one positive G·M such as 3.986e14 m3/s2; got {gm!r}.")
+    return float(value)
 
 
 @dataclass(frozen=True)
@@ -63,6 +68,8 @@ class FixedPerturber:
     def __post_init__(self):
         check_gm("FixedPerturber", self.name, self.gm)
         position = self.position
+        if isinstance(position, u.Quantity):
+            require_finite(f"FixedPerturber {self.name!r}: position", position.value, "a finite 3-vector")
         if (not isinstance(position, u.Quantity) or position.unit.physical_type != "length"
                 or position.shape != (3,) or not np.all(np.isfinite(position.value)) or not np.any(position.value)):
             raise SceneError(f"FixedPerturber {self.name!r}: position expects a finite, non-zero length "

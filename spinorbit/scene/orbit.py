@@ -172,7 +172,7 @@ class Orbit:
             anomaly at ``epoch`` (each within ±360°).
         epoch : astropy.time.Time
             The elements' epoch (scalar, inside DE421's 1899-12-04 … 2200-02-01).
-        frame : {"ecliptic", "ecliptic-jpl", "icrf"}
+        frame : {"ecliptic", "ecliptic-iau2006", "icrf"}
             What the angles are referred to: the ecliptic and equinox J2000 of astropy (IAU 2006,
             default), JPL's (IAU 1976 obliquity, no frame bias: the frame of SBDB and Horizons
             elements; 0.05″ from the former) or the ICRF equator (:mod:`spinorbit.orbital_elements`).
@@ -222,7 +222,7 @@ class Orbit:
         position, velocity : Quantity, shape (3,)
             Length and speed, in the axes of ``frame``, relative to ``centre``.
         epoch : astropy.time.Time
-        frame : {"icrf", "ecliptic", "ecliptic-jpl"}
+        frame : {"icrf", "ecliptic", "ecliptic-iau2006"}
         centre : {"sun", "barycenter"}
             Heliocentric (default) or barycentric.
         name, non_gravitational, extra_forces

@@ -20,7 +20,7 @@ from astropy.table import QTable
 
 from spinorbit.scene.sampling import NoSamples, subset_samples
 from spinorbit.scene.tolerances import MAX_RTOL_RETRIES, refine, sampling_error_bound
-from spinorbit.state_table import OMEGA_COLUMNS, from_principal, quaternion_array, schema_meta, table_columns
+from spinorbit.state_table import OMEGA_COLUMNS, from_principal, quaternion_array, table_columns
 from spinorbit.time import time_from_tdb_days
 
 __all__ = ["attitude_angles", "result_table", "run_coupled", "run_one_way", "run_torque_free", "scene_orbit_normals"]

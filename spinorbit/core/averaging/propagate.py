@@ -33,7 +33,7 @@ import math
 
 import numpy as np
 
-from spinorbit.core.integrators.dop853 import dop853_scratch, dop853_step, landing_step
+from spinorbit.core.integrators.dop853 import DEFAULT_MAX_STEPS, dop853_scratch, dop853_step, landing_step
 from spinorbit.core.jit import jit
 from spinorbit.core.averaging.mean_equations import (
     MC_A,
@@ -54,7 +54,7 @@ from spinorbit.core.elements.canonical import (
     motion_from_elements,
 )
 from spinorbit.core.dynamics.equations import MODEL_PERTURBERS
-from spinorbit.core.dynamics.validation import validate_sampled_span, validate_state
+from spinorbit.core.dynamics.validation import check_step_budget, validate_sampled_span, validate_state
 from spinorbit.core.elements.equations import attitude_and_momentum, inertial_quaternion, reduce_phase
 from spinorbit.core.model.gravity_field import BODY_NMAX
 from spinorbit.core.integrators.elements import (
@@ -429,7 +429,7 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
                        osculating=False, hand_over=True, min_frequency_ratio=MIN_FREQUENCY_RATIO,
                        max_perturbation=MAX_PERTURBATION, min_separatrix_distance=MIN_SEPARATRIX_DISTANCE,
                        handover_chunk=None, rtol=1e-12, frame=None, mean0=None, anomaly=None,
-                       steps_per_turn=None):
+                       steps_per_turn=None, max_steps=DEFAULT_MAX_STEPS):
     """Propagate the rotation through mean canonical elements (averaged over the free rotation).
 
     Parameters
@@ -476,6 +476,9 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
     steps_per_turn : float, optional
         Steps per 2π of true anomaly (default STEPS_PER_ANOMALY_TURN) or, stepping in time, per
         2π/n (default STEPS_PER_TURN). Ignored when orbit-averaged.
+    max_steps : int
+        Cap on the steps of the mean equations: a run needing more than it by the estimate
+        span / max_step (a lower bound) is refused before the first step (WorkLimitError).
 
     Returns
     -------
@@ -486,6 +489,13 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
     t_out = validate_output_times(t0, t_out)
     model = np.ascontiguousarray(model, dtype=float)
     validate_sampled_span(model, t0, t_out)
+    span = abs(t_out[-1] - t0)
+    if max_step is None:
+        max_step = span / 64.0 if orbit_averaged else span
+    if not (math.isfinite(max_step) and max_step > 0.0):
+        raise ValueError(f"max_step: expected a finite step > 0 (time unit of the model), got {max_step!r}.")
+    # a lower bound (the orbital rate only shortens the steps), known before the first step
+    check_step_budget("propagate_averaged", span / max_step, max_steps, "raise max_step or shorten the span")
     moments = moments_of(model)
     ic = inertia_constants(*moments)
     if frame is None:
@@ -502,9 +512,6 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
         mean = osculating_to_mean(t0, elements_of_state(y0, model, frame), model, frame, ic)
     else:
         mean = np.array(mean0, dtype=float)
-    span = abs(t_out[-1] - t0)
-    if max_step is None:
-        max_step = span / 64.0 if orbit_averaged else span
     possible = steps_in_anomaly(model, kind)
     if anomaly and not possible:
         raise ValueError("anomaly=True needs one perturber on an elliptic Kepler orbit and the degree-2 closed "

@@ -48,7 +48,12 @@ import math
 
 import numpy as np
 
-from spinorbit.core.dynamics.validation import validate_output_times, validate_sampled_span, validate_state
+from spinorbit.core.dynamics.validation import (
+    validate_fixed_steps,
+    validate_output_times,
+    validate_sampled_span,
+    validate_state,
+)
 from spinorbit.core.elements.canonical import FLIP_A, FLIP_B, FLIP_C, MODE_UNIFORM, elements_from_state, inertia_constants
 from spinorbit.core.elements.equations import attitude_and_momentum, elements_rhs_into, inertial_quaternion, reduce_phase
 from spinorbit.core.errors import SingularElementsError
@@ -430,16 +435,16 @@ def integrate_elements_fixed_step_kernel(el0, t0, t1, n_steps, model, frame):
     return out
 
 
-def integrate_elements_fixed_step(y0, t0, t1, n_steps, model):
+def integrate_elements_fixed_step(y0, t0, t1, n_steps, model, max_steps=DEFAULT_MAX_STEPS):
     """(q, ω) at t1 after ``n_steps`` equal DOP853 steps on the canonical elements (order measurements).
 
     Parameters as :func:`integrate_elements`; no error control, phases not reduced (a short span).
+    ``n_steps`` above ``max_steps`` is refused before the first step (WorkLimitError).
     """
     y0 = validate_state(y0)
-    if int(n_steps) < 1:
-        raise ValueError(f"n_steps: expected a positive number of steps, got {n_steps!r}.")
+    t0, t1, n_steps = validate_fixed_steps("integrate_elements_fixed_step", t0, t1, n_steps, max_steps)
     model = np.ascontiguousarray(model, dtype=float)
     moments = np.array([model[BODY_A], model[BODY_B], model[BODY_C]])
     frame = reference_frame_for(y0, moments)
     el0 = elements_of_state(y0, model, frame)
-    return integrate_elements_fixed_step_kernel(el0, float(t0), float(t1), int(n_steps), model, frame)
+    return integrate_elements_fixed_step_kernel(el0, t0, t1, n_steps, model, frame)

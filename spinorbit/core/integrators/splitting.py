@@ -60,9 +60,11 @@ import math
 
 import numpy as np
 
+from spinorbit.core.errors import require_finite
 from spinorbit.core.jit import jit
 from spinorbit.core.dynamics.equations import MODEL_PERTURBERS, STATE_SIZE, force_function_and_torque_xyz
-from spinorbit.core.dynamics.validation import validate_sampled_span, validate_state
+from spinorbit.core.dynamics.validation import check_step_budget, validate_sampled_span, validate_state
+from spinorbit.core.integrators.dop853 import DEFAULT_MAX_STEPS
 from spinorbit.core.model.gravity_field import BODY_A, BODY_B, BODY_C
 from spinorbit.core.dynamics.validation import validate_output_times
 from spinorbit.core.elements.canonical import (
@@ -376,7 +378,7 @@ def integrate_splitting_kernel(y0, t0, t_out, model, step, drift_coeffs, kick_co
 
 
 def integrate_splitting(y0, t0, t_out, model, step, scheme="saba2", free_flow_setup="short",
-                        return_stats=False):
+                        return_stats=False, max_steps=DEFAULT_MAX_STEPS):
     """Integrate the rotational equations with a fixed-step symplectic splitting (free flow + kicks).
 
     Parameters
@@ -406,6 +408,9 @@ def integrate_splitting(y0, t0, t_out, model, step, scheme="saba2", free_flow_se
     return_stats : bool
         Also return a dict ``steps``, ``drifts`` (torque-free evaluations), ``kicks`` (torque
         evaluations).
+    max_steps : int
+        Cap on the number of steps; the count, |t_end − t0|/step plus one per output interval at most,
+        is known before the run, which is refused if it exceeds the cap (WorkLimitError).
 
     Returns
     -------
@@ -431,6 +436,7 @@ def integrate_splitting(y0, t0, t_out, model, step, scheme="saba2", free_flow_se
         step = float(step)
     except (TypeError, ValueError):
         raise ValueError(f"step: expected a positive number (time unit of the model), got {step!r}.") from None
+    require_finite("step", step, "a finite step > 0 (time unit of the model)")
     if not (math.isfinite(step) and step > 0.0):
         raise ValueError(
             f"step: expected a finite step > 0 (time unit of the model), got {step!r}; "
@@ -438,6 +444,9 @@ def integrate_splitting(y0, t0, t_out, model, step, scheme="saba2", free_flow_se
         )
     if scheme not in SCHEMES:
         raise ValueError(f"scheme: expected one of {sorted(SCHEMES)}, got {scheme!r}.")
+    # each output interval takes ⌈interval/step⌉ steps: at most span/step + one per interval
+    check_step_budget("integrate_splitting", abs(t_out[-1] - t0) / step + t_out.size, max_steps,
+                      "use a longer step or a shorter span")
     model = np.ascontiguousarray(model, dtype=float)
     big_a, big_b, big_c = model[BODY_A], model[BODY_B], model[BODY_C]
     if not (0.0 < big_a <= big_b <= big_c):

@@ -101,7 +101,8 @@ def pi_principal(s, c2, delta2, f_part, nk):
         rc_term = rc_from_difference(x, x + y_minus_x, y_minus_x)
         result = s * rc_term
         if g != 0.0:
-            result += g * (s * s2 / 3.0) * rj(c2, delta2, 1.0, one_g)
+            # (g s²)(s/3), not g (s³/3): s³ underflows for m > 1e200, where s ≤ 1/√m and g s² ≤ m s² ≤ 1
+            result += (g * s2) * (s / 3.0) * rj(c2, delta2, 1.0, one_g)
         return result
     if f_part != f_part:
         f_part = _carlson_f(s, c2, delta2)

@@ -49,6 +49,7 @@ import math
 
 import numpy as np
 
+from spinorbit.core.errors import require_finite
 from spinorbit.core.jit import jit
 
 #: Highest Stokes degree supported. Degree 4 is what the Moon-class problems need (DE421 stops at 4
@@ -151,6 +152,7 @@ def make_body(moments, mass=0.0, reference_radius=1.0, stokes_c=None, stokes_s=N
         non-positive radius, Stokes terms without a positive mass, or arrays of the wrong shape.
     """
     moments = np.asarray(moments, dtype=float)
+    require_finite("moments", moments, "3 finite principal moments (A, B, C)")
     if moments.shape != (3,) or not np.all(np.isfinite(moments)):
         raise ValueError(f"moments: expected 3 finite principal moments (A, B, C), got {moments!r}.")
     if np.any(moments <= 0):
@@ -167,6 +169,8 @@ def make_body(moments, mass=0.0, reference_radius=1.0, stokes_c=None, stokes_s=N
     # The triangle inequality C ≤ A + B of a real mass distribution is deliberately *not* enforced:
     # standard test bodies violate it (Hairer–Lubich–Wanner's I = (2, 1, 2/3)) and the equations of
     # motion do not need it.
+    require_finite("mass", float(mass), "a finite mass ≥ 0")
+    require_finite("reference_radius", float(reference_radius), "a finite positive length")
     if not (np.isfinite(mass) and mass >= 0):
         raise ValueError(f"mass: expected a finite mass ≥ 0, got {mass!r}.")
     if not (np.isfinite(reference_radius) and reference_radius > 0):

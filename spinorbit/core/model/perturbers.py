@@ -31,6 +31,7 @@ import math
 
 import numpy as np
 
+from spinorbit.core.errors import require_finite
 from spinorbit.core.jit import jit
 
 KIND_KEPLER = 0
@@ -392,6 +393,7 @@ class _Source:
 
 
 def _check_mu(mu):
+    require_finite("mu", mu, "G·M of the perturber > 0 (length³/time²)")
     if not (np.isfinite(mu) and mu > 0):
         raise ValueError(f"mu: expected G·M of the perturber > 0 (length³/time²), got {mu!r}.")
 
@@ -424,6 +426,7 @@ def kepler_source(mu, a, e, inc, node, argp, mean_anomaly, epoch=0.0, mu_orbit=N
     mu_orbit = mu if mu_orbit is None else mu_orbit
     _check_mu(mu_orbit)
     values = np.array([a, e, inc, node, argp, mean_anomaly, epoch], dtype=float)
+    require_finite("Kepler elements", values)
     if not np.all(np.isfinite(values)):
         raise ValueError(f"Kepler elements: expected finite numbers, got {values!r}.")
     if e < 0 or abs(e - 1.0) < 1e-12:
@@ -451,6 +454,7 @@ def fixed_source(mu, position):
     """A perturber at rest at ``position`` (inertial, relative to the body; length)."""
     _check_mu(mu)
     position = np.asarray(position, dtype=float)
+    require_finite("position", position, "a finite non-zero 3-vector")
     if position.shape != (3,) or not np.all(np.isfinite(position)) or not np.any(position):
         raise ValueError(f"position: expected a finite non-zero 3-vector, got {position!r}.")
     params = np.zeros(PARAM_SIZE)
@@ -479,6 +483,7 @@ def sampled_source(mu, times, positions, velocities):
             f"times: expected ≥ 2 strictly increasing sample times, got shape {times.shape}; sort them."
         )
     for name, arr in (("positions", positions), ("velocities", velocities)):
+        require_finite(name, arr, "finite sampled values")
         if arr.shape != (times.size, 3) or not np.all(np.isfinite(arr)):
             raise ValueError(f"{name}: expected finite values of shape ({times.size}, 3), got {arr.shape}.")
     xv = np.hstack([positions, velocities])

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 import rebound
 
+from spinorbit.core.errors import SpinorbitError
 from spinorbit.coupling.rebound.memory_layout import PARTICLE_M, PARTICLE_X, particle_table
 from spinorbit.ephemeris import KNOWN_BODIES, barycentric_state_au, de421_constants, resolve_body
 from spinorbit.time import tdb_day_and_fraction
@@ -27,7 +28,7 @@ __all__ = ["DEFAULT_BODIES", "MissingBodyError", "simulation_from_de421", "body_
 DEFAULT_BODIES = tuple(body for body in KNOWN_BODIES if body != "earth-moon barycenter")
 
 
-class MissingBodyError(LookupError):
+class MissingBodyError(SpinorbitError, LookupError):
     """A body the caller named is not in the REBOUND simulation."""
 
 

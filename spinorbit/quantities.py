@@ -1,0 +1,183 @@
+"""Quantity arguments checked and converted in one place, for the API and the command line alike.
+
+Every Quantity argument of the units layer, and every option of the command line that takes a
+quantity, goes through :func:`value_in`: a wrong physical type is refused with the argument's name,
+the unit expected and what arrived; NaN and ±inf are refused where a finite value is needed. The
+command line parses its text with :func:`parse_quantity` and :func:`parse_unit`, which end in the
+same checks, so ``RotationState(..., 1 * u.Hz)`` and ``--omega-unit Hz`` give the same refusal.
+
+Rotation rates given as frequencies (``docs/conventions.md``, "Units"): a unit of physical type
+*frequency* (``u.Hz``, ``1 / u.day``) is refused, because astropy's ``dimensionless_angles``
+equivalency would silently read 1 Hz as 1 rad/s while "1 Hz" of rotation usually means one turn
+per second (2π rad/s). Turns per time are written with astropy's ``u.cycle`` (``u.cycle / u.s``,
+``--omega-unit cycle/d``), which converts with the factor 2π; radians and degrees per time as usual.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from astropy import units as u
+
+__all__ = ["QuantityInputError", "finite_values", "parse_quantity", "parse_unit", "value_in"]
+
+
+class QuantityInputError(u.UnitTypeError):
+    """A Quantity argument of the wrong physical type, a frequency given for a rotation rate, or unreadable text.
+
+    A subclass of astropy's ``UnitTypeError`` (itself a ``TypeError``), so code that catches astropy's
+    error keeps working.
+    """
+
+
+def _kind(unit) -> str:
+    """The short name of a unit's physical type ("angular velocity", not astropy's three aliases)."""
+    return str(u.Unit(unit).physical_type).split("/")[-1]
+
+
+def _expected(unit) -> str:
+    rate = ", an angle per time" if _kind(unit) == "angular velocity" else ""
+    return f"{_kind(unit)} units ({unit}{rate})"
+
+
+def _arrived(value) -> str:
+    if isinstance(value, u.Quantity):
+        return f"{value!s} (physical type {_kind(value.unit)})"
+    return f"{value!r} ({type(value).__name__})"
+
+
+def _frequency_advice(name: str, value, unit: u.UnitBase) -> str:
+    time_unit = (u.rad / unit).to_string()  # the time unit of the expected rate: d for rad / d
+    return (
+        f"{name}: got {value!s}, a frequency, where an angular velocity (an angle per time, {unit}) is needed. A frequency "
+        "is ambiguous for a rotation (1 Hz = 1 rad/s by astropy's dimensionless conversion, but one turn per second is "
+        f"2π rad/s), so spinorbit refuses it. Write turns per time with u.cycle (e.g. cycle / {time_unit}, converted "
+        f"with 2π) or an angle per time (rad / {time_unit}, deg / {time_unit})."
+    )
+
+
+def value_in(name: str, value, unit, example: str, *, plain_unit=None, finite: bool = True,
+             shape: tuple | None = None) -> np.ndarray | float:
+    """``value`` as plain floats in ``unit``, after checking its physical type.
+
+    Parameters
+    ----------
+    name : str
+        The argument or option, as the user wrote it (``"angular_velocity"``, ``"--span"``).
+    value : Quantity or array_like
+        A Quantity of ``unit``'s physical type; plain numbers are read in ``plain_unit``.
+    unit : str or astropy unit
+        The unit the caller works in (``rad / day``, ``day``, ``kg m2``).
+    example : str
+        A correct value to show in the message (``"0.1 * u.rad / u.s"``).
+    plain_unit : astropy unit, optional
+        The unit of plain numbers; None: plain numbers are refused.
+    finite : bool
+        Refuse NaN and ±inf (default).
+    shape : tuple, optional
+        The shape the value must have (``()`` for a scalar).
+
+    Returns
+    -------
+    float or ndarray
+        A float for a scalar, else an ndarray.
+
+    Raises
+    ------
+    QuantityInputError
+        Wrong physical type (a frequency where a rotation rate is needed gets its own advice), a
+        plain number where a Quantity is needed, or text that is not a number.
+    ValueError
+        NaN/inf with ``finite``, or the wrong shape.
+    """
+    unit = u.Unit(unit)
+    if isinstance(value, u.Quantity):
+        if unit.physical_type == "angular velocity" and value.unit.physical_type == "frequency":
+            raise QuantityInputError(_frequency_advice(name, value, unit))
+        try:
+            values = value.to_value(unit, equivalencies=u.dimensionless_angles())
+        except u.UnitConversionError:
+            raise QuantityInputError(
+                f"{name}: expected a Quantity in {_expected(unit)} such as {example}; got "
+                f"{_arrived(value)}."
+            ) from None
+        if unit.physical_type != "dimensionless" and value.unit.physical_type != unit.physical_type:
+            # dimensionless_angles lets rad/day pass as 1/day; only the right physical type may pass
+            raise QuantityInputError(
+                f"{name}: expected a Quantity in {_expected(unit)} such as {example}; got "
+                f"{_arrived(value)}."
+            )
+    elif plain_unit is None:
+        raise QuantityInputError(f"{name}: expected a Quantity in {_expected(unit)} such as "
+                                 f"{example}; got {_arrived(value)}.")
+    else:
+        try:
+            values = np.asarray(value, dtype=float) * u.Unit(plain_unit).to(unit)
+        except (TypeError, ValueError):
+            raise QuantityInputError(f"{name}: expected numbers (in {plain_unit}) or a Quantity such as {example}; "
+                                     f"got {_arrived(value)}.") from None
+    values = np.asarray(values, dtype=float)
+    if shape is not None and values.shape != tuple(shape):
+        what = "a scalar" if shape == () else f"shape {tuple(shape)}"
+        raise ValueError(f"{name}: expected {what} such as {example}; got shape {values.shape}.")
+    if finite:
+        finite_values(name, values, example)
+    return float(values) if values.ndim == 0 else values
+
+
+def finite_values(name: str, values, example: str = "") -> None:
+    """Raise ``ValueError`` naming ``name`` and the first non-finite entry if any entry is NaN or ±inf."""
+    values = np.asarray(values, dtype=float)
+    bad = ~np.isfinite(values)
+    if np.any(bad):
+        first = float(values[bad].flat[0])
+        raise ValueError(f"{name}: expected finite numbers{f' such as {example}' if example else ''}; got "
+                         f"{first!r}{f' among {values.size} values' if values.size > 1 else ''}.")
+
+
+def parse_unit(option: str, text: str, unit, example: str) -> u.UnitBase:
+    """An astropy unit of ``unit``'s physical type from command-line text (the checks of :func:`value_in`)."""
+    try:
+        result = u.Unit(text)
+    except (TypeError, ValueError):
+        raise QuantityInputError(f"{option} expects a unit of {_kind(unit)} such as {example}; got "
+                                 f"'{text}', which astropy cannot read.") from None
+    try:
+        value_in(option, 1.0 * result, unit, example)
+    except QuantityInputError:
+        if _kind(unit) == "angular velocity" and _kind(result) == "frequency":
+            raise QuantityInputError(_frequency_advice(option, f"'{text}'", u.Unit(unit))) from None
+        raise QuantityInputError(f"{option} expects a unit of {_kind(unit)} such as {example}; got '{text}' "
+                                 f"(physical type {_kind(result)}).") from None
+    return result
+
+
+def parse_quantity(option: str, words, unit, example: str, default_unit=None) -> u.Quantity:
+    """One number and a unit from command-line words (``["100", "d"]`` or ``"100 d"``), checked.
+
+    A number alone is in ``default_unit`` (``unit`` if None). Refused: text that is not one number
+    followed by a unit (``"1 2 d"``, ``"[1, 2] d"``), NaN/inf, and the wrong physical type.
+    """
+    text = " ".join(words) if isinstance(words, (list, tuple)) else str(words)
+    default_unit = u.Unit(unit if default_unit is None else default_unit)
+    article = "an" if _kind(unit)[0] in "aeiou" else "a"
+    hint = f"{article} {_kind(unit)} such as '{example}' (a number alone means {default_unit})"
+    number, _, rest = text.strip().partition(" ")
+    try:
+        magnitude = float(number)
+        quantity_unit = u.Unit(rest) if rest.strip() else default_unit
+    except (TypeError, ValueError):
+        raise QuantityInputError(f"{option} expects {hint}; got '{text}'.") from None
+    if not math.isfinite(magnitude):
+        raise QuantityInputError(f"{option} expects {hint}, finite; got '{text}'.")
+    if getattr(quantity_unit, "scale", 1.0) != 1.0:  # "1 2 d" reads as 1 × (2 d): not what was meant
+        raise QuantityInputError(f"{option} expects {hint}: one number, then the unit; got '{text}'.")
+    try:
+        value_in(option, magnitude * quantity_unit, unit, f"'{example}'")
+    except QuantityInputError as error:
+        if _kind(unit) == "angular velocity" and _kind(quantity_unit) == "frequency":
+            raise QuantityInputError(_frequency_advice(option, f"'{text}'", u.Unit(unit))) from error
+        raise QuantityInputError(f"{option} expects {hint}; got '{text}' (physical type {_kind(quantity_unit)})."
+                                 ) from error
+    return magnitude * quantity_unit

@@ -167,7 +167,7 @@ def test_a_principal_axis_rotator_through_a_scene_keeps_its_8_h():
     rotation (P_ψ = ∞, P_φ = P_sid = 8 h); under a weak torque the rows leave the axis by a hair and become
     tumblers with that wobble (finite P_ψ: the definition, docs/conventions.md), while the sidereal period
     stays 8 h to the size of the torque's effect."""
-    spin = 2 * np.pi / (8 * u.h)
+    spin = 2 * np.pi * u.rad / (8 * u.h)
     state = RotationState(RigidBody([0.61, 0.965, 1.0]), [1, 0, 0, 0], [0, 0, 1] * spin)
     times = EPOCH + np.linspace(0.0, 5.0, 6) * u.day
     scene = Scene(state, EPOCH, times)

@@ -27,7 +27,8 @@ from spinorbit.core.math.rotations import attitude_to_quat_many, quat_to_attitud
 from spinorbit.state import MODE_NAMES, QUATERNION_NORM_TOLERANCE, InvalidStateError, RotationState
 
 __all__ = ["MOTION_COLUMNS", "OMEGA_COLUMNS", "PERIOD_UNIT", "POLE_COLUMNS", "QUATERNION_COLUMNS", "add_obliquity",
-           "from_principal", "omega_array", "pole_directions", "quaternion_array", "schema_meta", "table_columns"]
+           "from_principal", "omega_array", "pole_directions", "quaternion_array", "schema_meta", "table_columns",
+           "time_column"]
 
 
 def from_principal(body, rows):
@@ -162,6 +163,16 @@ def table_columns(body, quaternions, omegas, omega=True, motion=None, orbit_norm
         raise ValueError(f"motion expects None, 'rows' or a RotationState; got {motion!r}.")
     columns.update(zip(MOTION_COLUMNS, values))
     return columns
+
+
+def time_column(days):
+    """The schema's ``time`` column of core times (TDB days since J2000): a TDB Time shown as ISO dates
+    (ECSV stores it as two floats, jd1 and jd2, so nothing is rounded away)."""
+    from spinorbit.time import time_from_tdb_days
+
+    times = time_from_tdb_days(days)
+    times.format = "isot"
+    return times
 
 
 def schema_meta(epoch, model):

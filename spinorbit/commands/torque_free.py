@@ -186,6 +186,7 @@ def _table(args, state, epoch, offsets, quaternions, omegas, omega_unit):
     p_psi, p_phi = state.periods
     table = Table()
     table["time"] = epoch + offsets * u.day
+    table["time"].format = "isot"  # as every result table shows its dates
     columns = table_columns(state.body, quaternions, omegas.to_value(u.rad / u.day), motion=state)
     for name, column in columns.items():
         table[name] = column

@@ -49,6 +49,7 @@ from spinorbit.ephemeris import (
     moon_orientation_raw,
 )
 from spinorbit.lunar_librations import euler313_from_attitudes, physical_librations
+from spinorbit.state_table import time_column
 from spinorbit.time import J2000_JD_TDB, tdb_day_and_fraction, time_from_tdb_days
 from spinorbit.coupling.sampling import de421_orbit, sample_from_ephemeris, sample_relative_states
 from spinorbit.coupling.long_run import integrate_to_outputs
@@ -562,7 +563,7 @@ def comparison_table(comparison: LibrationComparison, model: str, coupled: bool)
         "wall_seconds": float(comparison.wall_seconds),
         "sampling_seconds": float(comparison.sampling_seconds),
     })
-    table["time"] = time_from_tdb_days(comparison.times)
+    table["time"] = time_column(comparison.times)
     for suffix, angles, librations in (("", comparison.angles_model, comparison.librations_model),
                                        ("_de421", comparison.angles_de421, comparison.librations_de421)):
         for i, name in enumerate(_ANGLE_NAMES):

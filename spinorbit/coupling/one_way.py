@@ -28,8 +28,8 @@ from spinorbit.core.dynamics.equations import make_model
 from spinorbit.core.integrators.quaternion import integrate_quaternion
 from spinorbit import old_paths
 from spinorbit.state import RotationState
-from spinorbit.state_table import from_principal, schema_meta, table_columns
-from spinorbit.time import tdb_days, time_from_tdb_days
+from spinorbit.state_table import from_principal, schema_meta, table_columns, time_column
+from spinorbit.time import tdb_days
 
 __all__ = ["DEFAULT_RTOL", "INTEGRATORS", "closest_approaches", "heliocentric_normals", "propagate_one_way"]
 
@@ -164,7 +164,7 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
     if orbit_normals is None:
         orbit_normals = heliocentric_normals(samples, t_out)
     table = QTable()
-    table["time"] = time_from_tdb_days(t_out)
+    table["time"] = time_column(t_out)
     quaternions, omegas = from_principal(body, ys)  # all rows at once, no RotationState per row
     for name, column in table_columns(body, quaternions, omegas, motion="rows" if periods else None,
                                       orbit_normals=orbit_normals).items():

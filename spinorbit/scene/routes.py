@@ -20,7 +20,7 @@ from astropy.table import QTable
 
 from spinorbit.scene.sampling import NoSamples, subset_samples
 from spinorbit.scene.tolerances import MAX_RTOL_RETRIES, refine, sampling_error_bound
-from spinorbit.state_table import OMEGA_COLUMNS, from_principal, quaternion_array, table_columns
+from spinorbit.state_table import OMEGA_COLUMNS, from_principal, quaternion_array, table_columns, time_column
 from spinorbit.time import time_from_tdb_days
 
 __all__ = ["attitude_angles", "result_table", "run_coupled", "run_one_way", "run_torque_free", "scene_orbit_normals"]
@@ -41,7 +41,7 @@ def result_table(scene, quaternions, omegas, motion="rows"):
     from it (constants of the torque-free motion). Only the quantities the scene asks for are filled in.
     """
     table = QTable()
-    table["time"] = time_from_tdb_days(scene.output_days)
+    table["time"] = time_column(scene.output_days)
     for name, column in table_columns(scene.state.body, quaternions, omegas, omega="omega" in scene.quantities,
                                       motion=motion if "periods" in scene.quantities else None).items():
         table[name] = column

@@ -28,7 +28,7 @@ from spinorbit.state import MODE_NAMES, QUATERNION_NORM_TOLERANCE, InvalidStateE
 
 __all__ = ["MOTION_COLUMNS", "OMEGA_COLUMNS", "PERIOD_UNIT", "POLE_COLUMNS", "QUATERNION_COLUMNS", "add_obliquity",
            "from_principal", "omega_array", "pole_directions", "quaternion_array", "schema_meta", "table_columns",
-           "time_column"]
+           "as_schema_time", "time_column"]
 
 
 def from_principal(body, rows):
@@ -166,12 +166,18 @@ def table_columns(body, quaternions, omegas, omega=True, motion=None, orbit_norm
 
 
 def time_column(days):
-    """The schema's ``time`` column of core times (TDB days since J2000): a TDB Time shown as ISO dates
-    (ECSV stores it as two floats, jd1 and jd2, so nothing is rounded away)."""
+    """The schema's ``time`` column of core times (TDB days since J2000): a TDB Time as ISO dates to the
+    nanosecond (ECSV and CSV write the formatted strings, so the precision is what they keep)."""
     from spinorbit.time import time_from_tdb_days
 
-    times = time_from_tdb_days(days)
+    return as_schema_time(time_from_tdb_days(days))
+
+
+def as_schema_time(times):
+    """``times`` shown as the schema shows them: ISO (isot), TDB, nine decimals of the second."""
+    times = times.tdb
     times.format = "isot"
+    times.precision = 9
     return times
 
 

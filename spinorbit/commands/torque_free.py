@@ -181,12 +181,11 @@ def _table(args, state, epoch, offsets, quaternions, omegas, omega_unit):
     from astropy.table import Table
 
     from spinorbit import __version__
-    from spinorbit.state_table import schema_meta, table_columns
+    from spinorbit.state_table import as_schema_time, schema_meta, table_columns
 
     p_psi, p_phi = state.periods
     table = Table()
-    table["time"] = epoch + offsets * u.day
-    table["time"].format = "isot"  # as every result table shows its dates
+    table["time"] = as_schema_time(epoch + offsets * u.day)
     columns = table_columns(state.body, quaternions, omegas.to_value(u.rad / u.day), motion=state)
     for name, column in columns.items():
         table[name] = column

@@ -25,6 +25,7 @@ import argparse
 import json
 import os
 import resource
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -228,7 +229,12 @@ def main(argv=None) -> None:
     args = parser.parse_args(argv)
     checkouts = {"before": _export(args.before)} if args.before else {}
     checkouts["after"] = ROOT
-    text = markdown(measure(checkouts, args.repeat, args.cold_repeat), args.repeat, args.cold_repeat, args.before)
+    try:
+        results = measure(checkouts, args.repeat, args.cold_repeat)
+    finally:
+        if args.before:
+            shutil.rmtree(checkouts["before"], ignore_errors=True)
+    text = markdown(results, args.repeat, args.cold_repeat, args.before)
     print(text)
     if not args.no_write:
         print(f"wrote {write_section('startup', text)}")

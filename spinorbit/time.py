@@ -25,7 +25,6 @@ import warnings
 
 import numpy as np
 from astropy.time import Time, TimeDelta
-from astropy.utils import iers
 from erfa import ErfaWarning
 
 __all__ = [
@@ -101,6 +100,10 @@ def _convert(time: Time, scale: str) -> Time:
     """``time`` on ``scale``, offline; UTC/UT1 legs warn as ERFA does, the TT ↔ TDB leg does not."""
     if time.scale == scale:
         return time
+    # Imported here: astropy's IERS module loads astropy.table and its readers (0.13 s), which a run
+    # that stays on one scale (TDB, as the Moon's) never needs.
+    from astropy.utils import iers
+
     with iers.conf.set_temp("auto_download", False):
         try:
             if time.scale in ("utc", "ut1"):

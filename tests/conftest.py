@@ -15,3 +15,20 @@ settings.register_profile(
 )
 settings.register_profile("thorough", max_examples=5000, deadline=None, derandomize=True)
 settings.load_profile("default")
+
+
+def pytest_configure(config):
+    """Carried lunar core states (``spinorbit.coupling.lunar_core``) go to a cache of this test run only,
+    so the suite neither reads nor fills the user's ``~/.cache/spinorbit``."""
+    import os
+    import tempfile
+
+    if "SPINORBIT_CACHE_DIR" not in os.environ:
+        config._spinorbit_cache = os.environ["SPINORBIT_CACHE_DIR"] = tempfile.mkdtemp(prefix="spinorbit-test-cache-")
+
+
+def pytest_unconfigure(config):
+    import shutil
+
+    if getattr(config, "_spinorbit_cache", None):
+        shutil.rmtree(config._spinorbit_cache, ignore_errors=True)

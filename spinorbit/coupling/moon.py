@@ -52,9 +52,7 @@ from spinorbit.lunar_librations import euler313_from_attitudes, physical_librati
 from spinorbit.state_table import time_column
 from spinorbit.time import J2000_JD_TDB, tdb_day_and_fraction, time_from_tdb_days
 from spinorbit.coupling.sampling import de421_orbit, sample_from_ephemeris, sample_relative_states
-from spinorbit.coupling.long_run import integrate_to_outputs
-from spinorbit.coupling.rebound import DEFAULT_BODIES, simulation_from_de421
-from spinorbit.coupling.rigid_body import CoupledRigidBody
+from spinorbit.coupling.lunar_core import cached_core_state, core_key
 
 __all__ = [
     "ARCSEC_PER_RAD",
@@ -189,7 +187,7 @@ def moon_figure(moon_mass: float, model: str = "rigid", degree: int = 4) -> np.n
 
 
 def moon_at_de421(epoch=None, model: str = "rigid", degree: int = 4, coupled: bool = True,
-                  bodies=DEFAULT_BODIES, perturbers=None, tolerance: float = DEFAULT_TOLERANCE,
+                  bodies=None, perturbers=None, tolerance: float = DEFAULT_TOLERANCE,
                   full_field_perturbers=FULL_FIELD_PERTURBERS, spin_offset=None):
     """A DE421 simulation with the Moon's rotation attached (BS, EIH + Earth J2 on the orbits).
 
@@ -202,7 +200,7 @@ def moon_at_de421(epoch=None, model: str = "rigid", degree: int = 4, coupled: bo
     coupled : bool
         Fully coupled (default) or one-way.
     bodies : sequence of str
-        Bodies in the simulation (``simulation_from_de421``).
+        Bodies in the simulation (``simulation_from_de421``; default its ``DEFAULT_BODIES``).
     perturbers : sequence of str, optional
         Particles torquing the lunar figure; default all others (Sun, planets, Earth).
     tolerance : float
@@ -218,8 +216,12 @@ def moon_at_de421(epoch=None, model: str = "rigid", degree: int = 4, coupled: bo
     -------
     CoupledRigidBody
     """
+    # REBOUND and the coupled body load here, not with this module: the "de421" model needs neither.
+    from spinorbit.coupling.rebound import DEFAULT_BODIES, simulation_from_de421
+    from spinorbit.coupling.rigid_body import CoupledRigidBody
+
     epoch = Time(2451545.0, format="jd", scale="tdb") if epoch is None else epoch
-    sim = simulation_from_de421(epoch, bodies, integrator="bs")
+    sim = simulation_from_de421(epoch, DEFAULT_BODIES if bodies is None else bodies, integrator="bs")
     sim.integrator.eps_abs = tolerance
     sim.integrator.eps_rel = tolerance
     day, fraction = tdb_day_and_fraction(epoch)
@@ -283,7 +285,7 @@ def _euler313_near(attitudes, reference_angles):
     return reference_angles + np.remainder(angles - reference_angles + np.pi, 2.0 * np.pi) - np.pi
 
 
-def compare_with_de421(moon: CoupledRigidBody, span_days: float, step_days: float = 1.0,
+def compare_with_de421(moon, span_days: float, step_days: float = 1.0,
                        progress=None, schedule=None, resume=None, settings=None) -> LibrationComparison:
     """Integrate ``moon`` over ``span_days`` and compare its attitude with DE421 every ``step_days``.
 
@@ -304,6 +306,8 @@ def compare_with_de421(moon: CoupledRigidBody, span_days: float, step_days: floa
     -------
     LibrationComparison
     """
+    from spinorbit.coupling.long_run import integrate_to_outputs
+
     times = _output_times(moon.sim.t, span_days, step_days)
     _, quaternions, wall = integrate_to_outputs(moon, times, lambda body: body.quaternion, 4, schedule=schedule,
                                                 resume=resume, settings=settings, progress=progress)
@@ -431,15 +435,25 @@ def _epoch_state():
 def core_angular_velocity(day: float) -> tuple:
     """The fluid core's angular velocity on DE421's mantle axes at ``day`` (rad/day).
 
-    DE421 publishes the core's state only at its epoch JDEPOC (1969-06-28, header OMGCX…OMGCZ).
-    Elsewhere it is carried by this model from JDEPOC (mantle and core from the header), and the
-    result is expressed on DE421's mantle axes at ``day`` (through ICRF), so a run that starts from
-    DE421's mantle there gets the core DE421 had, to this model's accuracy (0.001″-level).
+    DE421 publishes it at JDEPOC (1969-06-28, header OMGCX…OMGCZ) only; elsewhere it is
+    :func:`carry_core_angular_velocity`, computed once per date (:mod:`spinorbit.coupling.lunar_core`).
     """
+    if day == _epoch_day():
+        return tuple(_epoch_state()[7:])
+    return cached_core_state(core_state_key(day), lambda: carry_core_angular_velocity(day))
+
+
+def core_state_key(day: float) -> dict:
+    """Every input of :func:`carry_core_angular_velocity` at ``day`` (the key of its cached value)."""
+    return core_key(day, rtol=INTERIOR_RTOL, perturbers=list(INTERIOR_PERTURBERS), mean_motion=LUNAR_MEAN_MOTION,
+                    sample_tolerance=INTERIOR_SAMPLE_TOLERANCE, distant_sample_tolerance=DISTANT_SAMPLE_TOLERANCE)
+
+
+def carry_core_angular_velocity(day: float) -> tuple:
+    """The core's angular velocity at ``day``, carried by this model from DE421's mantle and core at JDEPOC
+    and put on DE421's mantle axes at ``day`` (through ICRF): DE421's core to 0.001″ (rad/day; seconds)."""
     epoch = _epoch_day()
     state = _epoch_state()
-    if day == epoch:
-        return tuple(state[7:])
     model = interior_model(min(epoch, day), max(epoch, day))
     final = integrate_quaternion(state, epoch, np.array([day]), model, rtol=INTERIOR_RTOL)[-1]
     to_icrf = quat_to_attitude(np.ascontiguousarray(final[:4])).T

@@ -44,7 +44,6 @@ import numpy as np
 from astropy.time import Time
 
 from spinorbit.core.model.perturbers import sampled_source
-from spinorbit.coupling.rebound import SimulationSnapshot, body_index
 from spinorbit.ephemeris import DE421_SPAN_JD_TDB, EphemerisRangeError, barycentric_state_au, de421_constants, resolve_body
 from spinorbit.time import J2000_JD_TDB, tdb_days
 
@@ -380,6 +379,8 @@ def rebound_orbit(sim, body):
     callable
         ``days -> (positions (n, 3), velocities (n, 3))``, au and au/day.
     """
+    from spinorbit.coupling.rebound import SimulationSnapshot, body_index  # only REBOUND samplers need it
+
     centre = body_index(sim, body)
     snapshot = SimulationSnapshot.of(sim)
 
@@ -437,6 +438,8 @@ def sample_from_rebound(sim, body, start, end, perturbers=DEFAULT_PERTURBERS,
     """
     if not perturbers:
         raise ValueError("perturbers: expected at least one particle name.")
+    from spinorbit.coupling.rebound import SimulationSnapshot, body_index  # only REBOUND samplers need it
+
     centre = body_index(sim, body)
     indices = [body_index(sim, p) for p in perturbers]
     names = tuple(sim.particles[i].name.lower() for i in indices)

@@ -397,7 +397,8 @@ def dop853_integrate(rhs, params, status_of, after_accept, finish_output, y0, t0
         return ys, stats, t, y
     i_out = 0
     while i_out < n_out and t_out[i_out] == t0:
-        ys[i_out] = y
+        for i in range(n):  # element by element: a row assignment compiles numba's shape-error formatting
+            ys[i_out, i] = y[i]
         i_out += 1
     steps = 0
     previous_error = PREVIOUS_ERROR_FLOOR

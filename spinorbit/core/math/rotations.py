@@ -205,7 +205,12 @@ def quat_to_attitude_many(q):
     n = q.shape[0]
     out = np.empty((n, 3, 3))
     for i in range(n):
-        out[i] = quat_to_attitude(q[i])
+        matrix = quat_to_attitude(q[i])
+        # Element by element: a whole-row assignment makes numba compile its shape-mismatch message
+        # (string formatting, seconds of a first run's compile) into the kernel.
+        for j in range(3):
+            for k in range(3):
+                out[i, j, k] = matrix[j, k]
     return out
 
 
@@ -215,7 +220,9 @@ def attitude_to_quat_many(r):
     n = r.shape[0]
     out = np.empty((n, 4))
     for i in range(n):
-        out[i] = attitude_to_quat(r[i])
+        quaternion = attitude_to_quat(r[i])
+        for j in range(4):  # element by element, as in quat_to_attitude_many
+            out[i, j] = quaternion[j]
     return out
 
 

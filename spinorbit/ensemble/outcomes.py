@@ -4,7 +4,7 @@ The columns are the output schema's (``docs/conventions.md``, "Output tables"): 
 ``energy_ratio``, ``P_psi``, ``P_phi``, ``sidereal_period`` (h), ``pole_ra``, ``pole_dec``,
 ``pole_lon``, ``pole_lat`` (deg) and ``obliquity`` (deg, when the run has an orbit), plus
 ``pole_shift`` (deg: the angle between the angular momentum at that time and at the state's epoch)
-and the initial ``P_psi_initial``, ``P_phi_initial``, ``energy_ratio_initial`` (the member's state at
+and the initial ``P_psi_initial``, ``P_phi_initial``, ``sidereal_period_initial``, ``energy_ratio_initial`` (the member's state at
 its epoch), then the run's ``error_estimate`` (arcsec), ``tolerance_met`` and ``route``.
 With named times every time-dependent column is suffixed ``_t0``, ``_t1``, …
 
@@ -31,12 +31,12 @@ __all__ = ["OUTCOME_UNITS", "TIMED_COLUMNS", "outcome_row", "time_rows", "torque
 
 #: Columns that depend on the time of the outcome, in order.
 TIMED_COLUMNS = (*MOTION_COLUMNS, *POLE_COLUMNS, "obliquity", "pole_shift")
-INITIAL_COLUMNS = ("P_psi_initial", "P_phi_initial", "energy_ratio_initial")
+INITIAL_COLUMNS = ("P_psi_initial", "P_phi_initial", "sidereal_period_initial", "energy_ratio_initial")
 RUN_COLUMNS = ("error_estimate", "tolerance_met", "route")
 #: Unit of every numeric outcome column (a suffixed column has its base column's unit).
 OUTCOME_UNITS = {"P_psi": u.h, "P_phi": u.h, "sidereal_period": u.h, "pole_ra": u.deg, "pole_dec": u.deg,
                  "pole_lon": u.deg, "pole_lat": u.deg, "obliquity": u.deg, "pole_shift": u.deg, "P_psi_initial": u.h,
-                 "P_phi_initial": u.h, "error_estimate": u.arcsec}
+                 "P_phi_initial": u.h, "sidereal_period_initial": u.h, "error_estimate": u.arcsec}
 #: Output times within this many days of a named time are that time (float TDB days resolve ~1e-12 d).
 TIME_MATCH_DAYS = 1e-9
 
@@ -73,6 +73,7 @@ def _unit_from_radec(ra_deg, dec_deg):
 def _initial(state):
     p_psi, p_phi = state.periods
     return {"P_psi_initial": float(p_psi.to_value(u.h)), "P_phi_initial": float(p_phi.to_value(u.h)),
+            "sidereal_period_initial": float(state.sidereal_period.to_value(u.h)),
             "energy_ratio_initial": float(state.energy_ratio)}
 
 

@@ -14,7 +14,8 @@ from astropy import units as u
 from astropy.time import Time
 
 from spinorbit import RigidBody, RotationState, Scene
-from spinorbit.ensemble import Ensemble, EnsembleError, EnsembleInterrupted, Uniform, member_seed, sample_parameters
+from spinorbit.ensemble import Ensemble, EnsembleError, EnsembleInterrupted, Normal, SamplerError, Uniform
+from spinorbit.ensemble import member_seed, sample_parameters
 from spinorbit.ensemble import state_at_phase
 from spinorbit.ensemble.store import ChunkStore
 from spinorbit.runs.checkpoint import CheckpointError
@@ -215,7 +216,21 @@ def test_sampled_parameters_come_from_one_seed_per_member():
     assert np.all((large["ratio"] >= 0.61) & (large["ratio"] < 0.64))
     other = sample_parameters(3, seed=43, phase=Uniform(0.0, 1.0))
     assert list(other["phase"]) != list(small["phase"])
-    assert len(set(sample_parameters(2, phase=Uniform(0, 1)).meta["seed_entropy"] for _ in range(1))) == 1
+    fresh = sample_parameters(2, phase=Uniform(0, 1))  # no seed: fresh entropy, recorded to rebuild the draws
+    assert fresh["phase"][1] == np.random.default_rng(member_seed(fresh.meta["seed_entropy"], 1)).uniform(0, 1)
+    spins = sample_parameters(500, seed=1, spin=Normal(2.0 * u.rad / u.day, 0.1 * u.rad / u.day))
+    assert spins["spin"].unit == u.rad / u.day
+    assert abs(np.mean(spins["spin"].value) - 2.0) < 4 * 0.1 / np.sqrt(500)  # 4 sigma of the mean of 500 draws
+    with pytest.raises(SamplerError, match="sigma > 0"):
+        sample_parameters(1, spin=Normal(1.0, 0.0))
+    with pytest.raises(SamplerError, match="low < high"):
+        sample_parameters(1, phase=Uniform(1.0, 0.5))
+
+
+def test_progress_reports_members_done_in_order_up_to_all():
+    seen = []
+    Ensemble(member, phases(), chunk_size=3).run(executor="serial", progress=lambda done, total: seen.append((done, total)))
+    assert seen == [(0, 8), (3, 8), (6, 8), (8, 8)]
 
 
 def test_state_at_phase_moves_along_the_free_motion_only():
@@ -254,3 +269,21 @@ def test_a_corrupted_chunk_file_is_refused(tmp_path):
     path.write_bytes(bytes(data))
     with pytest.raises(CheckpointError, match="corrupted"):
         Ensemble(member, phases(2, torque=False), chunk_size=1).run(executor="serial", checkpoint=tmp_path)
+
+
+def test_apophis_command_runs_an_ensemble_and_writes_one_row_per_member(tmp_path, capsys):
+    from astropy.table import QTable
+
+    from spinorbit import cli
+
+    output, plot = tmp_path / "members.ecsv", tmp_path / "members.png"
+    status = cli.main(["apophis", "--members", "2", "--workers", "1", "--seed", "7", "--span", "1", "d",
+                       "--output", str(output), "--plot", str(plot)])
+    printed = capsys.readouterr().out
+    assert status == 0, printed
+    assert "pole shift" in printed and "failures           0" in printed and "modes after" in printed
+    table = QTable.read(output)
+    assert len(table) == 2 and list(table["seed_spawn_key"]) == [0, 1] and plot.stat().st_size > 10_000
+    assert np.all(table["P_psi_initial"].to_value(u.h) == pytest.approx(263.0, rel=1e-9))
+    assert cli.main(["apophis", "--workers", "2"]) == 2  # an ensemble option without --members
+    assert "add --members" in capsys.readouterr().err

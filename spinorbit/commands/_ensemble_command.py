@@ -54,7 +54,7 @@ def run_apophis_ensemble(args, span_days) -> int:
                                     perturbers=tuple(args.perturbers), tolerance_arcsec=tolerance)
     ensemble = Ensemble(apophis_member, parameters)
     executor = _executor(args)
-    progress = Progress(args.members, "members")
+    progress = Progress(args.members, "members", counted=True)
     try:
         table = ensemble.run(executor=executor, checkpoint=args.checkpoint_dir,
                              progress=lambda done, total: progress.advance(done - progress.done))

@@ -61,6 +61,7 @@ class DaskExecutor(concurrent.futures.Executor):
         self.client = client
 
     def submit(self, fn, /, *args, **kwargs):
+        """Run ``fn`` with the arguments on the cluster; a concurrent.futures.Future of its result."""
         remote = self.client.submit(fn, *args, pure=False, **kwargs)
         local = concurrent.futures.Future()
 

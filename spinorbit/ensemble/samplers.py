@@ -50,12 +50,10 @@ class Uniform:
     high: object
 
     def draw(self, rng):
-        low, unit = _plain(self.low, "Uniform low")
-        high, high_unit = _plain(u.Quantity(self.high).to(unit) if unit is not None else self.high, "Uniform high")
+        low, high, unit = _pair(self.low, self.high, "Uniform low", "Uniform high")
         if not low < high:
             raise SamplerError(f"Uniform expects low < high; got low={self.low!r}, high={self.high!r}.")
-        value = float(rng.uniform(low, high))
-        return value * unit if unit is not None else value
+        return _with_unit(float(rng.uniform(low, high)), unit)
 
 
 @dataclass(frozen=True)
@@ -66,12 +64,23 @@ class Normal:
     sigma: object
 
     def draw(self, rng):
-        mean, unit = _plain(self.mean, "Normal mean")
-        sigma = _plain(u.Quantity(self.sigma).to(unit) if unit is not None else self.sigma, "Normal sigma")[0]
+        mean, sigma, unit = _pair(self.mean, self.sigma, "Normal mean", "Normal sigma")
         if not sigma > 0.0:
             raise SamplerError(f"Normal expects sigma > 0; got {self.sigma!r}.")
-        value = float(rng.normal(mean, sigma))
-        return value * unit if unit is not None else value
+        return _with_unit(float(rng.normal(mean, sigma)), unit)
+
+
+def _pair(first, second, first_name, second_name):
+    """(first, second, unit or None): two numbers, or two Quantities of one kind in the first's unit."""
+    value, unit = _plain(first, first_name)
+    if unit is not None and not isinstance(second, u.Quantity):
+        raise SamplerError(f"{second_name} expects a Quantity like {first_name} ({first!r}); got {second!r}.")
+    other = _plain(u.Quantity(second).to(unit) if unit is not None else second, second_name)[0]
+    return value, other, unit
+
+
+def _with_unit(value, unit):
+    return value * unit if unit is not None else value
 
 
 def member_seeds(n, seed):
@@ -113,10 +122,8 @@ def sample_parameters(n, seed=None, **distributions):
     for child in children:
         rng = np.random.default_rng(child)
         rows.append({name: (d.draw(rng) if hasattr(d, "draw") else d) for name, d in distributions.items()})
-    table = QTable(rows=rows, names=list(distributions)) if not any(
-        isinstance(v, u.Quantity) for v in rows[0].values()) else QTable(
-        {name: u.Quantity([row[name] for row in rows]) if isinstance(rows[0][name], u.Quantity)
-         else np.array([row[name] for row in rows]) for name in distributions})
+    table = QTable({name: u.Quantity([row[name] for row in rows]) if isinstance(rows[0][name], u.Quantity)
+                    else np.array([row[name] for row in rows]) for name in distributions})
     table["seed_entropy"] = np.array([str(entropy)] * int(n))
     table["seed_spawn_key"] = np.array([child.spawn_key[-1] for child in children], dtype=np.int64)
     table.meta["seed_entropy"] = str(entropy)

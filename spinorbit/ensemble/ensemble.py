@@ -143,6 +143,8 @@ class Ensemble:
         ``make_scene(**parameters) -> Scene`` (one body). A module-level function, so that worker
         processes can import it; an expensive orbit it needs should be cached in its module
         (e.g. ``functools.cache``), so each process builds it once and members share its samples.
+        It is also called once per member in this process, to find the torque-free members, which
+        are not shipped (so this process builds the cached orbit once too).
     parameters : QTable or list of dict
         One row per member; the columns are make_scene's keyword arguments (except the seed columns
         ``seed_entropy`` and ``seed_spawn_key`` of :func:`~spinorbit.ensemble.samplers.sample_parameters`,
@@ -364,12 +366,14 @@ class Ensemble:
         if missing:
             raise EnsembleError(f"rerun: the chunks {missing} have not run yet; call run() (with the checkpoint) first.")
         clock = _time.perf_counter()
+        results = []
         with open_executor(executor) as (pool, description):
-            jobs = [[(i, self.member_parameters(i))] for i in indices]
-            if pool is None:
-                results = [run_chunk(self.make_scene, job, self.at_days) for job in jobs]
-            else:
-                results = [f.result() for f in [pool.submit(run_chunk, self.make_scene, job, self.at_days) for job in jobs]]
+            for index in indices:  # each alone, by the same path as in run(): torque-free ones in this process
+                rows, failures, ship = self._split([index])
+                if ship:
+                    job = (pool.submit(run_chunk, self.make_scene, ship, self.at_days) if pool is not None else None)
+                    rows, failures, _ = job.result() if job is not None else run_chunk(self.make_scene, ship, self.at_days)
+                results.append((rows, failures, {}))
         for index, (rows, failures, _) in zip(indices, results):
             self._rows.pop(index, None)
             self._failures.pop(index, None)

@@ -75,6 +75,9 @@ def measure(members):
     from spinorbit.ensemble.apophis import apophis_member, apophis_parameters, encounter_orbit
     from spinorbit.ensemble.ensemble import build_member
 
+    import os
+
+    load_before = os.getloadavg()[0]
     parameters = apophis_parameters(members, seed=2029)
     encounter_orbit()  # the orbit of this process, as a worker builds its own: not in the serial timing
     build_member(apophis_member, Ensemble(apophis_member, parameters).member_parameters(0)).run()  # compile/warm
@@ -108,7 +111,7 @@ def measure(members):
         pass
     return dict(members=members, chunk=chunk, wall_1=wall_1, wall_2=wall_2, first_2=first_2, per_member=per_member,
                 same=same, sent=sent / len(shipped), returned=returned / len(shipped), overhead_pool=overhead_pool,
-                overhead_dask=overhead_dask)
+                overhead_dask=overhead_dask, load=(load_before, os.getloadavg()[0]))
 
 
 def model(m, workers, setup):
@@ -133,11 +136,14 @@ def markdown(m):
              f"- data moved per member: {m['sent']:.0f} bytes out, {m['returned']:.0f} bytes back (pickled);",
              f"- T_setup(2) = {m['first_2'] - m['chunk'] * m['per_member']:.2f} s: the pool's start and each worker's "
              "own orbit (an N-body run) before its first chunk.", "",
-             f"Model T(2) = {predicted_2:.2f} s against {m['wall_2']:.2f} s measured. With the same setup the model "
-             "predicts " + ", ".join(f"{w} workers {model(m, w, m['first_2'] - m['chunk'] * m['per_member']):.1f} s"
-                                     for w in (4, 16, 64)) + " (extrapolated, not measured; it ignores the last "
-             "chunk's tail, which grows as the chunks per worker fall). Overhead and data are small against c, so the "
-             "efficiency at 2 workers is set by the setup against the run's length.", "",
+             f"Model T(2) = {predicted_2:.2f} s against {m['wall_2']:.2f} s measured. The model assumes two free "
+             f"cores; the 1-minute load average was {m['load'][0]:.1f} before and {m['load'][1]:.1f} after the "
+             "measurement (other processes on the machine's cores). The model does not include that load, and this "
+             "measurement cannot separate it from other causes of the gap. With the same setup and free cores the "
+             "model predicts " + ", ".join(f"{w} workers {model(m, w, m['first_2'] - m['chunk'] * m['per_member']):.1f} s"
+                                           for w in (4, 16, 64)) + " (extrapolated, not measured; it ignores the "
+             "last chunk's tail, which grows as the chunks per worker fall). The task overhead and the data moved "
+             "are small against c, so on free cores the efficiency is set by the setup against the run's length.", "",
              "heyoka's `ensemble_propagate_until` on the same physics is not measured (no heyoka formulation of the "
              "REBOUND-orbit torques in `benchmarks/peers.py` yet)."]
     return "\n".join(lines)

@@ -287,3 +287,11 @@ def test_apophis_command_runs_an_ensemble_and_writes_one_row_per_member(tmp_path
     assert np.all(table["P_psi_initial"].to_value(u.h) == pytest.approx(263.0, rel=1e-9))
     assert cli.main(["apophis", "--workers", "2"]) == 2  # an ensemble option without --members
     assert "add --members" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_the_embedded_dask_cluster_gives_the_serial_bits(serial):
+    # executor="dask": a LocalCluster of worker processes started and closed by the run itself
+    embedded = Ensemble(member, phases(), chunk_size=CHUNK)
+    assert_same_bits(serial, embedded.run(executor="dask"))
+    assert "embedded Dask LocalCluster" in embedded.last_run["executor"]

@@ -114,21 +114,24 @@ def torque_free_rows(scenes, at=None):
     for positions in groups.values():
         body = scenes[positions[0]].state.body
         quaternions = np.array([scenes[p].state.quaternion for p in positions])
-        omegas = np.array([scenes[p].state.angular_velocity.to_value(u.rad / u.day) for p in positions])
+        # angular_velocity is in rad/day by construction: .value skips a unit conversion per member
+        omegas = np.array([scenes[p].state.angular_velocity.value for p in positions])
         columns = table_columns(body, quaternions, omegas, omega=False, motion="rows")
         plain = {name: (np.asarray(value) if name == "mode" else
                         u.Quantity(value).to_value(OUTCOME_UNITS[name]) if name in OUTCOME_UNITS else np.asarray(value))
                  for name, value in columns.items() if name in TIMED_COLUMNS}
+        timed = at is not None
         for j, p in enumerate(positions):
-            scene = scenes[p]
+            values = {name: (str(plain[name][j]) if name == "mode" else float(plain[name][j]))
+                      for name in TIMED_COLUMNS[:-2]}
+            values["pole_shift"] = 0.0  # the angular momentum is fixed in free rotation
             row = {}
-            for k, _ in enumerate(time_rows(scene, at)):
-                for name in TIMED_COLUMNS[:-2]:
-                    value = plain[name][j]
-                    row[_suffix(name, k, at is not None)] = str(value) if name == "mode" else float(value)
-                row[_suffix("pole_shift", k, at is not None)] = 0.0  # the momentum is fixed in free rotation
-            row.update(_initial(scene.state))
-            row.update(error_estimate=0.0, tolerance_met=True, route="torque-free")
+            for k in range(len(time_rows(scenes[p], at)) if timed else 1):
+                row.update({_suffix(name, k, timed): value for name, value in values.items()})
+            # constants of the motion: the initial values are the same numbers
+            row.update(P_psi_initial=values["P_psi"], P_phi_initial=values["P_phi"],
+                       sidereal_period_initial=values["sidereal_period"], energy_ratio_initial=values["energy_ratio"],
+                       error_estimate=0.0, tolerance_met=True, route="torque-free")
             rows[p] = row
     return rows
 

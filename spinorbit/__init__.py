@@ -6,6 +6,8 @@ The front door. Public names are listed here; everything else is an implementati
 - :class:`RotationState` — attitude and spin; mode, periods, canonical elements, exact free motion.
 - :class:`Scene` — a run described declaratively (body, perturbers, orbit, times, tolerance); its
   ``plan()`` says how it will run and why, ``run()`` does it (:mod:`spinorbit.scene.scene`).
+- :class:`Ensemble` — many Scenes from a table of parameters, on any executor, one outcome table
+  (:mod:`spinorbit.ensemble`).
 - :mod:`spinorbit.special` — elliptic functions and integrals for every parameter m ≥ 0.
 - :mod:`spinorbit.core` — the plain-float core (paper-named maps ``andoyer_to_canonical`` and
   ``canonical_to_andoyer``).
@@ -28,6 +30,7 @@ _PUBLIC = {
     "SingularElementsError": ".core.errors",
     "Scene": ".scene",
     "Orbit": ".scene",
+    "Ensemble": ".ensemble",
     "SpinorbitError": ".core.errors",
     "NonFiniteError": ".core.errors",
 }

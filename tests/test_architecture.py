@@ -36,6 +36,7 @@ UPPER_LAYERS = (
     ("coupling", ("spinorbit.coupling",)),
     ("scene", ("spinorbit.scene",)),
     ("data", ("spinorbit.data",)),
+    ("ensemble", ("spinorbit.ensemble",)),
     ("command line", ("spinorbit.cli", "spinorbit.commands", "spinorbit.__main__")),
 )
 #: Modules every layer may import: the front door's lazy table and the old-path shims.

@@ -181,9 +181,11 @@ class Progress:
         Where to draw (stderr by default).
     delay : float, optional
         Seconds before the bar shows itself (:data:`PROGRESS_DELAY_S` by default).
+    counted : bool, optional
+        Also show "done/total" items (an ensemble's members).
     """
 
-    def __init__(self, total: int, label: str, stream=None, delay: float | None = None):
+    def __init__(self, total: int, label: str, stream=None, delay: float | None = None, counted: bool = False):
         self.total, self.label = max(int(total), 1), label
         self.stream = sys.stderr if stream is None else stream
         self.enabled = bool(getattr(self.stream, "isatty", lambda: False)())
@@ -192,6 +194,7 @@ class Progress:
         self.drawn = False
         self.done = 0
         self.delay = PROGRESS_DELAY_S if delay is None else float(delay)
+        self.counted = counted
 
     def advance(self, count: int) -> None:
         """Record ``count`` more items done; redraw if due."""
@@ -210,7 +213,8 @@ class Progress:
         elapsed = now - self.start
         eta = f", {elapsed * (1 - fraction) / fraction:.0f} s left" if 0 < fraction < 1 else ""
         bar = "#" * filled + "." * (30 - filled)
-        self.stream.write(f"\r{self.label} [{bar}] {100 * fraction:3.0f}% ({elapsed:.0f} s{eta}) ")
+        count = f" {self.done}/{self.total}" if self.counted else ""
+        self.stream.write(f"\r{self.label} [{bar}] {100 * fraction:3.0f}%{count} ({elapsed:.0f} s{eta}) ")
         self.stream.flush()
         self.last_draw, self.drawn = now, True
 

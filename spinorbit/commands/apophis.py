@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from spinorbit.commands._common import check_outputs
+from spinorbit.commands._ensemble_command import add_ensemble_arguments, run_apophis_ensemble
 from spinorbit.commands._scene_command import (
     add_scene_arguments,
     run_and_report,
@@ -34,6 +35,8 @@ examples:
   spinorbit apophis --plan --perturbers sun earth moon jupiter venus
   spinorbit apophis --span 10 d --output apophis.ecsv --plot apophis.png
   spinorbit apophis --phase 0.25                     # the state moved by P_psi/4 along its free motion
+  spinorbit apophis --members 200 --workers 2 --plot apophis_ensemble.png   # the distribution over phase x moments
+  spinorbit apophis --members 5000 --scheduler tcp://10.0.0.1:8786 --checkpoint-dir runs/apophis
 
 exit status: 0 on success; 2 with a one-line message if the input is wrong or an output file
 cannot be written (nothing is left half-written)."""
@@ -50,6 +53,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--phase", type=float, default=0.0, metavar="FRACTION",
                         help="rotation phase at the state's epoch (2029-04-08 21:47 TDB) as a fraction of P_psi "
                         "in [0, 1): unknown from the published solution; default 0, the state as constructed")
+    add_ensemble_arguments(parser)
 
 
 def run(args) -> int:
@@ -66,9 +70,16 @@ def run(args) -> int:
     from spinorbit.scene import Orbit
 
     check_outputs(args)
+    if args.members is None and (args.workers is not None or args.scheduler is not None or args.checkpoint_dir):
+        raise CommandError("--workers, --scheduler and --checkpoint-dir go with --members N (an ensemble); add --members.")
     if not 0.0 <= args.phase < 1.0:
         raise CommandError(f"--phase expects a fraction of P_psi in [0, 1); got {args.phase:g}.")
     days = span_and_times(args, APOPHIS_2029.time_tdb, MAX_SPAN_DAYS)[0].to_value(u.day)
+    if args.members is not None:
+        from spinorbit.commands._scene_command import tolerance
+
+        args.tolerance_quantity = tolerance(args)
+        return run_apophis_ensemble(args, days)
     start = APOPHIS_2029.time_tdb - 0.5 * days * u.day
     span, times = span_and_times(args, start, MAX_SPAN_DAYS)
     orbit = Orbit.rebound(apophis_encounter_simulation(args.orbit), "Apophis")

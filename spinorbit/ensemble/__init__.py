@@ -1,0 +1,18 @@
+"""Ensembles of Scenes: Monte Carlo over unknown phases and parameters, on any executor (``docs/ensembles.md``).
+
+- :mod:`~spinorbit.ensemble.ensemble` — :class:`Ensemble`: members from ``make_scene(**row)``, fixed
+  chunks, one outcome table, checkpoints, failures and reruns;
+- :mod:`~spinorbit.ensemble.samplers` — parameters drawn from one seed per member; the free motion's phases;
+- :mod:`~spinorbit.ensemble.executors` — in this process, a process pool, any Executor, Dask;
+- :mod:`~spinorbit.ensemble.store` — completed chunks in checksummed, atomic checkpoint files;
+- :mod:`~spinorbit.ensemble.outcomes` — a member's outcome row from its SceneResult;
+- :mod:`~spinorbit.ensemble.apophis` — the Apophis 2029 encounter over phase and moment-ratio uncertainty.
+"""
+
+from spinorbit.ensemble.ensemble import Ensemble
+from spinorbit.ensemble.errors import EnsembleError, EnsembleInterrupted
+from spinorbit.ensemble.executors import ExecutorError
+from spinorbit.ensemble.samplers import Normal, SamplerError, Uniform, member_seed, sample_parameters, state_at_phase
+
+__all__ = ["Ensemble", "EnsembleError", "EnsembleInterrupted", "ExecutorError", "Normal", "SamplerError", "Uniform",
+           "member_seed", "sample_parameters", "state_at_phase"]

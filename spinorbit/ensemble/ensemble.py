@@ -1,0 +1,431 @@
+"""An ensemble of Scenes: one member per parameter row, run in fixed chunks on any executor, one outcome table.
+
+A member is a :class:`~spinorbit.scene.Scene` built by ``make_scene(**parameters)`` from one row of
+the parameter table (``docs/ensembles.md``). The members are cut into chunks of consecutive indices
+whose size depends on the ensemble alone (its member count, or ``chunk_size``), never on the
+executor or the number of workers; a chunk runs in one process, its members sharing the perturber
+samples of one orbit (:meth:`Scene.sharing_samples`), so the table is the same bits whichever
+executor ran it. A worker builds its members' Scenes itself: only ``make_scene`` (picklable: a
+module-level function) and the parameter rows travel. Members with no perturbers and no orbit are
+not shipped: their outcomes are constants of the free motion, taken per chunk in one vectorised
+call in this process (:func:`~spinorbit.ensemble.outcomes.torque_free_rows`).
+
+Completed chunks are checkpointed (:class:`~spinorbit.ensemble.store.ChunkStore`); a resumed run
+runs only the chunks without a file. A member that raises is recorded (index, parameters, exception
+type and message), its row masked, and :meth:`Ensemble.rerun` runs it again alone.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import hashlib
+import math
+import time as _time
+
+import numpy as np
+from astropy import units as u
+from astropy.table import MaskedColumn, QTable
+from astropy.utils.masked import Masked
+
+from spinorbit.ensemble.errors import EnsembleError, EnsembleInterrupted
+from spinorbit.ensemble.executors import open_executor
+from spinorbit.ensemble.outcomes import (
+    INITIAL_COLUMNS,
+    OUTCOME_UNITS,
+    RUN_COLUMNS,
+    TIMED_COLUMNS,
+    days_of,
+    outcome_row,
+    torque_free_rows,
+)
+from spinorbit.ensemble.samplers import SEED_COLUMNS, sample_parameters
+from spinorbit.ensemble.store import ChunkStore
+
+__all__ = ["Ensemble", "EnsembleError", "EnsembleInterrupted", "run_chunk"]
+
+#: Most members in a default chunk; the default is ceil(n / 32) up to this (chunks few enough to
+#: spread over many workers, large enough that a chunk's shared sampling pays).
+MAX_DEFAULT_CHUNK = 16
+
+
+def _plain_value(value):
+    """A parameter value as make_scene receives it: numpy scalars as Python numbers, Quantities as they are."""
+    if isinstance(value, u.Quantity):
+        return value
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def _parameter_table(parameters):
+    if isinstance(parameters, QTable):
+        table = parameters.copy()
+    elif isinstance(parameters, (list, tuple)) and parameters and all(isinstance(r, dict) for r in parameters):
+        names = list(parameters[0])
+        if any(list(r) != names for r in parameters):
+            raise EnsembleError(f"parameters: every dict must have the same keys in the same order as the first "
+                                f"({names}); pad the others or use a QTable.")
+        table = QTable({name: u.Quantity([r[name] for r in parameters]) if isinstance(parameters[0][name], u.Quantity)
+                        else np.array([r[name] for r in parameters]) for name in names})
+    else:
+        raise EnsembleError(f"parameters expects a QTable or a non-empty list of dicts (one per member); got "
+                            f"{type(parameters).__name__}. For sampled parameters use Ensemble.sampled(...).")
+    if len(table) == 0:
+        raise EnsembleError("parameters has no rows: an ensemble needs at least one member.")
+    return table
+
+
+def _fingerprint_text(value):
+    if isinstance(value, u.Quantity):
+        return f"Q{np.asarray(value.value, dtype=float).tobytes().hex()}{value.unit}"
+    if isinstance(value, float):
+        return value.hex()
+    return f"{type(value).__name__}{value!r}"
+
+
+def build_member(make_scene, parameters):
+    """The single-body Scene of one member (EnsembleError when make_scene returns something else)."""
+    from spinorbit.scene import Scene
+
+    scene = make_scene(**parameters)
+    if not isinstance(scene, Scene) or scene.members is not None:
+        raise EnsembleError(f"make_scene expects to return a single-body spinorbit.Scene; it returned "
+                            f"{type(scene).__name__}{' of several bodies' if isinstance(scene, Scene) else ''}.")
+    return scene
+
+
+def failure_record(index, parameters, error):
+    """What a failed member leaves: index, parameters (repr), exception type and message (JSON-ready)."""
+    return {"index": int(index), "parameters": {k: repr(v) for k, v in parameters.items()},
+            "type": type(error).__name__, "message": str(error)}
+
+
+def _sharing_key(scene):
+    """Members with the same orbit object, span, user ephemerides and sample tolerance sample once."""
+    return (id(scene.orbit), float(scene.epoch_day), float(scene.output_days[-1]),
+            tuple(id(p) for p in scene.moving), scene.sample_tolerance)
+
+
+def run_chunk(make_scene, members, at_days=None, keep_tables=False):
+    """Run one chunk of members in this process (what a worker does): (rows, failures, tables).
+
+    ``members`` is a list of (index, parameter dict); rows and failures are dicts by index, tables
+    the members' result tables when ``keep_tables``.
+    """
+    from spinorbit.scene.sampling import SharedSamples
+
+    rows, failures, tables, shared = {}, {}, {}, {}
+    for index, parameters in members:
+        try:
+            scene = build_member(make_scene, parameters)
+            # the scene stays referenced with its samples, so an id() in the key is never reused in the chunk
+            _, samples = shared.setdefault(_sharing_key(scene), (scene, SharedSamples()))
+            with scene.sharing_samples(samples):
+                result = scene.run()
+            rows[index] = outcome_row(scene, result, at_days)
+            if keep_tables:
+                tables[index] = result.table
+        except Exception as error:  # noqa: BLE001 — a member's failure is recorded, the chunk goes on
+            failures[index] = failure_record(index, parameters, error)
+    return rows, failures, tables
+
+
+def _torque_free(scene):
+    return not scene.named and not scene.fixed and not scene.moving and scene.orbit is None
+
+
+class Ensemble:
+    """Members built by ``make_scene(**row)`` from a table of parameters, run in fixed chunks on any executor.
+
+    Parameters
+    ----------
+    make_scene : callable
+        ``make_scene(**parameters) -> Scene`` (one body). A module-level function, so that worker
+        processes can import it; an expensive orbit it needs should be cached in its module
+        (e.g. ``functools.cache``), so each process builds it once and members share its samples.
+        It is also called once per member in this process, to find the torque-free members, which
+        are not shipped (so this process builds the cached orbit once too).
+    parameters : QTable or list of dict
+        One row per member; the columns are make_scene's keyword arguments (except the seed columns
+        ``seed_entropy`` and ``seed_spawn_key`` of :func:`~spinorbit.ensemble.samplers.sample_parameters`,
+        which are recorded, not passed).
+    chunk_size : int, optional
+        Members per chunk; default ``min(16, ceil(n / 32))``. It fixes the work units, so results do
+        not depend on the executor or the number of workers.
+    at : astropy.time.Time, optional
+        Times (among every member's output times) at which to report the outcome; default the last
+        output time. With ``at`` the time-dependent columns are suffixed ``_t0``, ``_t1``, …
+
+    Attributes
+    ----------
+    failures : list of dict
+        Failed members: ``index``, ``parameters`` (repr), ``type`` and ``message`` of the exception.
+    member_tables : dict
+        ``{index: QTable}`` of the members run with ``keep_tables=True`` in this process's calls.
+    last_run : dict
+        ``members_run``, ``members_restored``, ``members_in_process``, ``chunks_run``,
+        ``wall_seconds`` and ``executor`` of the last :meth:`run` or :meth:`rerun`.
+    """
+
+    def __init__(self, make_scene, parameters, chunk_size=None, at=None):
+        if not callable(make_scene):
+            raise EnsembleError(f"make_scene expects a callable returning a Scene; got {make_scene!r}.")
+        self.make_scene = make_scene
+        self.parameters = _parameter_table(parameters)
+        n = len(self.parameters)
+        if chunk_size is None:
+            chunk_size = min(MAX_DEFAULT_CHUNK, math.ceil(n / 32))
+        if not (isinstance(chunk_size, (int, np.integer)) and not isinstance(chunk_size, bool) and chunk_size >= 1):
+            raise EnsembleError(f"chunk_size expects a positive number of members; got {chunk_size!r}.")
+        self.chunk_size = int(chunk_size)
+        self.at_days = None if at is None else days_of(at)
+        self.at = at
+        self._rows, self._failures, self.member_tables, self.last_run = {}, {}, {}, {}
+        self._complete = set()  # chunks whose every member has a row or a failure
+
+    @classmethod
+    def sampled(cls, make_scene, n, seed=None, chunk_size=None, at=None, **distributions):
+        """An ensemble of ``n`` members whose parameters are drawn, each from its own seed
+        (:func:`~spinorbit.ensemble.samplers.sample_parameters`; the seeds are columns of the result)."""
+        return cls(make_scene, sample_parameters(n, seed, **distributions), chunk_size=chunk_size, at=at)
+
+    # ------------------------------------------------------------------------------------------
+    @property
+    def n_members(self):
+        return len(self.parameters)
+
+    @property
+    def n_chunks(self):
+        return math.ceil(self.n_members / self.chunk_size)
+
+    def chunk_members(self, chunk):
+        return list(range(chunk * self.chunk_size, min((chunk + 1) * self.chunk_size, self.n_members)))
+
+    def member_parameters(self, index):
+        """The keyword arguments of make_scene for member ``index`` (the seed columns left out)."""
+        row = self.parameters[index]
+        return {name: _plain_value(row[name]) for name in self.parameters.colnames if name not in SEED_COLUMNS}
+
+    @property
+    def fingerprint(self):
+        """SHA-256 of what fixes the results: make_scene's name, every parameter's bits, chunk size, times."""
+        digest = hashlib.sha256()
+        digest.update(f"{getattr(self.make_scene, '__module__', '')}.{getattr(self.make_scene, '__qualname__', '')}"
+                      f"|{self.chunk_size}|{self.n_members}|".encode())
+        if self.at_days is not None:
+            digest.update(self.at_days.tobytes())
+        for index in range(self.n_members):
+            row = self.parameters[index]
+            digest.update("|".join(f"{name}={_fingerprint_text(_plain_value(row[name]))}"
+                                   for name in self.parameters.colnames).encode())
+        return digest.hexdigest()
+
+    @property
+    def failures(self):
+        return [self._failures[i] for i in sorted(self._failures)]
+
+    # ------------------------------------------------------------------------------------------
+    def _restore(self, store):
+        restored = 0
+        for chunk in range(self.n_chunks):
+            if chunk in self._complete:
+                continue
+            stored = store.read(chunk)
+            if stored is not None:
+                rows, failures = stored
+                self._rows.update(rows)
+                self._failures.update(failures)
+                self._complete.add(chunk)
+                restored += len(self.chunk_members(chunk))
+        return restored
+
+    def _split(self, members):
+        """(in-process rows, in-process failures, members to ship) of a list of member indices."""
+        local, rows, failures, shipped = [], {}, {}, []
+        for index in members:
+            parameters = self.member_parameters(index)
+            try:
+                scene = build_member(self.make_scene, parameters)
+            except Exception as error:  # noqa: BLE001 — recorded like a worker's failure
+                failures[index] = failure_record(index, parameters, error)
+                continue
+            (local if _torque_free(scene) else shipped).append((index, scene, parameters))
+        if local:
+            try:
+                for (index, _, _), row in zip(local, torque_free_rows([s for _, s, _ in local], self.at_days)):
+                    rows[index] = row
+            except Exception as error:  # noqa: BLE001
+                failures.update({i: failure_record(i, p, error) for i, _, p in local})
+        return rows, failures, [(index, parameters) for index, _, parameters in shipped]
+
+    def run(self, executor=None, checkpoint=None, progress=None, keep_tables=False):
+        """Run every member not yet done (none restored from ``checkpoint``) and return the outcome table.
+
+        Parameters
+        ----------
+        executor : None, "serial", "dask", int, dask.distributed.Client or concurrent.futures.Executor
+            Where the chunks run (:func:`~spinorbit.ensemble.executors.open_executor`).
+        checkpoint : path, optional
+            Directory of the chunk files: completed chunks are read from it and not run again, and each
+            chunk completed now is written there at once (checksummed, atomic).
+        progress : callable, optional
+            ``progress(members_done, members_total)`` after each completed chunk.
+        keep_tables : bool
+            Keep every member's full result table in :attr:`member_tables` (the torque-free members
+            are then run through their Scene in this process).
+
+        Returns
+        -------
+        QTable
+            :meth:`table`.
+
+        Raises
+        ------
+        EnsembleInterrupted
+            Chunks were lost to the executor (a killed worker, a broken pool); those completed are in
+            the checkpoint and in memory: run again (with the same checkpoint) to run only the rest.
+        """
+        clock = _time.perf_counter()
+        store = None if checkpoint is None else ChunkStore(checkpoint, self.fingerprint)
+        restored = 0 if store is None else self._restore(store)
+        pending = [c for c in range(self.n_chunks) if c not in self._complete]
+        done = self.n_members - sum(len(self.chunk_members(c)) for c in pending)
+        stats = {"members_run": 0, "members_in_process": 0, "members_restored": restored, "chunks_run": 0}
+        report = progress or (lambda done, total: None)
+        report(done, self.n_members)
+
+        def finish(chunk, rows, failures, tables):
+            nonlocal done
+            if store is not None:
+                store.write(chunk, self.chunk_members(chunk), rows, failures)
+            self._rows.update(rows)
+            self._failures.update(failures)
+            self.member_tables.update(tables)
+            self._complete.add(chunk)
+            stats["chunks_run"] += 1
+            done += len(self.chunk_members(chunk))
+            report(done, self.n_members)
+
+        lost = {}
+        with open_executor(executor) as (pool, description):
+            partial, shipped = {}, {}
+            for chunk in pending:
+                members = self.chunk_members(chunk)
+                if keep_tables:
+                    rows, failures, ship = {}, {}, [(i, self.member_parameters(i)) for i in members]
+                else:
+                    rows, failures, ship = self._split(members)
+                stats["members_in_process"] += len(members) - len(ship)
+                stats["members_run"] += len(members)
+                partial[chunk] = (rows, failures)
+                if ship:
+                    shipped[chunk] = ship
+                else:
+                    finish(chunk, rows, failures, {})
+            if pool is None:
+                for chunk, ship in shipped.items():
+                    rows, failures, tables = run_chunk(self.make_scene, ship, self.at_days, keep_tables)
+                    finish(chunk, {**partial[chunk][0], **rows}, {**partial[chunk][1], **failures}, tables)
+            else:
+                futures = {pool.submit(run_chunk, self.make_scene, ship, self.at_days, keep_tables): chunk
+                           for chunk, ship in shipped.items()}
+                for future in concurrent.futures.as_completed(futures):
+                    chunk = futures[future]
+                    try:
+                        rows, failures, tables = future.result()
+                    except Exception as error:  # noqa: BLE001 — the executor lost it: kept for the message
+                        lost[chunk] = error
+                        continue
+                    finish(chunk, {**partial[chunk][0], **rows}, {**partial[chunk][1], **failures}, tables)
+        stats.update(wall_seconds=_time.perf_counter() - clock, executor=description)
+        self.last_run = stats
+        if lost:
+            members = sum(len(self.chunk_members(c)) for c in lost)
+            first = next(iter(lost.values()))
+            where = f"in '{checkpoint}'" if checkpoint is not None else "in memory only (no checkpoint given)"
+            raise EnsembleInterrupted(
+                f"{len(lost)} of {self.n_chunks} chunks ({members} members) did not come back from {description} "
+                f"({type(first).__name__}: {first}); the {self.n_members - members} members completed are kept "
+                f"{where}. Call run() again (with the same checkpoint) to run only the missing members.")
+        return self.table()
+
+    def rerun(self, indices, executor="serial", checkpoint=None):
+        """Run members ``indices`` again, each alone, replace their rows (and failures); return the table.
+
+        Their chunks must be complete (run or restored from ``checkpoint``); with ``checkpoint`` the
+        chunk files are rewritten with the new rows.
+        """
+        store = None if checkpoint is None else ChunkStore(checkpoint, self.fingerprint)
+        if store is not None:
+            self._restore(store)
+        indices = sorted({int(i) for i in indices})
+        bad = [i for i in indices if not 0 <= i < self.n_members]
+        if bad:
+            raise EnsembleError(f"rerun expects member indices in [0, {self.n_members}); got {bad}.")
+        missing = sorted({i // self.chunk_size for i in indices} - self._complete)
+        if missing:
+            raise EnsembleError(f"rerun: the chunks {missing} have not run yet; call run() (with the checkpoint) first.")
+        clock = _time.perf_counter()
+        results = []
+        with open_executor(executor) as (pool, description):
+            for index in indices:  # each alone, by the same path as in run(): torque-free ones in this process
+                rows, failures, ship = self._split([index])
+                if ship:
+                    job = (pool.submit(run_chunk, self.make_scene, ship, self.at_days) if pool is not None else None)
+                    rows, failures, _ = job.result() if job is not None else run_chunk(self.make_scene, ship, self.at_days)
+                results.append((rows, failures, {}))
+        for index, (rows, failures, _) in zip(indices, results):
+            self._rows.pop(index, None)
+            self._failures.pop(index, None)
+            self._rows.update(rows)
+            self._failures.update(failures)
+        if store is not None:
+            for chunk in sorted({i // self.chunk_size for i in indices}):
+                members = self.chunk_members(chunk)
+                store.write(chunk, members, {i: self._rows[i] for i in members if i in self._rows},
+                            {i: self._failures[i] for i in members if i in self._failures})
+        self.last_run = {"members_run": len(indices), "members_in_process": 0, "members_restored": 0,
+                         "chunks_run": len(indices), "wall_seconds": _time.perf_counter() - clock,
+                         "executor": description}
+        return self.table()
+
+    # ------------------------------------------------------------------------------------------
+    def outcome_names(self):
+        """Outcome column names in the table's order (those some member has)."""
+        timed = [] if self.at_days is None else range(self.at_days.size)
+        names = list(TIMED_COLUMNS) if self.at_days is None else [f"{n}_t{k}" for k in timed for n in TIMED_COLUMNS]
+        names += [*INITIAL_COLUMNS, *RUN_COLUMNS]
+        present = {name for row in self._rows.values() for name in row}
+        return [name for name in names if name in present]
+
+    def table(self):
+        """One row per member in member order: parameters, outcome columns, ``error`` ("" when it ran).
+
+        Members not run yet or failed have their outcome columns masked; ``meta`` holds the
+        failures, the chunk size, the outcome times and the fingerprint.
+        """
+        table = self.parameters.copy()
+        n = self.n_members
+        for name in self.outcome_names():
+            present = np.array([name in self._rows.get(i, {}) for i in range(n)])
+            values = [self._rows[i][name] if p else None for i, p in zip(range(n), present)]
+            base = name.rsplit("_t", 1)[0] if self.at_days is not None and "_t" in name else name
+            if any(isinstance(v, str) for v in values):
+                column = MaskedColumn([v if p else "" for v, p in zip(values, present)], mask=~present)
+                table[name] = column if not present.all() else np.array(column.data)
+            elif any(isinstance(v, bool) for v in values):
+                column = MaskedColumn([bool(v) if p else False for v, p in zip(values, present)], mask=~present)
+                table[name] = column if not present.all() else np.array(column.data)
+            else:
+                data = np.array([v if p else 0.0 for v, p in zip(values, present)], dtype=float)
+                if base in OUTCOME_UNITS:
+                    data = data * OUTCOME_UNITS[base]
+                table[name] = data if present.all() else Masked(data, mask=~present)
+        errors = [f"{self._failures[i]['type']}: {self._failures[i]['message']}" if i in self._failures else ""
+                  for i in range(n)]
+        table["error"] = np.array(errors, dtype=str) if any(errors) else np.array([""] * n, dtype="<U1")
+        table.meta.update({"members": n, "chunk_size": self.chunk_size, "fingerprint": self.fingerprint,
+                           "failures": self.failures,
+                           "outcome_times_tdb_days": None if self.at_days is None else self.at_days.tolist(),
+                           "outcome_time": "last output time" if self.at_days is None else "named times (_t<k>)"})
+        return table

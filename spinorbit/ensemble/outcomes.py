@@ -1,0 +1,141 @@
+"""A member's outcome row: its spin state at the end (or at named times) from its SceneResult.
+
+The columns are the output schema's (``docs/conventions.md``, "Output tables"): ``mode``,
+``energy_ratio``, ``P_psi``, ``P_phi``, ``sidereal_period`` (h), ``pole_ra``, ``pole_dec``,
+``pole_lon``, ``pole_lat`` (deg) and ``obliquity`` (deg, when the run has an orbit), plus
+``pole_shift`` (deg: the angle between the angular momentum at that time and at the state's epoch)
+and the initial ``P_psi_initial``, ``P_phi_initial``, ``sidereal_period_initial``, ``energy_ratio_initial`` (the member's state at
+its epoch), then the run's ``error_estimate`` (arcsec), ``tolerance_met`` and ``route``.
+With named times every time-dependent column is suffixed ``_t0``, ``_t1``, …
+
+A row is a dict of plain floats, strings and booleans (units in :data:`OUTCOME_UNITS`), so that a
+chunk's rows cross process boundaries and checkpoints as numbers, bit for bit.
+
+Torque-free members (no perturbers, no orbit) need no integration: mode, E/E0, the periods and the
+pole are constants of the motion, so :func:`torque_free_rows` takes them for all such members of
+one body at once from their initial states (:func:`spinorbit.state_table.table_columns`, one
+compiled loop), in place of the Scene's propagation (whose end pole differs from the initial one by
+the rounding of the propagated momentum only; ``tests/test_ensemble.py``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from astropy import units as u
+
+from spinorbit.ensemble.errors import EnsembleError
+from spinorbit.state_table import MOTION_COLUMNS, POLE_COLUMNS, table_columns
+from spinorbit.time import tdb_days
+
+__all__ = ["OUTCOME_UNITS", "TIMED_COLUMNS", "outcome_row", "time_rows", "torque_free_rows"]
+
+#: Columns that depend on the time of the outcome, in order.
+TIMED_COLUMNS = (*MOTION_COLUMNS, *POLE_COLUMNS, "obliquity", "pole_shift")
+INITIAL_COLUMNS = ("P_psi_initial", "P_phi_initial", "sidereal_period_initial", "energy_ratio_initial")
+RUN_COLUMNS = ("error_estimate", "tolerance_met", "route")
+#: Unit of every numeric outcome column (a suffixed column has its base column's unit).
+OUTCOME_UNITS = {"P_psi": u.h, "P_phi": u.h, "sidereal_period": u.h, "pole_ra": u.deg, "pole_dec": u.deg,
+                 "pole_lon": u.deg, "pole_lat": u.deg, "obliquity": u.deg, "pole_shift": u.deg, "P_psi_initial": u.h,
+                 "P_phi_initial": u.h, "sidereal_period_initial": u.h, "error_estimate": u.arcsec}
+#: Output times within this many days of a named time are that time (float TDB days resolve ~1e-12 d).
+TIME_MATCH_DAYS = 1e-9
+
+
+def _suffix(name, k, timed):
+    return f"{name}_t{k}" if timed else name
+
+
+def time_rows(scene, at):
+    """Row indices of the scene's table at the named times (TDB days), or [last row] when ``at`` is None."""
+    days = np.atleast_1d(np.asarray(scene.output_days, dtype=float))
+    if at is None:
+        return [days.size - 1]
+    rows = []
+    for day in at:
+        k = int(np.argmin(np.abs(days - day)))
+        if abs(days[k] - day) > TIME_MATCH_DAYS:
+            raise EnsembleError(f"at: the time {day!r} (TDB days since J2000) is not among the member's output times "
+                                f"({days[0]!r} … {days[-1]!r}, {days.size} times); name times the scene outputs.")
+        rows.append(k)
+    return rows
+
+
+def _angle_deg(a, b):
+    """Angle (deg) between unit vectors, by atan2 (accurate at small angles)."""
+    return float(np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b)), float(np.dot(a, b)))))
+
+
+def _unit_from_radec(ra_deg, dec_deg):
+    ra, dec = np.radians(ra_deg), np.radians(dec_deg)
+    return np.array([np.cos(dec) * np.cos(ra), np.cos(dec) * np.sin(ra), np.sin(dec)])
+
+
+def _initial(state):
+    p_psi, p_phi = state.periods
+    return {"P_psi_initial": float(p_psi.to_value(u.h)), "P_phi_initial": float(p_phi.to_value(u.h)),
+            "sidereal_period_initial": float(state.sidereal_period.to_value(u.h)),
+            "energy_ratio_initial": float(state.energy_ratio)}
+
+
+def outcome_row(scene, result, at=None):
+    """The outcome columns (dict of plain values) of one single-body member's SceneResult."""
+    table = result.table
+    timed = at is not None
+    start_pole = scene.state.angular_momentum_direction
+    row = {}
+    for k, index in enumerate(time_rows(scene, at)):
+        record = table[index]
+        for name in TIMED_COLUMNS[:-1]:
+            if name not in table.colnames:
+                continue
+            value = record[name]
+            row[_suffix(name, k, timed)] = (str(value) if name == "mode" else
+                                            float(u.Quantity(value).to_value(OUTCOME_UNITS[name]))
+                                            if name in OUTCOME_UNITS else float(value))
+        pole = _unit_from_radec(row[_suffix("pole_ra", k, timed)], row[_suffix("pole_dec", k, timed)])
+        row[_suffix("pole_shift", k, timed)] = _angle_deg(start_pole, pole)
+    row.update(_initial(scene.state))
+    row.update(error_estimate=float(result.error_estimate.to_value(u.arcsec)), tolerance_met=bool(result.tolerance_met),
+               route=str(result.plan.route))
+    return row
+
+
+def torque_free_rows(scenes, at=None):
+    """Outcome rows of torque-free single-body members without orbits, one vectorised call per body.
+
+    Returns a list of dicts in the order of ``scenes``.
+    """
+    groups = {}
+    for position, scene in enumerate(scenes):
+        body = scene.state.body
+        key = (body.moment_values.tobytes(), body.to_principal.tobytes())
+        groups.setdefault(key, []).append(position)
+    rows = [None] * len(scenes)
+    for positions in groups.values():
+        body = scenes[positions[0]].state.body
+        quaternions = np.array([scenes[p].state.quaternion for p in positions])
+        # angular_velocity is in rad/day by construction: .value skips a unit conversion per member
+        omegas = np.array([scenes[p].state.angular_velocity.value for p in positions])
+        columns = table_columns(body, quaternions, omegas, omega=False, motion="rows")
+        plain = {name: (np.asarray(value) if name == "mode" else
+                        u.Quantity(value).to_value(OUTCOME_UNITS[name]) if name in OUTCOME_UNITS else np.asarray(value))
+                 for name, value in columns.items() if name in TIMED_COLUMNS}
+        timed = at is not None
+        for j, p in enumerate(positions):
+            values = {name: (str(plain[name][j]) if name == "mode" else float(plain[name][j]))
+                      for name in TIMED_COLUMNS[:-2]}
+            values["pole_shift"] = 0.0  # the angular momentum is fixed in free rotation
+            row = {}
+            for k in range(len(time_rows(scenes[p], at)) if timed else 1):
+                row.update({_suffix(name, k, timed): value for name, value in values.items()})
+            # constants of the motion: the initial values are the same numbers
+            row.update(P_psi_initial=values["P_psi"], P_phi_initial=values["P_phi"],
+                       sidereal_period_initial=values["sidereal_period"], energy_ratio_initial=values["energy_ratio"],
+                       error_estimate=0.0, tolerance_met=True, route="torque-free")
+            rows[p] = row
+    return rows
+
+
+def days_of(times):
+    """TDB days since J2000 of a Time (scalar or array) as a 1-D float array."""
+    return np.atleast_1d(tdb_days(times)[0])

@@ -58,8 +58,9 @@ def spans_section():
             "| wall per simulated year: integration (+ DE421 sampling) | the whole call per year |\n"
             "|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     return (f"`python benchmarks/moon_validation.py` ({machine_line()}):\n\n{head}\n" + "\n".join(rows) + "\n\n"
-            "The whole call includes building the model (REBOUND set-up, DE421 sampling, the core carried "
-            "from DE421's 1969 epoch for the de421 model) and the comparison with DE421 at every step.")
+            "The whole call includes building the model (REBOUND set-up, DE421 sampling, and for the de421 "
+            "model the core state at the start: shipped for J2000, otherwise carried from DE421's 1969 epoch "
+            "once and cached, coupling/lunar_core.py) and the comparison with DE421 at every step.")
 
 
 def free_modes_section():

@@ -31,9 +31,10 @@ import numpy as np
 from spinorbit.core.jit import jit
 from spinorbit.core.averaging.mean_equations import torus_frequencies
 from spinorbit.core.elements.canonical import (
+    body_part_of_elements,
     elliptic_constants,
     motion_from_elements,
-    state_from_elements_motion,
+    state_from_body_part,
 )
 from spinorbit.core.dynamics.equations import force_function_and_torque_xyz
 from spinorbit.core.elements.equations import inertial_quaternion, reduce_phase, working_elements
@@ -73,7 +74,8 @@ W_DIFFERENCE_STEP = 1e-5
 def torus_u_grid(times, elements, model, frame, ic, n_s, n_psi):
     """U (energy) on the (s_w, ψ) grid s_w = P j/n_s, ψ = 2π k/n_psi at the elements' (S, Z, H, h),
     at each of ``times``: shape (len(times), n_s, n_psi). The attitude of each grid point is built
-    once for all times."""
+    once for all times, and the free motion's body part (one sn/cn/dn and one pn) once per s_w: along
+    ψ only z, hence g, moves (:func:`.canonical.body_part_of_elements`)."""
     period, nu, _ = torus_frequencies(elements[0], elements[1], ic)
     work, flip = working_elements(elements)
     # The motion and elliptic constants of (S, Z) once for the whole grid (they cost as much as the
@@ -84,15 +86,47 @@ def torus_u_grid(times, elements, model, frame, ic, n_s, n_psi):
     for j in range(n_s):
         s_w = period * j / n_s
         work[3] = s_w
+        body = body_part_of_elements(s_w, mo, mk, pk)
         for k in range(n_psi):
             work[4] = 2.0 * math.pi * k / n_psi - nu * s_w
-            attitude, _ = state_from_elements_motion(work, flip, mo, mk, pk)
+            attitude, _ = state_from_body_part(work, flip, body)
             q = inertial_quaternion(attitude, frame)
             for i in range(times.shape[0]):
                 out[i, j, k] = force_function_and_torque_xyz(times[i], q[0], q[1], q[2], q[3], model)[0]
     return out
 
 
+@jit
+def _dft2(grid):
+    """numpy.fft.fft2(grid) / grid.size for the small torus grids, by two direct 1-D transforms
+    (numba has no FFT; 32 × 8 and 64 × 16 points cost ~10⁴–10⁵ complex products)."""
+    n_s, n_psi = grid.shape
+    twiddle_s = np.exp(-2j * math.pi * np.arange(n_s) / n_s)
+    twiddle_psi = np.exp(-2j * math.pi * np.arange(n_psi) / n_psi)
+    rows = np.zeros((n_s, n_psi), dtype=np.complex128)
+    for a in range(n_s):
+        for k in range(n_psi):
+            for b in range(n_psi):
+                rows[a, k] += grid[a, b] * twiddle_psi[(k * b) % n_psi]
+    out = np.zeros((n_s, n_psi), dtype=np.complex128)
+    for j in range(n_s):
+        for a in range(n_s):
+            w = twiddle_s[(j * a) % n_s]
+            for k in range(n_psi):
+                out[j, k] += rows[a, k] * w
+    return out / (n_s * n_psi)
+
+
+@jit
+def _fft_frequencies(n):
+    """numpy.fft.fftfreq(n, 1/n): 0, 1, …, ⌈n/2⌉ − 1, −⌊n/2⌋, …, −1."""
+    out = np.empty(n)
+    for i in range(n):
+        out[i] = i if i < (n + 1) // 2 else i - n
+    return out
+
+
+@jit
 def _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi):
     """(Ŵ, jω + kν per unit s_w, k, ν, mean U) of W's Fourier series at the elements' momenta."""
     period, nu, s_rate = torus_frequencies(elements[0], elements[1], ic)
@@ -101,45 +135,70 @@ def _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi):
     omega_fast = max(2.0 * math.pi / period, abs(nu)) * s_rate
     dt = TIME_DIFFERENCE_FRACTION * 2.0 * math.pi / omega_fast
     five = TIME_DERIVATIVE_ORDER > 2  # c⃛ needs t ± 2δt; ċ, c̈ then take the 4th-order stencils
-    offsets = (0.0, 1.0, -1.0, 2.0, -2.0) if five else (0.0, 1.0, -1.0)
-    grids = torus_u_grid(np.array([t + m * dt for m in offsets]), elements, model, frame, ic, n_s, n_psi)
-    c = [np.fft.fft2(g) / (n_s * n_psi) for g in grids]
-    coeff = c[0]
     if five:
-        c_dot = (8.0 * (c[1] - c[2]) - (c[3] - c[4])) / (12.0 * dt)
-        c_ddot = (16.0 * (c[1] + c[2]) - (c[3] + c[4]) - 30.0 * coeff) / (12.0 * dt * dt)
-        c_dddot = ((c[3] - c[4]) - 2.0 * (c[1] - c[2])) / (2.0 * dt**3)
+        offsets = np.array([0.0, 1.0, -1.0, 2.0, -2.0])
     else:
-        c_dot = (c[1] - c[2]) / (2.0 * dt)
-        c_ddot = (c[1] - 2.0 * coeff + c[2]) / (dt * dt)
-        c_dddot = 0.0
-    j = np.fft.fftfreq(n_s, 1.0 / n_s)[:, None]
-    k = np.fft.fftfreq(n_psi, 1.0 / n_psi)[None, :]
-    rate = j * (2.0 * math.pi / period) + k * nu  # d(phase)/d s_w
+        offsets = np.array([0.0, 1.0, -1.0])
+    g = torus_u_grid(t + offsets * dt, elements, model, frame, ic, n_s, n_psi)
+    # the differences in t are linear, so they are taken on the grids before the transform
+    if five:
+        g_dot = (8.0 * (g[1] - g[2]) - (g[3] - g[4])) / (12.0 * dt)
+        g_ddot = (16.0 * (g[1] + g[2]) - (g[3] + g[4]) - 30.0 * g[0]) / (12.0 * dt * dt)
+        g_dddot = ((g[3] - g[4]) - 2.0 * (g[1] - g[2])) / (2.0 * dt**3)
+    else:
+        g_dot = (g[1] - g[2]) / (2.0 * dt)
+        g_ddot = (g[1] - 2.0 * g[0] + g[2]) / (dt * dt)
+        g_dddot = np.zeros_like(g[0])
+    coeff, c_dot, c_ddot, c_dddot = _dft2(g[0]), _dft2(g_dot), _dft2(g_ddot), _dft2(g_dddot)
+    j = _fft_frequencies(n_s)
+    k = _fft_frequencies(n_psi)
+    rate = np.empty((n_s, n_psi))
+    for a in range(n_s):
+        for b in range(n_psi):
+            rate[a, b] = j[a] * (2.0 * math.pi / period) + k[b] * nu  # d(phase)/d s_w
     mean_u = coeff[0, 0].real
     # Harmonics at the rounding level of the grid are dropped: with a small divisor Ω_jk (some
     # jω + kν is always close to 0 on a large grid) their noise, divided by Ω³ in the c̈ term, would
     # dominate the corrections.
     coeff[0, 0] = 0.0
-    significant = np.abs(coeff) > HARMONIC_NOISE * np.abs(coeff).max()
-    with np.errstate(divide="ignore", invalid="ignore"):
-        i_omega = 1j * s_rate * rate
-        third = c_dddot / i_omega**4 if TIME_DERIVATIVE_ORDER > 2 else np.zeros_like(coeff)
-        third = np.where(np.abs(coeff) > THIRD_TERM_FLOOR * np.abs(coeff).max(), third, 0.0)
-        w_hat = np.where(~significant, 0.0, coeff / i_omega - c_dot / i_omega**2
-                         + (c_ddot / i_omega**3 if TIME_DERIVATIVE_ORDER > 1 else 0.0) - third)
+    largest = np.abs(coeff).max()
+    w_hat = np.zeros((n_s, n_psi), dtype=np.complex128)
+    for a in range(n_s):
+        for b in range(n_psi):
+            size = abs(coeff[a, b])
+            if not size > HARMONIC_NOISE * largest:
+                continue
+            i_omega = 1j * s_rate * rate[a, b]
+            w = coeff[a, b] / i_omega - c_dot[a, b] / i_omega**2
+            if TIME_DERIVATIVE_ORDER > 1:
+                w += c_ddot[a, b] / i_omega**3
+            if TIME_DERIVATIVE_ORDER > 2 and size > THIRD_TERM_FLOOR * largest:
+                w -= c_dddot[a, b] / i_omega**4
+            w_hat[a, b] = w
     return w_hat, rate, k, nu, mean_u
 
 
-def _series(w_hat, rate, k, nu, elements, factor=None):
-    """Real part of Σ Ŵ·factor e^{i(jω s_w + kψ)} at the elements' (s, z)."""
+# What :func:`_series` sums: W itself, ∂W/∂s_w (factor i(jω + kν)) or ∂W/∂z (factor i k).
+SERIES_W, SERIES_D_S, SERIES_D_Z = 0, 1, 2
+
+
+@jit
+def _series(w_hat, rate, k, nu, elements, which):
+    """Real part of Σ Ŵ·factor e^{i(jω s_w + kψ)} at the elements' (s, z), factor by ``which``."""
     sign = 1.0 if elements[0] >= 0.0 else -1.0
     s_w = sign * elements[3]
     psi = elements[4] + nu * s_w
-    j_omega = rate - k * nu
-    phase = np.exp(1j * (j_omega * s_w + k * psi))
-    terms = w_hat * phase if factor is None else w_hat * factor * phase
-    return float(np.sum(terms).real)
+    total = 0.0
+    for a in range(w_hat.shape[0]):
+        for b in range(w_hat.shape[1]):
+            j_omega = rate[a, b] - k[b] * nu
+            term = w_hat[a, b] * np.exp(1j * (j_omega * s_w + k[b] * psi))
+            if which == SERIES_D_S:
+                term *= 1j * rate[a, b]
+            elif which == SERIES_D_Z:
+                term *= 1j * k[b]
+            total += term.real
+    return total
 
 
 def torus_grid_for(model):
@@ -147,12 +206,44 @@ def torus_grid_for(model):
     return GRID_DEGREE2 if model[BODY_NMAX] <= 2 else GRID_DEGREE4
 
 
+@jit
+def _generating_function(t, elements, model, frame, ic, n_s, n_psi):
+    w_hat, rate, k, nu, _ = _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi)
+    return _series(w_hat, rate, k, nu, elements, SERIES_W)
+
+
 def generating_function(t, elements, model, frame, ic, n_s=None, n_psi=None):
     """W(t, elements) (energy·time): the first-order generating function (module docstring)."""
     if n_s is None or n_psi is None:
         n_s, n_psi = torus_grid_for(model)
+    elements = np.ascontiguousarray(elements, dtype=float)
+    return _generating_function(float(t), elements, model, frame, ic, n_s, n_psi)
+
+
+@jit
+def _short_period_offsets(t, elements, model, frame, ic, n_s, n_psi):
+    """Kernel of :func:`short_period_offsets` (compiled: the map is the averaged propagator's fixed cost)."""
+    sign = 1.0 if elements[0] >= 0.0 else -1.0
     w_hat, rate, k, nu, _ = _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi)
-    return _series(w_hat, rate, k, nu, elements)
+    out = np.empty(6)
+    out[0] = sign * _series(w_hat, rate, k, nu, elements, SERIES_D_S)  # ∂W/∂s = sign ∂W/∂s_w
+    out[1] = _series(w_hat, rate, k, nu, elements, SERIES_D_Z)  # ∂W/∂z
+    # central differences of W in S, Z, H (relative step of Z) and h (absolute step)
+    partial = np.empty(4)
+    for n, index in enumerate((0, 1, 2, 5)):
+        step = W_DIFFERENCE_STEP if index == 5 else W_DIFFERENCE_STEP * elements[1]
+        shifted = elements.copy()
+        shifted[index] += step
+        w_plus = _generating_function(t, shifted, model, frame, ic, n_s, n_psi)
+        shifted[index] = elements[index] - step
+        w_minus = _generating_function(t, shifted, model, frame, ic, n_s, n_psi)
+        partial[n] = (w_plus - w_minus) / (2.0 * step)
+    d_big_s, d_big_z, d_big_h, d_h = partial
+    out[2] = d_h
+    out[3] = -d_big_s
+    out[4] = -d_big_z
+    out[5] = -d_big_h
+    return out
 
 
 def short_period_offsets(t, elements, model, frame, ic, n_s=None, n_psi=None):
@@ -177,26 +268,7 @@ def short_period_offsets(t, elements, model, frame, ic, n_s=None, n_psi=None):
     if n_s is None or n_psi is None:
         n_s, n_psi = torus_grid_for(model)
     elements = np.ascontiguousarray(elements, dtype=float)
-    sign = 1.0 if elements[0] >= 0.0 else -1.0
-    w_hat, rate, k, nu, _ = _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi)
-    out = np.empty(6)
-    out[0] = sign * _series(w_hat, rate, k, nu, elements, 1j * rate)  # ∂W/∂s = sign ∂W/∂s_w
-    out[1] = _series(w_hat, rate, k, nu, elements, 1j * k)  # ∂W/∂z
-    steps = (W_DIFFERENCE_STEP * elements[1],) * 3 + (W_DIFFERENCE_STEP,)
-    partial = []
-    for index, step in zip((0, 1, 2, 5), steps):
-        values = []
-        for delta in (step, -step):
-            shifted = elements.copy()
-            shifted[index] += delta
-            values.append(generating_function(t, shifted, model, frame, ic, n_s, n_psi))
-        partial.append((values[0] - values[1]) / (2.0 * step))
-    d_big_s, d_big_z, d_big_h, d_h = partial
-    out[2] = d_h
-    out[3] = -d_big_s
-    out[4] = -d_big_z
-    out[5] = -d_big_h
-    return out
+    return _short_period_offsets(float(t), elements, model, frame, ic, n_s, n_psi)
 
 
 def mean_to_osculating(t, mean, model, frame, ic):

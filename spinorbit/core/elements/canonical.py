@@ -453,21 +453,38 @@ def state_from_elements(elements, flip, ic):
 
 
 @jit
+def body_part_of_elements(s, mo, mk, pk):
+    """The part of the backward map that depends on s alone: (M_x, M_y, M_z, sin l, cos l, g − z).
+
+    One sn/cn/dn and one pn; callers that vary only z, H or h at fixed (S, Z, s) (the torus grid of
+    :mod:`spinorbit.core.averaging.short_period`) compute it once (:func:`state_from_body_part`).
+    """
+    arg = s * mo[MO_ARG_PER_S]
+    mx, my, mz, sin_l, cos_l = body_from_argument(arg, mo, mk)
+    return mx, my, mz, sin_l, cos_l, mo[MO_G_PER_S] * s + mo[MO_PN_COEFF] * pn_k(arg, mk, pk)
+
+
+@jit
+def state_from_body_part(elements, flip, body):
+    """The rest of the backward map: (attitude, body momentum) from ``body`` =
+    :func:`body_part_of_elements` of elements[s] and the elements' Z, H, z, h."""
+    big_z, big_h = elements[EL_Z], elements[EL_H]
+    z, h = elements[EL_SMALL_Z], elements[EL_SMALL_H]
+    mx, my, mz, sin_l, cos_l, g_minus_z = body
+    sin_i = math.sqrt(max((big_z - big_h) * (big_z + big_h), 0.0)) / big_z
+    working = attitude_from_parts(mx, my, mz, sin_l, cos_l, z + g_minus_z, big_h / big_z, sin_i, h)
+    fx, fy, fz = flip_signs(flip)
+    return flip_attitude(working, flip), np.array([fx * mx, fy * my, fz * mz])
+
+
+@jit
 def state_from_elements_motion(elements, flip, mo, mk, pk):
     """:func:`state_from_elements` with the motion and elliptic constants of (S, Z) supplied.
 
     For callers that need them anyway (the element integrator's RHS also builds the Jacobian from
     them): computing them costs about as much as the rest of the backward map.
     """
-    big_z, big_h, s = elements[EL_Z], elements[EL_H], elements[EL_SMALL_S]
-    z, h = elements[EL_SMALL_Z], elements[EL_SMALL_H]
-    arg = s * mo[MO_ARG_PER_S]
-    mx, my, mz, sin_l, cos_l = body_from_argument(arg, mo, mk)
-    g = z + mo[MO_G_PER_S] * s + mo[MO_PN_COEFF] * pn_k(arg, mk, pk)
-    sin_i = math.sqrt(max((big_z - big_h) * (big_z + big_h), 0.0)) / big_z
-    working = attitude_from_parts(mx, my, mz, sin_l, cos_l, g, big_h / big_z, sin_i, h)
-    fx, fy, fz = flip_signs(flip)
-    return flip_attitude(working, flip), np.array([fx * mx, fy * my, fz * mz])
+    return state_from_body_part(elements, flip, body_part_of_elements(elements[EL_SMALL_S], mo, mk, pk))
 
 
 # Status codes of the paper-named kernels (the Python wrappers turn them into exceptions).

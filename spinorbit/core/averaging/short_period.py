@@ -13,8 +13,9 @@ with ω = 2π/P, and
 
 the c_jk from a 2-D FFT of U sampled on the torus grid (:func:`torus_u_grid`). The osculating
 elements are x_osc = x_mean + {x, W}: ΔS = ∂W/∂s, ΔZ = ∂W/∂z, ΔH = ∂W/∂h, Δs = −∂W/∂S,
-Δz = −∂W/∂Z, Δh = −∂W/∂H. ∂W/∂s = (U − ⟨U⟩)/(aS) and ∂W/∂z are spectral; the momentum partials are
-central differences of W at fixed (s, z, h). U also moves with time t through the perturbers (orbital time scale, rate n ≪ Ω); the
+Δz = −∂W/∂Z, Δh = −∂W/∂H. ∂W/∂s = (U − ⟨U⟩)/(aS) and ∂W/∂z are spectral; ∂W/∂H and ∂W/∂h are the same
+series of ∂U/∂H, ∂U/∂h (from the torque: H, h leave the free motion unchanged); ∂W/∂S, ∂W/∂Z are
+central differences of W at fixed (s, z, H, h). U also moves with time t through the perturbers (orbital time scale, rate n ≪ Ω); the
 homological equation is then a S ∂W/∂s + ∂W/∂t = U − ⟨U⟩, solved to third order in n/Ω:
 Ŵ_jk = c_jk/(iΩ_jk) − ċ_jk/(iΩ_jk)² + c̈_jk/(iΩ_jk)³ − c⃛_jk/(iΩ_jk)⁴ (without the ċ term the
 corrections keep an error ∝ the torque × n/Ω, measured as a first-order slope; the c̈ term removes
@@ -37,7 +38,14 @@ from spinorbit.core.elements.canonical import (
     state_from_body_part,
 )
 from spinorbit.core.dynamics.equations import force_function_and_torque_xyz
-from spinorbit.core.elements.equations import inertial_quaternion, reduce_phase, working_elements
+from spinorbit.core.elements.equations import (
+    DU_H,
+    DU_SMALL_H,
+    andoyer_gradient_from_torque,
+    inertial_quaternion,
+    reduce_phase,
+    working_elements,
+)
 from spinorbit.core.model.gravity_field import BODY_NMAX
 
 #: Torus grid (points per period of s, points in the precession phase ψ) by the figure's degree.
@@ -66,34 +74,55 @@ THIRD_TERM_FLOOR = 1e-6
 #: of the differences is ~ (n δt)² ≈ 1e-5 relative; 1e-2 was measured worse (the second difference
 #: then amplifies the grid's rounding: round trips of 2e-7 instead of 3e-9 at 100× the solar torque).
 TIME_DIFFERENCE_FRACTION = 0.1
-#: Relative step (of Z) of the central differences of W in S, Z, H; absolute step (rad) in h.
+#: Relative step (of Z) of the central differences of W in S and Z (∂W/∂H, ∂W/∂h come from the torque).
 W_DIFFERENCE_STEP = 1e-5
 
 
+# Fields of the torus grids: U and its partials in H and h at fixed (S, Z, s, z), from the torque.
+FIELD_U, FIELD_DU_DH, FIELD_DU_DSMALL_H = range(3)
+
+
 @jit
-def torus_u_grid(times, elements, model, frame, ic, n_s, n_psi):
-    """U (energy) on the (s_w, ψ) grid s_w = P j/n_s, ψ = 2π k/n_psi at the elements' (S, Z, H, h),
-    at each of ``times``: shape (len(times), n_s, n_psi). The attitude of each grid point is built
-    once for all times, and the free motion's body part (one sn/cn/dn and one pn) once per s_w: along
-    ψ only z, hence g, moves (:func:`.canonical.body_part_of_elements`)."""
+def torus_grids(times, elements, model, frame, ic, n_s, n_psi, n_fields):
+    """U (energy), and for ``n_fields`` = 3 also ∂U/∂H, ∂U/∂h, on the (s_w, ψ) grid s_w = P j/n_s,
+    ψ = 2π k/n_psi at the elements' (S, Z, H, h), at each of ``times``: shape
+    (len(times), n_fields, n_s, n_psi) (FIELD_*).
+
+    The attitude of each grid point is built once for all times, and the free motion's body part
+    (one sn/cn/dn and one pn) once per s_w: along ψ only z, hence g, moves
+    (:func:`.canonical.body_part_of_elements`). ∂U/∂H and ∂U/∂h are the Andoyer partials from the
+    body torque (:func:`.equations.andoyer_gradient_from_torque`): H and h are both an Andoyer and a
+    canonical pair, so they are the canonical partials too, exactly, with no difference step.
+    """
     period, nu, _ = torus_frequencies(elements[0], elements[1], ic)
     work, flip = working_elements(elements)
     # The motion and elliptic constants of (S, Z) once for the whole grid (they cost as much as the
     # rest of a backward map).
     mo = motion_from_elements(work[0], work[1], ic)
     mk, pk = elliptic_constants(mo)
-    out = np.empty((times.shape[0], n_s, n_psi))
+    out = np.empty((times.shape[0], n_fields, n_s, n_psi))
     for j in range(n_s):
         s_w = period * j / n_s
         work[3] = s_w
         body = body_part_of_elements(s_w, mo, mk, pk)
         for k in range(n_psi):
             work[4] = 2.0 * math.pi * k / n_psi - nu * s_w
-            attitude, _ = state_from_body_part(work, flip, body)
+            attitude, momentum = state_from_body_part(work, flip, body)
             q = inertial_quaternion(attitude, frame)
             for i in range(times.shape[0]):
-                out[i, j, k] = force_function_and_torque_xyz(times[i], q[0], q[1], q[2], q[3], model)[0]
+                u, nx, ny, nz = force_function_and_torque_xyz(times[i], q[0], q[1], q[2], q[3], model)
+                out[i, FIELD_U, j, k] = u
+                if n_fields > 1:
+                    gradient = andoyer_gradient_from_torque(attitude, momentum, nx, ny, nz)
+                    out[i, FIELD_DU_DH, j, k] = gradient[DU_H]
+                    out[i, FIELD_DU_DSMALL_H, j, k] = gradient[DU_SMALL_H]
     return out
+
+
+@jit
+def torus_u_grid(times, elements, model, frame, ic, n_s, n_psi):
+    """U (energy) on the torus grid of :func:`torus_grids` at each of ``times``: (len(times), n_s, n_psi)."""
+    return torus_grids(times, elements, model, frame, ic, n_s, n_psi, 1)[:, FIELD_U]
 
 
 @jit
@@ -127,8 +156,13 @@ def _fft_frequencies(n):
 
 
 @jit
-def _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi):
-    """(Ŵ, jω + kν per unit s_w, k, ν, mean U) of W's Fourier series at the elements' momenta."""
+def _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi, n_fields):
+    """(Ŵ, jω + kν per unit s_w, k, ν, mean U) of W's Fourier series at the elements' momenta.
+
+    Ŵ has shape (n_fields, n_s, n_psi): the series of W and, for ``n_fields`` = 3, of ∂W/∂H and
+    ∂W/∂h (the same linear map applied to ∂U/∂H, ∂U/∂h, which leave ω, ν and the grid unchanged;
+    the harmonics kept are those significant in U).
+    """
     period, nu, s_rate = torus_frequencies(elements[0], elements[1], ic)
     # ∂U/∂t and ∂²U/∂t² through the perturbers' motion: central differences over a fraction of the
     # fastest torus period (the grid varies on the orbital time scale).
@@ -139,42 +173,50 @@ def _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi):
         offsets = np.array([0.0, 1.0, -1.0, 2.0, -2.0])
     else:
         offsets = np.array([0.0, 1.0, -1.0])
-    g = torus_u_grid(t + offsets * dt, elements, model, frame, ic, n_s, n_psi)
-    # the differences in t are linear, so they are taken on the grids before the transform
-    if five:
-        g_dot = (8.0 * (g[1] - g[2]) - (g[3] - g[4])) / (12.0 * dt)
-        g_ddot = (16.0 * (g[1] + g[2]) - (g[3] + g[4]) - 30.0 * g[0]) / (12.0 * dt * dt)
-        g_dddot = ((g[3] - g[4]) - 2.0 * (g[1] - g[2])) / (2.0 * dt**3)
-    else:
-        g_dot = (g[1] - g[2]) / (2.0 * dt)
-        g_ddot = (g[1] - 2.0 * g[0] + g[2]) / (dt * dt)
-        g_dddot = np.zeros_like(g[0])
-    coeff, c_dot, c_ddot, c_dddot = _dft2(g[0]), _dft2(g_dot), _dft2(g_ddot), _dft2(g_dddot)
+    grids = torus_grids(t + offsets * dt, elements, model, frame, ic, n_s, n_psi, n_fields)
     j = _fft_frequencies(n_s)
     k = _fft_frequencies(n_psi)
     rate = np.empty((n_s, n_psi))
     for a in range(n_s):
         for b in range(n_psi):
             rate[a, b] = j[a] * (2.0 * math.pi / period) + k[b] * nu  # d(phase)/d s_w
-    mean_u = coeff[0, 0].real
-    # Harmonics at the rounding level of the grid are dropped: with a small divisor Ω_jk (some
-    # jω + kν is always close to 0 on a large grid) their noise, divided by Ω³ in the c̈ term, would
-    # dominate the corrections.
-    coeff[0, 0] = 0.0
-    largest = np.abs(coeff).max()
-    w_hat = np.zeros((n_s, n_psi), dtype=np.complex128)
-    for a in range(n_s):
-        for b in range(n_psi):
-            size = abs(coeff[a, b])
-            if not size > HARMONIC_NOISE * largest:
-                continue
-            i_omega = 1j * s_rate * rate[a, b]
-            w = coeff[a, b] / i_omega - c_dot[a, b] / i_omega**2
-            if TIME_DERIVATIVE_ORDER > 1:
-                w += c_ddot[a, b] / i_omega**3
-            if TIME_DERIVATIVE_ORDER > 2 and size > THIRD_TERM_FLOOR * largest:
-                w -= c_dddot[a, b] / i_omega**4
-            w_hat[a, b] = w
+    w_hat = np.zeros((n_fields, n_s, n_psi), dtype=np.complex128)
+    mean_u = 0.0
+    significant = np.zeros((n_s, n_psi), dtype=np.bool_)
+    third_kept = np.zeros((n_s, n_psi), dtype=np.bool_)
+    for field in range(n_fields):
+        g = grids[:, field]
+        # the differences in t are linear, so they are taken on the grids before the transform
+        if five:
+            g_dot = (8.0 * (g[1] - g[2]) - (g[3] - g[4])) / (12.0 * dt)
+            g_ddot = (16.0 * (g[1] + g[2]) - (g[3] + g[4]) - 30.0 * g[0]) / (12.0 * dt * dt)
+            g_dddot = ((g[3] - g[4]) - 2.0 * (g[1] - g[2])) / (2.0 * dt**3)
+        else:
+            g_dot = (g[1] - g[2]) / (2.0 * dt)
+            g_ddot = (g[1] - 2.0 * g[0] + g[2]) / (dt * dt)
+            g_dddot = np.zeros_like(g[0])
+        coeff, c_dot, c_ddot, c_dddot = _dft2(g[0]), _dft2(g_dot), _dft2(g_ddot), _dft2(g_dddot)
+        if field == FIELD_U:
+            mean_u = coeff[0, 0].real
+            # Harmonics at the rounding level of the grid are dropped: with a small divisor Ω_jk
+            # (some jω + kν is always close to 0 on a large grid) their noise, divided by Ω³ in the
+            # c̈ term, would dominate the corrections.
+            coeff[0, 0] = 0.0
+            largest = np.abs(coeff).max()
+            size = np.abs(coeff)
+            significant = size > HARMONIC_NOISE * largest
+            third_kept = size > THIRD_TERM_FLOOR * largest
+        for a in range(n_s):
+            for b in range(n_psi):
+                if not significant[a, b]:
+                    continue
+                i_omega = 1j * s_rate * rate[a, b]
+                w = coeff[a, b] / i_omega - c_dot[a, b] / i_omega**2
+                if TIME_DERIVATIVE_ORDER > 1:
+                    w += c_ddot[a, b] / i_omega**3
+                if TIME_DERIVATIVE_ORDER > 2 and third_kept[a, b]:
+                    w -= c_dddot[a, b] / i_omega**4
+                w_hat[field, a, b] = w
     return w_hat, rate, k, nu, mean_u
 
 
@@ -208,8 +250,8 @@ def torus_grid_for(model):
 
 @jit
 def _generating_function(t, elements, model, frame, ic, n_s, n_psi):
-    w_hat, rate, k, nu, _ = _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi)
-    return _series(w_hat, rate, k, nu, elements, SERIES_W)
+    w_hat, rate, k, nu, _ = _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi, 1)
+    return _series(w_hat[FIELD_U], rate, k, nu, elements, SERIES_W)
 
 
 def generating_function(t, elements, model, frame, ic, n_s=None, n_psi=None):
@@ -224,21 +266,23 @@ def generating_function(t, elements, model, frame, ic, n_s=None, n_psi=None):
 def _short_period_offsets(t, elements, model, frame, ic, n_s, n_psi):
     """Kernel of :func:`short_period_offsets` (compiled: the map is the averaged propagator's fixed cost)."""
     sign = 1.0 if elements[0] >= 0.0 else -1.0
-    w_hat, rate, k, nu, _ = _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi)
+    w_hat, rate, k, nu, _ = _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi, 3)
     out = np.empty(6)
-    out[0] = sign * _series(w_hat, rate, k, nu, elements, SERIES_D_S)  # ∂W/∂s = sign ∂W/∂s_w
-    out[1] = _series(w_hat, rate, k, nu, elements, SERIES_D_Z)  # ∂W/∂z
-    # central differences of W in S, Z, H (relative step of Z) and h (absolute step)
-    partial = np.empty(4)
-    for n, index in enumerate((0, 1, 2, 5)):
-        step = W_DIFFERENCE_STEP if index == 5 else W_DIFFERENCE_STEP * elements[1]
+    out[0] = sign * _series(w_hat[FIELD_U], rate, k, nu, elements, SERIES_D_S)  # ∂W/∂s = sign ∂W/∂s_w
+    out[1] = _series(w_hat[FIELD_U], rate, k, nu, elements, SERIES_D_Z)  # ∂W/∂z
+    d_big_h = _series(w_hat[FIELD_DU_DH], rate, k, nu, elements, SERIES_W)  # ∂W/∂H
+    d_h = _series(w_hat[FIELD_DU_DSMALL_H], rate, k, nu, elements, SERIES_W)  # ∂W/∂h
+    # S and Z move the free motion itself (the grid, ω, ν): central differences of W, step ∝ Z
+    partial = np.empty(2)
+    for n, index in enumerate((0, 1)):
+        step = W_DIFFERENCE_STEP * elements[1]
         shifted = elements.copy()
         shifted[index] += step
         w_plus = _generating_function(t, shifted, model, frame, ic, n_s, n_psi)
         shifted[index] = elements[index] - step
         w_minus = _generating_function(t, shifted, model, frame, ic, n_s, n_psi)
         partial[n] = (w_plus - w_minus) / (2.0 * step)
-    d_big_s, d_big_z, d_big_h, d_h = partial
+    d_big_s, d_big_z = partial
     out[2] = d_h
     out[3] = -d_big_s
     out[4] = -d_big_z

@@ -37,7 +37,7 @@ from spinorbit.core.elements.canonical import (
     motion_from_elements,
     state_from_body_part,
 )
-from spinorbit.core.dynamics.equations import force_function_and_torque_xyz
+from spinorbit.core.dynamics.equations import MODEL_PERTURBERS, perturber_force_function_and_torque_xyz
 from spinorbit.core.elements.equations import (
     DU_H,
     DU_SMALL_H,
@@ -47,6 +47,7 @@ from spinorbit.core.elements.equations import (
     working_elements,
 )
 from spinorbit.core.model.gravity_field import BODY_NMAX
+from spinorbit.core.model.perturbers import PERTURBER_ROW, perturber_position_xyz
 
 #: Torus grid (points per period of s, points in the precession phase ψ) by the figure's degree.
 #: Degree 2 has ψ-harmonics |k| ≤ 2 (8 points resolve them exactly); 32 points in s leave 4e-12 of
@@ -100,6 +101,15 @@ def torus_grids(times, elements, model, frame, ic, n_s, n_psi, n_fields):
     # rest of a backward map).
     mo = motion_from_elements(work[0], work[1], ic)
     mk, pk = elliptic_constants(mo)
+    # the perturbers' positions once per time, not once per grid point (a Kepler solve each)
+    n_perturbers = int(model[MODEL_PERTURBERS])
+    positions = np.empty((times.shape[0], n_perturbers, 3))
+    mus = np.empty(n_perturbers)
+    for p in range(n_perturbers):
+        row = MODEL_PERTURBERS + 1 + p * PERTURBER_ROW
+        mus[p] = model[row + 1]
+        for i in range(times.shape[0]):
+            positions[i, p, 0], positions[i, p, 1], positions[i, p, 2] = perturber_position_xyz(times[i], model, row)
     out = np.empty((times.shape[0], n_fields, n_s, n_psi))
     for j in range(n_s):
         s_w = period * j / n_s
@@ -110,7 +120,12 @@ def torus_grids(times, elements, model, frame, ic, n_s, n_psi, n_fields):
             attitude, momentum = state_from_body_part(work, flip, body)
             q = inertial_quaternion(attitude, frame)
             for i in range(times.shape[0]):
-                u, nx, ny, nz = force_function_and_torque_xyz(times[i], q[0], q[1], q[2], q[3], model)
+                u, nx, ny, nz = 0.0, 0.0, 0.0, 0.0
+                for p in range(n_perturbers):
+                    u_p, nx_p, ny_p, nz_p = perturber_force_function_and_torque_xyz(
+                        q[0], q[1], q[2], q[3], positions[i, p, 0], positions[i, p, 1], positions[i, p, 2], mus[p],
+                        model)
+                    u, nx, ny, nz = u + u_p, nx + nx_p, ny + ny_p, nz + nz_p
                 out[i, FIELD_U, j, k] = u
                 if n_fields > 1:
                     gradient = andoyer_gradient_from_torque(attitude, momentum, nx, ny, nz)
@@ -126,24 +141,22 @@ def torus_u_grid(times, elements, model, frame, ic, n_s, n_psi):
 
 
 @jit
-def _dft2(grid):
-    """numpy.fft.fft2(grid) / grid.size for the small torus grids, by two direct 1-D transforms
-    (numba has no FFT; 32 × 8 and 64 × 16 points cost ~10⁴–10⁵ complex products)."""
+def _dft_matrix(n):
+    """The n × n matrix of the forward DFT, exp(−2πi jk/n) (numpy.fft's sign convention)."""
+    out = np.empty((n, n), dtype=np.complex128)
+    for j in range(n):
+        for k in range(n):
+            out[j, k] = np.exp(-2j * math.pi * ((j * k) % n) / n)
+    return out
+
+
+@jit
+def _dft2(grid, matrix_s, matrix_psi):
+    """numpy.fft.fft2(grid) / grid.size for the small torus grids, as two matrix products with the
+    DFT matrices of :func:`_dft_matrix` (numba has no FFT; 32 × 8 and 64 × 16 points)."""
     n_s, n_psi = grid.shape
-    twiddle_s = np.exp(-2j * math.pi * np.arange(n_s) / n_s)
-    twiddle_psi = np.exp(-2j * math.pi * np.arange(n_psi) / n_psi)
-    rows = np.zeros((n_s, n_psi), dtype=np.complex128)
-    for a in range(n_s):
-        for k in range(n_psi):
-            for b in range(n_psi):
-                rows[a, k] += grid[a, b] * twiddle_psi[(k * b) % n_psi]
-    out = np.zeros((n_s, n_psi), dtype=np.complex128)
-    for j in range(n_s):
-        for a in range(n_s):
-            w = twiddle_s[(j * a) % n_s]
-            for k in range(n_psi):
-                out[j, k] += rows[a, k] * w
-    return out / (n_s * n_psi)
+    rows = np.dot(grid.astype(np.complex128), matrix_psi)
+    return np.dot(matrix_s, rows) / (n_s * n_psi)
 
 
 @jit
@@ -156,13 +169,15 @@ def _fft_frequencies(n):
 
 
 @jit
-def _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi, n_fields):
-    """(Ŵ, jω + kν per unit s_w, k, ν, mean U) of W's Fourier series at the elements' momenta.
+def _generating_coefficients(t, elements, model, frame, ic, matrix_s, matrix_psi, n_fields):
+    """(Ŵ, jω + kν per unit s_w, k, ν, mean U) of W's Fourier series at the elements' momenta, on the
+    torus grid of the DFT matrices ``matrix_s``, ``matrix_psi`` (:func:`_dft_matrix` of n_s, n_psi).
 
     Ŵ has shape (n_fields, n_s, n_psi): the series of W and, for ``n_fields`` = 3, of ∂W/∂H and
     ∂W/∂h (the same linear map applied to ∂U/∂H, ∂U/∂h, which leave ω, ν and the grid unchanged;
     the harmonics kept are those significant in U).
     """
+    n_s, n_psi = matrix_s.shape[0], matrix_psi.shape[0]
     period, nu, s_rate = torus_frequencies(elements[0], elements[1], ic)
     # ∂U/∂t and ∂²U/∂t² through the perturbers' motion: central differences over a fraction of the
     # fastest torus period (the grid varies on the orbital time scale).
@@ -195,7 +210,8 @@ def _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi, n_fields
             g_dot = (g[1] - g[2]) / (2.0 * dt)
             g_ddot = (g[1] - 2.0 * g[0] + g[2]) / (dt * dt)
             g_dddot = np.zeros_like(g[0])
-        coeff, c_dot, c_ddot, c_dddot = _dft2(g[0]), _dft2(g_dot), _dft2(g_ddot), _dft2(g_dddot)
+        coeff, c_dot, c_ddot, c_dddot = (_dft2(g[0], matrix_s, matrix_psi), _dft2(g_dot, matrix_s, matrix_psi),
+                                         _dft2(g_ddot, matrix_s, matrix_psi), _dft2(g_dddot, matrix_s, matrix_psi))
         if field == FIELD_U:
             mean_u = coeff[0, 0].real
             # Harmonics at the rounding level of the grid are dropped: with a small divisor Ω_jk
@@ -249,8 +265,8 @@ def torus_grid_for(model):
 
 
 @jit
-def _generating_function(t, elements, model, frame, ic, n_s, n_psi):
-    w_hat, rate, k, nu, _ = _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi, 1)
+def _generating_function(t, elements, model, frame, ic, matrix_s, matrix_psi):
+    w_hat, rate, k, nu, _ = _generating_coefficients(t, elements, model, frame, ic, matrix_s, matrix_psi, 1)
     return _series(w_hat[FIELD_U], rate, k, nu, elements, SERIES_W)
 
 
@@ -259,14 +275,15 @@ def generating_function(t, elements, model, frame, ic, n_s=None, n_psi=None):
     if n_s is None or n_psi is None:
         n_s, n_psi = torus_grid_for(model)
     elements = np.ascontiguousarray(elements, dtype=float)
-    return _generating_function(float(t), elements, model, frame, ic, n_s, n_psi)
+    return _generating_function(float(t), elements, model, frame, ic, _dft_matrix(n_s), _dft_matrix(n_psi))
 
 
 @jit
 def _short_period_offsets(t, elements, model, frame, ic, n_s, n_psi):
     """Kernel of :func:`short_period_offsets` (compiled: the map is the averaged propagator's fixed cost)."""
     sign = 1.0 if elements[0] >= 0.0 else -1.0
-    w_hat, rate, k, nu, _ = _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi, 3)
+    matrix_s, matrix_psi = _dft_matrix(n_s), _dft_matrix(n_psi)
+    w_hat, rate, k, nu, _ = _generating_coefficients(t, elements, model, frame, ic, matrix_s, matrix_psi, 3)
     out = np.empty(6)
     out[0] = sign * _series(w_hat[FIELD_U], rate, k, nu, elements, SERIES_D_S)  # ∂W/∂s = sign ∂W/∂s_w
     out[1] = _series(w_hat[FIELD_U], rate, k, nu, elements, SERIES_D_Z)  # ∂W/∂z
@@ -278,9 +295,9 @@ def _short_period_offsets(t, elements, model, frame, ic, n_s, n_psi):
         step = W_DIFFERENCE_STEP * elements[1]
         shifted = elements.copy()
         shifted[index] += step
-        w_plus = _generating_function(t, shifted, model, frame, ic, n_s, n_psi)
+        w_plus = _generating_function(t, shifted, model, frame, ic, matrix_s, matrix_psi)
         shifted[index] = elements[index] - step
-        w_minus = _generating_function(t, shifted, model, frame, ic, n_s, n_psi)
+        w_minus = _generating_function(t, shifted, model, frame, ic, matrix_s, matrix_psi)
         partial[n] = (w_plus - w_minus) / (2.0 * step)
     d_big_s, d_big_z = partial
     out[2] = d_h

@@ -48,6 +48,7 @@ from spinorbit.core.elements.equations import (
 )
 from spinorbit.core.model.gravity_field import BODY_NMAX
 from spinorbit.core.model.perturbers import PERTURBER_ROW, perturber_position_xyz
+from spinorbit.core.math.rotations import qmul_parts
 
 #: Torus grid (points per period of s, points in the precession phase ψ) by the figure's degree.
 #: Degree 2 has ψ-harmonics |k| ≤ 2 (8 points resolve them exactly); 32 points in s leave 4e-12 of
@@ -111,14 +112,28 @@ def torus_grids(times, elements, model, frame, ic, n_s, n_psi, n_fields):
         for i in range(times.shape[0]):
             positions[i, p, 0], positions[i, p, 1], positions[i, p, 2] = perturber_position_xyz(times[i], model, row)
     out = np.empty((times.shape[0], n_fields, n_s, n_psi))
+    q = np.empty(4)
     for j in range(n_s):
         s_w = period * j / n_s
         work[3] = s_w
         body = body_part_of_elements(s_w, mo, mk, pk)
         for k in range(n_psi):
             work[4] = 2.0 * math.pi * k / n_psi - nu * s_w
-            attitude, momentum = state_from_body_part(work, flip, body)
-            q = inertial_quaternion(attitude, frame)
+            if n_fields > 1 or k == 0:
+                attitude, momentum = state_from_body_part(work, flip, body)
+                q = inertial_quaternion(attitude, frame)
+                if k == 0:
+                    q_first, axis = q.copy(), inertial_direction(q, momentum)
+            else:
+                # z is the angle about the angular momentum: a step δ in z turns the body by δ about
+                # the (inertial, constant) momentum direction, so the attitude is that turn of the
+                # first point's (one product instead of the backward map; checked against it in
+                # tests/test_averaged.py)
+                half = math.pi * k / n_psi
+                sin_half = math.sin(half)
+                q[0], q[1], q[2], q[3] = qmul_parts(math.cos(half), sin_half * axis[0], sin_half * axis[1],
+                                                    sin_half * axis[2], q_first[0], q_first[1], q_first[2],
+                                                    q_first[3])
             for i in range(times.shape[0]):
                 u, nx, ny, nz = 0.0, 0.0, 0.0, 0.0
                 for p in range(n_perturbers):
@@ -132,6 +147,18 @@ def torus_grids(times, elements, model, frame, ic, n_s, n_psi, n_fields):
                     out[i, FIELD_DU_DH, j, k] = gradient[DU_H]
                     out[i, FIELD_DU_DSMALL_H, j, k] = gradient[DU_SMALL_H]
     return out
+
+
+@jit
+def inertial_direction(q, body_vector):
+    """Unit vector (3,) along q ⊗ v ⊗ q* (body → inertial) of a body-frame vector."""
+    w, x, y, z = q[0], q[1], q[2], q[3]
+    vx, vy, vz = body_vector[0], body_vector[1], body_vector[2]
+    out = np.empty(3)
+    out[0] = (w * w + x * x - y * y - z * z) * vx + 2.0 * (x * y - w * z) * vy + 2.0 * (x * z + w * y) * vz
+    out[1] = 2.0 * (x * y + w * z) * vx + (w * w - x * x + y * y - z * z) * vy + 2.0 * (y * z - w * x) * vz
+    out[2] = 2.0 * (x * z - w * y) * vx + 2.0 * (y * z + w * x) * vy + (w * w - x * x - y * y + z * z) * vz
+    return out / math.sqrt(out[0] ** 2 + out[1] ** 2 + out[2] ** 2)
 
 
 @jit

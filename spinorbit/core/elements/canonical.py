@@ -371,14 +371,23 @@ def node_angles(attitude, momentum, sin_l, cos_l):
     l + g at J = 0 follows the elements' convention instead of an arbitrary one.
     """
     big_g = math.sqrt(momentum[0] ** 2 + momentum[1] ** 2 + momentum[2] ** 2)
-    inertial = attitude.T @ momentum
+    # Rᵀ M and the first row of R3(g) = Wᵀ R Nᵀ written out: the 3 × 3 products by ``@`` go through
+    # BLAS calls and temporaries that cost the per-state set-up of the free flow 0.9 µs of its 2.3.
+    inertial = np.empty(3)
+    for c in range(3):
+        inertial[c] = attitude[0, c] * momentum[0] + attitude[1, c] * momentum[1] + attitude[2, c] * momentum[2]
     big_h = inertial[2]
     sin_i = math.hypot(inertial[0], inertial[1]) / big_g
     cos_i = big_h / big_g
     h = math.atan2(inertial[0], -inertial[1])
     w = node_to_body(sin_l, cos_l, math.hypot(momentum[0], momentum[1]) / big_g, momentum[2] / big_g)
-    r3g = w.T @ attitude @ node_frame(cos_i, sin_i, h).T
-    return big_h, cos_i, sin_i, h, math.atan2(r3g[0, 1], r3g[0, 0])
+    node = node_frame(cos_i, sin_i, h)
+    row = np.empty(3)  # first row of Wᵀ R
+    for c in range(3):
+        row[c] = w[0, 0] * attitude[0, c] + w[1, 0] * attitude[1, c] + w[2, 0] * attitude[2, c]
+    r3g_00 = row[0] * node[0, 0] + row[1] * node[0, 1] + row[2] * node[0, 2]
+    r3g_01 = row[0] * node[1, 0] + row[1] * node[1, 1] + row[2] * node[1, 2]
+    return big_h, cos_i, sin_i, h, math.atan2(r3g_01, r3g_00)
 
 
 @jit

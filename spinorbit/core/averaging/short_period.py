@@ -13,8 +13,9 @@ with ω = 2π/P, and
 
 the c_jk from a 2-D FFT of U sampled on the torus grid (:func:`torus_u_grid`). The osculating
 elements are x_osc = x_mean + {x, W}: ΔS = ∂W/∂s, ΔZ = ∂W/∂z, ΔH = ∂W/∂h, Δs = −∂W/∂S,
-Δz = −∂W/∂Z, Δh = −∂W/∂H. ∂W/∂s = (U − ⟨U⟩)/(aS) and ∂W/∂z are spectral; the momentum partials are
-central differences of W at fixed (s, z, h). U also moves with time t through the perturbers (orbital time scale, rate n ≪ Ω); the
+Δz = −∂W/∂Z, Δh = −∂W/∂H. ∂W/∂s = (U − ⟨U⟩)/(aS) and ∂W/∂z are spectral; ∂W/∂H and ∂W/∂h are the same
+series of ∂U/∂H, ∂U/∂h (from the torque: H, h leave the free motion unchanged); ∂W/∂S, ∂W/∂Z are
+central differences of W at fixed (s, z, H, h). U also moves with time t through the perturbers (orbital time scale, rate n ≪ Ω); the
 homological equation is then a S ∂W/∂s + ∂W/∂t = U − ⟨U⟩, solved to third order in n/Ω:
 Ŵ_jk = c_jk/(iΩ_jk) − ċ_jk/(iΩ_jk)² + c̈_jk/(iΩ_jk)³ − c⃛_jk/(iΩ_jk)⁴ (without the ċ term the
 corrections keep an error ∝ the torque × n/Ω, measured as a first-order slope; the c̈ term removes
@@ -31,13 +32,23 @@ import numpy as np
 from spinorbit.core.jit import jit
 from spinorbit.core.averaging.mean_equations import torus_frequencies
 from spinorbit.core.elements.canonical import (
+    body_part_of_elements,
     elliptic_constants,
     motion_from_elements,
-    state_from_elements_motion,
+    state_from_body_part,
 )
-from spinorbit.core.dynamics.equations import force_function_and_torque_xyz
-from spinorbit.core.elements.equations import inertial_quaternion, reduce_phase, working_elements
+from spinorbit.core.dynamics.equations import MODEL_PERTURBERS, perturber_force_function_and_torque_xyz
+from spinorbit.core.elements.equations import (
+    DU_H,
+    DU_SMALL_H,
+    andoyer_gradient_from_torque,
+    inertial_quaternion,
+    reduce_phase,
+    working_elements,
+)
 from spinorbit.core.model.gravity_field import BODY_NMAX
+from spinorbit.core.model.perturbers import PERTURBER_ROW, perturber_position_xyz
+from spinorbit.core.math.rotations import qmul_parts
 
 #: Torus grid (points per period of s, points in the precession phase ψ) by the figure's degree.
 #: Degree 2 has ψ-harmonics |k| ≤ 2 (8 points resolve them exactly); 32 points in s leave 4e-12 of
@@ -65,81 +76,214 @@ THIRD_TERM_FLOOR = 1e-6
 #: of the differences is ~ (n δt)² ≈ 1e-5 relative; 1e-2 was measured worse (the second difference
 #: then amplifies the grid's rounding: round trips of 2e-7 instead of 3e-9 at 100× the solar torque).
 TIME_DIFFERENCE_FRACTION = 0.1
-#: Relative step (of Z) of the central differences of W in S, Z, H; absolute step (rad) in h.
+#: Relative step (of Z) of the central differences of W in S and Z (∂W/∂H, ∂W/∂h come from the torque).
 W_DIFFERENCE_STEP = 1e-5
 
 
+# Fields of the torus grids: U and its partials in H and h at fixed (S, Z, s, z), from the torque.
+FIELD_U, FIELD_DU_DH, FIELD_DU_DSMALL_H = range(3)
+
+
 @jit
-def torus_u_grid(times, elements, model, frame, ic, n_s, n_psi):
-    """U (energy) on the (s_w, ψ) grid s_w = P j/n_s, ψ = 2π k/n_psi at the elements' (S, Z, H, h),
-    at each of ``times``: shape (len(times), n_s, n_psi). The attitude of each grid point is built
-    once for all times."""
+def torus_grids(times, elements, model, frame, ic, n_s, n_psi, n_fields):
+    """U (energy), and for ``n_fields`` = 3 also ∂U/∂H, ∂U/∂h, on the (s_w, ψ) grid s_w = P j/n_s,
+    ψ = 2π k/n_psi at the elements' (S, Z, H, h), at each of ``times``: shape
+    (len(times), n_fields, n_s, n_psi) (FIELD_*).
+
+    The attitude of each grid point is built once for all times, and the free motion's body part
+    (one sn/cn/dn and one pn) once per s_w: along ψ only z, hence g, moves
+    (:func:`.canonical.body_part_of_elements`). ∂U/∂H and ∂U/∂h are the Andoyer partials from the
+    body torque (:func:`.equations.andoyer_gradient_from_torque`): H and h are both an Andoyer and a
+    canonical pair, so they are the canonical partials too, exactly, with no difference step.
+    """
     period, nu, _ = torus_frequencies(elements[0], elements[1], ic)
     work, flip = working_elements(elements)
     # The motion and elliptic constants of (S, Z) once for the whole grid (they cost as much as the
     # rest of a backward map).
     mo = motion_from_elements(work[0], work[1], ic)
     mk, pk = elliptic_constants(mo)
-    out = np.empty((times.shape[0], n_s, n_psi))
+    # the perturbers' positions once per time, not once per grid point (a Kepler solve each)
+    n_perturbers = int(model[MODEL_PERTURBERS])
+    positions = np.empty((times.shape[0], n_perturbers, 3))
+    mus = np.empty(n_perturbers)
+    for p in range(n_perturbers):
+        row = MODEL_PERTURBERS + 1 + p * PERTURBER_ROW
+        mus[p] = model[row + 1]
+        for i in range(times.shape[0]):
+            positions[i, p, 0], positions[i, p, 1], positions[i, p, 2] = perturber_position_xyz(times[i], model, row)
+    out = np.empty((times.shape[0], n_fields, n_s, n_psi))
+    q = np.empty(4)
     for j in range(n_s):
         s_w = period * j / n_s
         work[3] = s_w
+        body = body_part_of_elements(s_w, mo, mk, pk)
         for k in range(n_psi):
             work[4] = 2.0 * math.pi * k / n_psi - nu * s_w
-            attitude, _ = state_from_elements_motion(work, flip, mo, mk, pk)
-            q = inertial_quaternion(attitude, frame)
+            if n_fields > 1 or k == 0:
+                attitude, momentum = state_from_body_part(work, flip, body)
+                q = inertial_quaternion(attitude, frame)
+                if k == 0:
+                    q_first, axis = q.copy(), inertial_direction(q, momentum)
+            else:
+                # z is the angle about the angular momentum: a step δ in z turns the body by δ about
+                # the (inertial, constant) momentum direction, so the attitude is that turn of the
+                # first point's (one product instead of the backward map; checked against it in
+                # tests/test_averaged.py)
+                half = math.pi * k / n_psi
+                sin_half = math.sin(half)
+                q[0], q[1], q[2], q[3] = qmul_parts(math.cos(half), sin_half * axis[0], sin_half * axis[1],
+                                                    sin_half * axis[2], q_first[0], q_first[1], q_first[2],
+                                                    q_first[3])
             for i in range(times.shape[0]):
-                out[i, j, k] = force_function_and_torque_xyz(times[i], q[0], q[1], q[2], q[3], model)[0]
+                u, nx, ny, nz = 0.0, 0.0, 0.0, 0.0
+                for p in range(n_perturbers):
+                    u_p, nx_p, ny_p, nz_p = perturber_force_function_and_torque_xyz(
+                        q[0], q[1], q[2], q[3], positions[i, p, 0], positions[i, p, 1], positions[i, p, 2], mus[p],
+                        model)
+                    u, nx, ny, nz = u + u_p, nx + nx_p, ny + ny_p, nz + nz_p
+                out[i, FIELD_U, j, k] = u
+                if n_fields > 1:
+                    gradient = andoyer_gradient_from_torque(attitude, momentum, nx, ny, nz)
+                    out[i, FIELD_DU_DH, j, k] = gradient[DU_H]
+                    out[i, FIELD_DU_DSMALL_H, j, k] = gradient[DU_SMALL_H]
     return out
 
 
-def _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi):
-    """(Ŵ, jω + kν per unit s_w, k, ν, mean U) of W's Fourier series at the elements' momenta."""
+@jit
+def inertial_direction(q, body_vector):
+    """Unit vector (3,) along q ⊗ v ⊗ q* (body → inertial) of a body-frame vector."""
+    w, x, y, z = q[0], q[1], q[2], q[3]
+    vx, vy, vz = body_vector[0], body_vector[1], body_vector[2]
+    out = np.empty(3)
+    out[0] = (w * w + x * x - y * y - z * z) * vx + 2.0 * (x * y - w * z) * vy + 2.0 * (x * z + w * y) * vz
+    out[1] = 2.0 * (x * y + w * z) * vx + (w * w - x * x + y * y - z * z) * vy + 2.0 * (y * z - w * x) * vz
+    out[2] = 2.0 * (x * z - w * y) * vx + 2.0 * (y * z + w * x) * vy + (w * w - x * x - y * y + z * z) * vz
+    return out / math.sqrt(out[0] ** 2 + out[1] ** 2 + out[2] ** 2)
+
+
+@jit
+def torus_u_grid(times, elements, model, frame, ic, n_s, n_psi):
+    """U (energy) on the torus grid of :func:`torus_grids` at each of ``times``: (len(times), n_s, n_psi)."""
+    return torus_grids(times, elements, model, frame, ic, n_s, n_psi, 1)[:, FIELD_U]
+
+
+@jit
+def _dft_matrix(n):
+    """The n × n matrix of the forward DFT, exp(−2πi jk/n) (numpy.fft's sign convention)."""
+    out = np.empty((n, n), dtype=np.complex128)
+    for j in range(n):
+        for k in range(n):
+            out[j, k] = np.exp(-2j * math.pi * ((j * k) % n) / n)
+    return out
+
+
+@jit
+def _dft2(grid, matrix_s, matrix_psi):
+    """numpy.fft.fft2(grid) / grid.size for the small torus grids, as two matrix products with the
+    DFT matrices of :func:`_dft_matrix` (numba has no FFT; 32 × 8 and 64 × 16 points)."""
+    n_s, n_psi = grid.shape
+    rows = np.dot(grid.astype(np.complex128), matrix_psi)
+    return np.dot(matrix_s, rows) / (n_s * n_psi)
+
+
+@jit
+def _fft_frequencies(n):
+    """numpy.fft.fftfreq(n, 1/n): 0, 1, …, ⌈n/2⌉ − 1, −⌊n/2⌋, …, −1."""
+    out = np.empty(n)
+    for i in range(n):
+        out[i] = i if i < (n + 1) // 2 else i - n
+    return out
+
+
+@jit
+def _generating_coefficients(t, elements, model, frame, ic, matrix_s, matrix_psi, n_fields):
+    """(Ŵ, jω + kν per unit s_w, k, ν, mean U) of W's Fourier series at the elements' momenta, on the
+    torus grid of the DFT matrices ``matrix_s``, ``matrix_psi`` (:func:`_dft_matrix` of n_s, n_psi).
+
+    Ŵ has shape (n_fields, n_s, n_psi): the series of W and, for ``n_fields`` = 3, of ∂W/∂H and
+    ∂W/∂h (the same linear map applied to ∂U/∂H, ∂U/∂h, which leave ω, ν and the grid unchanged;
+    the harmonics kept are those significant in U).
+    """
+    n_s, n_psi = matrix_s.shape[0], matrix_psi.shape[0]
     period, nu, s_rate = torus_frequencies(elements[0], elements[1], ic)
     # ∂U/∂t and ∂²U/∂t² through the perturbers' motion: central differences over a fraction of the
     # fastest torus period (the grid varies on the orbital time scale).
     omega_fast = max(2.0 * math.pi / period, abs(nu)) * s_rate
     dt = TIME_DIFFERENCE_FRACTION * 2.0 * math.pi / omega_fast
     five = TIME_DERIVATIVE_ORDER > 2  # c⃛ needs t ± 2δt; ċ, c̈ then take the 4th-order stencils
-    offsets = (0.0, 1.0, -1.0, 2.0, -2.0) if five else (0.0, 1.0, -1.0)
-    grids = torus_u_grid(np.array([t + m * dt for m in offsets]), elements, model, frame, ic, n_s, n_psi)
-    c = [np.fft.fft2(g) / (n_s * n_psi) for g in grids]
-    coeff = c[0]
     if five:
-        c_dot = (8.0 * (c[1] - c[2]) - (c[3] - c[4])) / (12.0 * dt)
-        c_ddot = (16.0 * (c[1] + c[2]) - (c[3] + c[4]) - 30.0 * coeff) / (12.0 * dt * dt)
-        c_dddot = ((c[3] - c[4]) - 2.0 * (c[1] - c[2])) / (2.0 * dt**3)
+        offsets = np.array([0.0, 1.0, -1.0, 2.0, -2.0])
     else:
-        c_dot = (c[1] - c[2]) / (2.0 * dt)
-        c_ddot = (c[1] - 2.0 * coeff + c[2]) / (dt * dt)
-        c_dddot = 0.0
-    j = np.fft.fftfreq(n_s, 1.0 / n_s)[:, None]
-    k = np.fft.fftfreq(n_psi, 1.0 / n_psi)[None, :]
-    rate = j * (2.0 * math.pi / period) + k * nu  # d(phase)/d s_w
-    mean_u = coeff[0, 0].real
-    # Harmonics at the rounding level of the grid are dropped: with a small divisor Ω_jk (some
-    # jω + kν is always close to 0 on a large grid) their noise, divided by Ω³ in the c̈ term, would
-    # dominate the corrections.
-    coeff[0, 0] = 0.0
-    significant = np.abs(coeff) > HARMONIC_NOISE * np.abs(coeff).max()
-    with np.errstate(divide="ignore", invalid="ignore"):
-        i_omega = 1j * s_rate * rate
-        third = c_dddot / i_omega**4 if TIME_DERIVATIVE_ORDER > 2 else np.zeros_like(coeff)
-        third = np.where(np.abs(coeff) > THIRD_TERM_FLOOR * np.abs(coeff).max(), third, 0.0)
-        w_hat = np.where(~significant, 0.0, coeff / i_omega - c_dot / i_omega**2
-                         + (c_ddot / i_omega**3 if TIME_DERIVATIVE_ORDER > 1 else 0.0) - third)
+        offsets = np.array([0.0, 1.0, -1.0])
+    grids = torus_grids(t + offsets * dt, elements, model, frame, ic, n_s, n_psi, n_fields)
+    j = _fft_frequencies(n_s)
+    k = _fft_frequencies(n_psi)
+    rate = np.empty((n_s, n_psi))
+    for a in range(n_s):
+        for b in range(n_psi):
+            rate[a, b] = j[a] * (2.0 * math.pi / period) + k[b] * nu  # d(phase)/d s_w
+    w_hat = np.zeros((n_fields, n_s, n_psi), dtype=np.complex128)
+    mean_u = 0.0
+    significant = np.zeros((n_s, n_psi), dtype=np.bool_)
+    third_kept = np.zeros((n_s, n_psi), dtype=np.bool_)
+    for field in range(n_fields):
+        g = grids[:, field]
+        # the differences in t are linear, so they are taken on the grids before the transform
+        if five:
+            g_dot = (8.0 * (g[1] - g[2]) - (g[3] - g[4])) / (12.0 * dt)
+            g_ddot = (16.0 * (g[1] + g[2]) - (g[3] + g[4]) - 30.0 * g[0]) / (12.0 * dt * dt)
+            g_dddot = ((g[3] - g[4]) - 2.0 * (g[1] - g[2])) / (2.0 * dt**3)
+        else:
+            g_dot = (g[1] - g[2]) / (2.0 * dt)
+            g_ddot = (g[1] - 2.0 * g[0] + g[2]) / (dt * dt)
+            g_dddot = np.zeros_like(g[0])
+        coeff, c_dot, c_ddot, c_dddot = (_dft2(g[0], matrix_s, matrix_psi), _dft2(g_dot, matrix_s, matrix_psi),
+                                         _dft2(g_ddot, matrix_s, matrix_psi), _dft2(g_dddot, matrix_s, matrix_psi))
+        if field == FIELD_U:
+            mean_u = coeff[0, 0].real
+            # Harmonics at the rounding level of the grid are dropped: with a small divisor Ω_jk
+            # (some jω + kν is always close to 0 on a large grid) their noise, divided by Ω³ in the
+            # c̈ term, would dominate the corrections.
+            coeff[0, 0] = 0.0
+            largest = np.abs(coeff).max()
+            size = np.abs(coeff)
+            significant = size > HARMONIC_NOISE * largest
+            third_kept = size > THIRD_TERM_FLOOR * largest
+        for a in range(n_s):
+            for b in range(n_psi):
+                if not significant[a, b]:
+                    continue
+                i_omega = 1j * s_rate * rate[a, b]
+                w = coeff[a, b] / i_omega - c_dot[a, b] / i_omega**2
+                if TIME_DERIVATIVE_ORDER > 1:
+                    w += c_ddot[a, b] / i_omega**3
+                if TIME_DERIVATIVE_ORDER > 2 and third_kept[a, b]:
+                    w -= c_dddot[a, b] / i_omega**4
+                w_hat[field, a, b] = w
     return w_hat, rate, k, nu, mean_u
 
 
-def _series(w_hat, rate, k, nu, elements, factor=None):
-    """Real part of Σ Ŵ·factor e^{i(jω s_w + kψ)} at the elements' (s, z)."""
+# What :func:`_series` sums: W itself, ∂W/∂s_w (factor i(jω + kν)) or ∂W/∂z (factor i k).
+SERIES_W, SERIES_D_S, SERIES_D_Z = 0, 1, 2
+
+
+@jit
+def _series(w_hat, rate, k, nu, elements, which):
+    """Real part of Σ Ŵ·factor e^{i(jω s_w + kψ)} at the elements' (s, z), factor by ``which``."""
     sign = 1.0 if elements[0] >= 0.0 else -1.0
     s_w = sign * elements[3]
     psi = elements[4] + nu * s_w
-    j_omega = rate - k * nu
-    phase = np.exp(1j * (j_omega * s_w + k * psi))
-    terms = w_hat * phase if factor is None else w_hat * factor * phase
-    return float(np.sum(terms).real)
+    total = 0.0
+    for a in range(w_hat.shape[0]):
+        for b in range(w_hat.shape[1]):
+            j_omega = rate[a, b] - k[b] * nu
+            term = w_hat[a, b] * np.exp(1j * (j_omega * s_w + k[b] * psi))
+            if which == SERIES_D_S:
+                term *= 1j * rate[a, b]
+            elif which == SERIES_D_Z:
+                term *= 1j * k[b]
+            total += term.real
+    return total
 
 
 def torus_grid_for(model):
@@ -147,12 +291,47 @@ def torus_grid_for(model):
     return GRID_DEGREE2 if model[BODY_NMAX] <= 2 else GRID_DEGREE4
 
 
+@jit
+def _generating_function(t, elements, model, frame, ic, matrix_s, matrix_psi):
+    w_hat, rate, k, nu, _ = _generating_coefficients(t, elements, model, frame, ic, matrix_s, matrix_psi, 1)
+    return _series(w_hat[FIELD_U], rate, k, nu, elements, SERIES_W)
+
+
 def generating_function(t, elements, model, frame, ic, n_s=None, n_psi=None):
     """W(t, elements) (energy·time): the first-order generating function (module docstring)."""
     if n_s is None or n_psi is None:
         n_s, n_psi = torus_grid_for(model)
-    w_hat, rate, k, nu, _ = _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi)
-    return _series(w_hat, rate, k, nu, elements)
+    elements = np.ascontiguousarray(elements, dtype=float)
+    return _generating_function(float(t), elements, model, frame, ic, _dft_matrix(n_s), _dft_matrix(n_psi))
+
+
+@jit
+def _short_period_offsets(t, elements, model, frame, ic, n_s, n_psi):
+    """Kernel of :func:`short_period_offsets` (compiled: the map is the averaged propagator's fixed cost)."""
+    sign = 1.0 if elements[0] >= 0.0 else -1.0
+    matrix_s, matrix_psi = _dft_matrix(n_s), _dft_matrix(n_psi)
+    w_hat, rate, k, nu, _ = _generating_coefficients(t, elements, model, frame, ic, matrix_s, matrix_psi, 3)
+    out = np.empty(6)
+    out[0] = sign * _series(w_hat[FIELD_U], rate, k, nu, elements, SERIES_D_S)  # ∂W/∂s = sign ∂W/∂s_w
+    out[1] = _series(w_hat[FIELD_U], rate, k, nu, elements, SERIES_D_Z)  # ∂W/∂z
+    d_big_h = _series(w_hat[FIELD_DU_DH], rate, k, nu, elements, SERIES_W)  # ∂W/∂H
+    d_h = _series(w_hat[FIELD_DU_DSMALL_H], rate, k, nu, elements, SERIES_W)  # ∂W/∂h
+    # S and Z move the free motion itself (the grid, ω, ν): central differences of W, step ∝ Z
+    partial = np.empty(2)
+    for n, index in enumerate((0, 1)):
+        step = W_DIFFERENCE_STEP * elements[1]
+        shifted = elements.copy()
+        shifted[index] += step
+        w_plus = _generating_function(t, shifted, model, frame, ic, matrix_s, matrix_psi)
+        shifted[index] = elements[index] - step
+        w_minus = _generating_function(t, shifted, model, frame, ic, matrix_s, matrix_psi)
+        partial[n] = (w_plus - w_minus) / (2.0 * step)
+    d_big_s, d_big_z = partial
+    out[2] = d_h
+    out[3] = -d_big_s
+    out[4] = -d_big_z
+    out[5] = -d_big_h
+    return out
 
 
 def short_period_offsets(t, elements, model, frame, ic, n_s=None, n_psi=None):
@@ -177,26 +356,7 @@ def short_period_offsets(t, elements, model, frame, ic, n_s=None, n_psi=None):
     if n_s is None or n_psi is None:
         n_s, n_psi = torus_grid_for(model)
     elements = np.ascontiguousarray(elements, dtype=float)
-    sign = 1.0 if elements[0] >= 0.0 else -1.0
-    w_hat, rate, k, nu, _ = _generating_coefficients(t, elements, model, frame, ic, n_s, n_psi)
-    out = np.empty(6)
-    out[0] = sign * _series(w_hat, rate, k, nu, elements, 1j * rate)  # ∂W/∂s = sign ∂W/∂s_w
-    out[1] = _series(w_hat, rate, k, nu, elements, 1j * k)  # ∂W/∂z
-    steps = (W_DIFFERENCE_STEP * elements[1],) * 3 + (W_DIFFERENCE_STEP,)
-    partial = []
-    for index, step in zip((0, 1, 2, 5), steps):
-        values = []
-        for delta in (step, -step):
-            shifted = elements.copy()
-            shifted[index] += delta
-            values.append(generating_function(t, shifted, model, frame, ic, n_s, n_psi))
-        partial.append((values[0] - values[1]) / (2.0 * step))
-    d_big_s, d_big_z, d_big_h, d_h = partial
-    out[2] = d_h
-    out[3] = -d_big_s
-    out[4] = -d_big_z
-    out[5] = -d_big_h
-    return out
+    return _short_period_offsets(float(t), elements, model, frame, ic, n_s, n_psi)
 
 
 def mean_to_osculating(t, mean, model, frame, ic):

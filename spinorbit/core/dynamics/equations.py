@@ -127,6 +127,21 @@ def body_frame_position(q, r_inertial):
 
 
 @jit(inline="always")  # RHS hot path: no array crosses a call boundary (see perturbers.py)
+def perturber_force_function_and_torque_xyz(q0, q1, q2, q3, ix, iy, iz, mu, model):
+    """(U, Nx, Ny, Nz) of one perturber of gravitational parameter mu at inertial position (ix, iy, iz)
+    relative to the body: the one torque definition, for callers that evaluate the perturbers'
+    positions once for many attitudes (the torus grids of :mod:`spinorbit.core.averaging.short_period`).
+    """
+    x, y, z = body_frame_xyz(q0, q1, q2, q3, ix, iy, iz)
+    # Torque from the field without the monopole: its radial gradient has no torque but would
+    # add rounding noise (see gravity_field.figure_field_without_monopole_xyz).
+    u_k, gx, gy, gz = figure_field_without_monopole_xyz(x, y, z, mu, model)
+    u = u_k + mu * model[BODY_MASS] / math.sqrt(x * x + y * y + z * z)
+    # N = (∂U/∂r) × r
+    return u, gy * z - gz * y, gz * x - gx * z, gx * y - gy * x
+
+
+@jit(inline="always")  # RHS hot path: no array crosses a call boundary (see perturbers.py)
 def force_function_and_torque_xyz(t, q0, q1, q2, q3, model):
     """(U, Nx, Ny, Nz) summed over all perturbers: the one torque definition, allocation-free.
 
@@ -139,16 +154,12 @@ def force_function_and_torque_xyz(t, q0, q1, q2, q3, model):
     for k in range(int(model[MODEL_PERTURBERS])):
         row = MODEL_PERTURBERS + 1 + k * PERTURBER_ROW
         ix, iy, iz = perturber_position_xyz(t, model, row)
-        x, y, z = body_frame_xyz(q0, q1, q2, q3, ix, iy, iz)
-        # Torque from the field without the monopole: its radial gradient has no torque but would
-        # add rounding noise (see gravity_field.figure_field_without_monopole_xyz).
-        mu = model[row + 1]
-        u_k, gx, gy, gz = figure_field_without_monopole_xyz(x, y, z, mu, model)
-        u += u_k + mu * model[BODY_MASS] / math.sqrt(x * x + y * y + z * z)
-        # N = (∂U/∂r) × r
-        nx += gy * z - gz * y
-        ny += gz * x - gx * z
-        nz += gx * y - gy * x
+        u_k, nx_k, ny_k, nz_k = perturber_force_function_and_torque_xyz(q0, q1, q2, q3, ix, iy, iz,
+                                                                        model[row + 1], model)
+        u += u_k
+        nx += nx_k
+        ny += ny_k
+        nz += nz_k
     return u, nx, ny, nz
 
 

@@ -56,7 +56,7 @@ if __name__ == "__main__":  # worker processes import this file; only the main o
     speed = (table["sidereal_period_initial"] / table["sidereal_period"]).to_value(u.one)
     shift = table["pole_shift"].to_value(u.deg)
     modes = list(table["mode"])
-    print(f"modes after: " + ", ".join(f"{m} {modes.count(m) / len(modes):.0%}" for m in sorted(set(modes))))
+    print("modes after: " + ", ".join(f"{m} {modes.count(m) / len(modes):.0%}" for m in sorted(set(modes))))
     print(f"effective spin rate after/before: {speed.min():.2f} to {speed.max():.2f} (median {np.median(speed):.2f}); "
           f"halved in {np.mean(speed <= 0.5):.0%}, doubled in {np.mean(speed >= 2.0):.0%} of the members")
     print(f"pole shift: {shift.min():.1f} to {shift.max():.1f} deg (median {np.median(shift):.1f}); "

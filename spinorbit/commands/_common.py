@@ -166,6 +166,20 @@ def atomic_output(option: str, path: str):
         raise CommandError(f"{option}: cannot write '{path}' ({error.strerror}); choose another path.") from None
 
 
+def write_table_output(path: str, table, detail: str) -> None:
+    """``--output``: ``table`` as ECSV or CSV by the extension, written atomically; print the 'wrote' line."""
+    with atomic_output("--output", path) as temporary:
+        table.write(temporary, format=table_format(temporary), overwrite=True)
+    print(f"wrote              {path} ({detail})")
+
+
+def write_plot_output(path: str, draw) -> None:
+    """``--plot``: ``draw(temporary_path)`` saves the figure, moved into place atomically; print the 'wrote' line."""
+    with atomic_output("--plot", path) as temporary:
+        draw(temporary)
+    print(f"wrote              {path}")
+
+
 class Progress:
     """A dependency-free progress bar on stderr for runs longer than :data:`PROGRESS_DELAY_S`.
 

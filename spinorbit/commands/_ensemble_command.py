@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from spinorbit.cli import CommandError
-from spinorbit.commands._common import Progress, atomic_output, plot_format, table_format
+from spinorbit.commands._common import Progress, plot_format, write_plot_output, write_table_output
 
 #: Most members the command accepts in one call (a larger study belongs in a script with a checkpoint).
 MAX_MEMBERS = 1_000_000
@@ -42,7 +42,6 @@ def _executor(args):
 
 def run_apophis_ensemble(args, span_days) -> int:
     """Run the ensemble, print the summary, write --output (one row per member) and --plot (histograms)."""
-    import numpy as np
 
     from spinorbit.ensemble import Ensemble
     from spinorbit.ensemble.apophis import apophis_member, apophis_parameters
@@ -65,19 +64,14 @@ def run_apophis_ensemble(args, span_days) -> int:
     for line in summary(table, ensemble):
         print(line)
     if args.output is not None:
-        with atomic_output("--output", args.output) as temporary:
-            table.write(temporary, format=table_format(temporary), overwrite=True)
-        print(f"wrote              {args.output} ({len(table)} members)")
+        write_table_output(args.output, table, f"{len(table)} members")
     if args.plot is not None:
-        with atomic_output("--plot", args.plot) as temporary:
-            histograms(table, temporary, plot_format(args.plot))
-        print(f"wrote              {args.plot}")
+        write_plot_output(args.plot, lambda temporary: histograms(table, temporary, plot_format(args.plot)))
     return 0 if not ensemble.failures else 1
 
 
 def _values(table, name):
     import numpy as np
-    from astropy import units as u
 
     column = table[name]
     data = np.ma.masked_invalid(np.ma.asarray(getattr(column, "unmasked", column).value if hasattr(column, "unit") and

@@ -7,7 +7,7 @@ import contextlib
 import threading
 
 from spinorbit.cli import CommandError
-from spinorbit.commands._common import Progress, atomic_output, plot_format, quantity, table_format
+from spinorbit.commands._common import Progress, plot_format, quantity, write_plot_output, write_table_output
 
 #: Seconds of planning before its progress bar shows (issue 15: plans of long runs take tens of seconds).
 PLAN_PROGRESS_DELAY_S = 1.0
@@ -197,13 +197,9 @@ def write_outputs(args, result, name: str, title: str, period_unit: str) -> None
     """ECSV and plot, each atomically."""
     if args.output is not None:
         table = ecsv_table(result, name, period_unit)
-        with atomic_output("--output", args.output) as temporary:
-            table.write(temporary, format=table_format(temporary), overwrite=True)
-        print(f"wrote              {args.output} ({len(table)} rows)")
+        write_table_output(args.output, table, f"{len(table)} rows")
     if args.plot is not None:
-        with atomic_output("--plot", args.plot) as temporary:
-            plot(result, temporary, title, period_unit, args.plot)
-        print(f"wrote              {args.plot}")
+        write_plot_output(args.plot, lambda temporary: plot(result, temporary, title, period_unit, args.plot))
 
 
 def plot(result, path: str, title: str, period_unit: str = "h", name: str | None = None) -> None:

@@ -8,8 +8,8 @@ import os
 import sys
 
 from spinorbit.cli import CommandError
-from spinorbit.commands._common import (Progress, atomic_output, check_output_path, check_outputs, number, plot_format,
-                                        quantity, table_format)
+from spinorbit.commands._common import (Progress, check_output_path, check_outputs, number, plot_format, quantity,
+                                        write_plot_output, write_table_output)
 
 #: The models (spinorbit.coupling.moon.MOON_MODELS, repeated so that --help does not import REBOUND).
 MOON_MODELS = ("de421", "rigid", "core-corrected")
@@ -218,12 +218,9 @@ def run(args) -> int:
     print(f"final difference   {comparison.attitude_difference_arcsec[-1]:.5f} arcsec")
     if args.output is not None:
         table = comparison_table(comparison, args.model, args.model != "de421" and not args.one_way)
-        with atomic_output("--output", args.output) as temporary:
-            table.write(temporary, format=table_format(temporary), overwrite=True)
-        print(f"wrote              {args.output} ({len(table)} rows)")
+        write_table_output(args.output, table, f"{len(table)} rows")
     if args.plot is not None:
-        with atomic_output("--plot", args.plot) as temporary:
-            plot_comparison(comparison, temporary, f"Moon vs DE421, {args.model}, {span_text}")
-        print(f"wrote              {args.plot}")
+        write_plot_output(args.plot, lambda temporary: plot_comparison(comparison, temporary,
+                                                                       f"Moon vs DE421, {args.model}, {span_text}"))
     print(f"max attitude difference vs DE421: {comparison.max_difference_arcsec:.5f} arcsec over {span_text}")
     return 0

@@ -6,8 +6,8 @@ import argparse
 import math
 
 from spinorbit.cli import CommandError
-from spinorbit.commands._common import (Progress, atomic_output, check_output_paths, number, plot_format, quantity,
-                                        table_format, unit)
+from spinorbit.commands._common import (Progress, check_output_paths, number, plot_format, quantity, unit,
+                                        write_plot_output, write_table_output)
 
 NAME = "torque-free"
 SUMMARY = "exact torque-free rotation for given moments of inertia and spin"
@@ -239,13 +239,9 @@ def run(args) -> int:
     table = _table(args, state, epoch, offsets, quaternions, omegas, omega_unit)
     span = f"{offsets[-1]:g} d"
     if args.output is not None:
-        with atomic_output("--output", args.output) as temporary:
-            table.write(temporary, format=table_format(temporary), overwrite=True)
-        print(f"wrote              {args.output} ({len(table)} rows over {span})")
+        write_table_output(args.output, table, f"{len(table)} rows over {span}")
     if args.plot is not None:
-        with atomic_output("--plot", args.plot) as temporary:
-            _plot(table, temporary, args.plot)
-        print(f"wrote              {args.plot}")
+        write_plot_output(args.plot, lambda temporary: _plot(table, temporary, args.plot))
     if args.output is None and args.plot is None:
         print(f"propagated         {len(table)} times over {span}; give --output FILE.ecsv to keep them")
     return 0

@@ -16,7 +16,7 @@ import numpy as np
 
 from spinorbit.frames import icrf_to_ecliptic_matrix
 
-__all__ = ["obliquity_deg", "orbit_normals", "pole_angles_deg"]
+__all__ = ["angle_between_deg", "directions_from_ra_dec_deg", "obliquity_deg", "orbit_normals", "pole_angles_deg"]
 
 
 def _unit_rows(vectors, what):
@@ -52,15 +52,28 @@ def orbit_normals(positions, velocities):
     return _unit_rows(np.cross(np.atleast_2d(positions), np.atleast_2d(velocities)), "the orbit normal (r × v)")
 
 
-def obliquity_deg(directions, normals):
-    """Angle (deg, in [0, 180]) between pole directions and orbit normals, row by row (ICRF, (N, 3) each).
+def directions_from_ra_dec_deg(ra_deg, dec_deg):
+    """Unit ICRF vectors (N, 3) of right ascensions and declinations in degrees (the inverse of the
+    (RA, Dec) that :func:`pole_angles_deg` gives)."""
+    ra, dec = np.radians(np.atleast_1d(ra_deg)), np.radians(np.atleast_1d(dec_deg))
+    return np.stack([np.cos(dec) * np.cos(ra), np.cos(dec) * np.sin(ra), np.sin(dec)], axis=1)
 
-    Computed as atan2(|p × n|, p · n), accurate near 0° and 180° where acos of the dot product is not.
+
+def angle_between_deg(first, second, first_name="the first direction", second_name="the second direction"):
+    """Angle (deg, in [0, 180]) between two sets of directions, row by row ((3,) or (N, 3) each; one row
+    of ``second`` serves every row of ``first``).
+
+    Computed as atan2(|a × b|, a · b), accurate near 0° and 180° where acos of the dot product is not.
     """
-    pole, normal = _unit_rows(directions, "the pole"), _unit_rows(normals, "the orbit normal")
-    if normal.shape[0] == 1 and pole.shape[0] > 1:
-        normal = np.broadcast_to(normal, pole.shape)
-    if normal.shape != pole.shape:
-        raise ValueError(f"obliquity expects one orbit normal per pole; got {normal.shape[0]} normals for "
-                         f"{pole.shape[0]} poles.")
-    return np.degrees(np.arctan2(np.linalg.norm(np.cross(pole, normal), axis=1), np.sum(pole * normal, axis=1)))
+    a, b = _unit_rows(first, first_name), _unit_rows(second, second_name)
+    if b.shape[0] == 1 and a.shape[0] > 1:
+        b = np.broadcast_to(b, a.shape)
+    if b.shape != a.shape:
+        raise ValueError(f"the angle between {first_name} and {second_name} expects one row of each per row; got "
+                         f"{a.shape[0]} and {b.shape[0]}.")
+    return np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.sum(a * b, axis=1)))
+
+
+def obliquity_deg(directions, normals):
+    """Angle (deg, in [0, 180]) between pole directions and orbit normals, row by row (ICRF, (N, 3) each)."""
+    return angle_between_deg(directions, normals, "the pole", "the orbit normal")

@@ -207,6 +207,6 @@ COLUMN_DESCRIPTIONS = {
 
 def add_obliquity(table, normals):
     """Add the ``obliquity`` column (deg) of a table's ``pole_ra, pole_dec`` against orbit normals (N, 3), ICRF."""
-    ra, dec = (np.radians(u.Quantity(table[name]).to_value(u.deg)) for name in ("pole_ra", "pole_dec"))
-    directions = np.stack([np.cos(dec) * np.cos(ra), np.cos(dec) * np.sin(ra), np.sin(dec)], axis=1)
+    directions = _pole.directions_from_ra_dec_deg(*(u.Quantity(table[name]).to_value(u.deg)
+                                                    for name in ("pole_ra", "pole_dec")))
     table["obliquity"] = _pole.obliquity_deg(directions, normals) * u.deg

@@ -24,6 +24,7 @@ import numpy as np
 from astropy import units as u
 
 from spinorbit.ensemble.errors import EnsembleError
+from spinorbit.pole import angle_between_deg, directions_from_ra_dec_deg
 from spinorbit.state_table import MOTION_COLUMNS, POLE_COLUMNS, table_columns
 from spinorbit.time import tdb_days
 
@@ -60,16 +61,6 @@ def time_rows(scene, at):
     return rows
 
 
-def _angle_deg(a, b):
-    """Angle (deg) between unit vectors, by atan2 (accurate at small angles)."""
-    return float(np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b)), float(np.dot(a, b)))))
-
-
-def _unit_from_radec(ra_deg, dec_deg):
-    ra, dec = np.radians(ra_deg), np.radians(dec_deg)
-    return np.array([np.cos(dec) * np.cos(ra), np.cos(dec) * np.sin(ra), np.sin(dec)])
-
-
 def _initial(state):
     p_psi, p_phi = state.periods
     return {"P_psi_initial": float(p_psi.to_value(u.h)), "P_phi_initial": float(p_phi.to_value(u.h)),
@@ -92,8 +83,8 @@ def outcome_row(scene, result, at=None):
             row[_suffix(name, k, timed)] = (str(value) if name == "mode" else
                                             float(u.Quantity(value).to_value(OUTCOME_UNITS[name]))
                                             if name in OUTCOME_UNITS else float(value))
-        pole = _unit_from_radec(row[_suffix("pole_ra", k, timed)], row[_suffix("pole_dec", k, timed)])
-        row[_suffix("pole_shift", k, timed)] = _angle_deg(start_pole, pole)
+        pole = directions_from_ra_dec_deg(row[_suffix("pole_ra", k, timed)], row[_suffix("pole_dec", k, timed)])
+        row[_suffix("pole_shift", k, timed)] = float(angle_between_deg(pole, start_pole, "the pole", "the start pole")[0])
     row.update(_initial(scene.state))
     row.update(error_estimate=float(result.error_estimate.to_value(u.arcsec)), tolerance_met=bool(result.tolerance_met),
                route=str(result.plan.route))

@@ -195,15 +195,38 @@ def shortest_period(momentum, inertia, ic):
     return min(p_psi, p_phi, 2.0 * math.pi / float(np.linalg.norm(momentum / inertia)))
 
 
-def _quadrature_grid(t_end, shortest_period):
-    """Gauss–Legendre nodes and weights on [0, t_end] in panels of ≤ shortest_period/PANELS_PER_PERIOD."""
-    panels = max(1, int(math.ceil(abs(t_end) / (shortest_period / PANELS_PER_PERIOD))))
+def _quadrature_grid(breakpoints, shortest_period):
+    """Gauss–Legendre nodes, weights and panel ends on consecutive breakpoints (0 first, monotone).
+
+    Each interval is cut into panels of at most shortest_period/PANELS_PER_PERIOD. Returns (nodes,
+    weights, index of the interval of each node).
+    """
     x, w = np.polynomial.legendre.leggauss(QUADRATURE_NODES)
-    edges = np.linspace(0.0, t_end, panels + 1)
-    half = 0.5 * np.diff(edges)
-    nodes = (0.5 * (edges[:-1] + edges[1:]))[:, None] + half[:, None] * x[None, :]
-    weights = half[:, None] * w[None, :]
-    return nodes.ravel(), weights.ravel()
+    nodes, weights, interval = [], [], []
+    longest = shortest_period / PANELS_PER_PERIOD
+    for k in range(breakpoints.size - 1):
+        lo, hi = breakpoints[k], breakpoints[k + 1]
+        panels = max(1, int(math.ceil(abs(hi - lo) / longest)))
+        edges = np.linspace(lo, hi, panels + 1)
+        half = 0.5 * np.diff(edges)
+        nodes.append(((0.5 * (edges[:-1] + edges[1:]))[:, None] + half[:, None] * x[None, :]).ravel())
+        weights.append((half[:, None] * w[None, :]).ravel())
+        interval.append(np.full(panels * QUADRATURE_NODES, k))
+    if not nodes:
+        return np.empty(0), np.empty(0), np.empty(0, dtype=np.int64)
+    return np.concatenate(nodes), np.concatenate(weights), np.concatenate(interval)
+
+
+@jit
+def node_forcing(qs, ms, taus, big_s, s0, inertia, ic, out):
+    """w(τ) = K(τ)⁻¹ g(τ) (6 × 2) at each quadrature node, into ``out`` (n, 6, 2)."""
+    rate = big_s / inertia[0]
+    for k in range(taus.shape[0]):
+        basis = omega_basis(element_basis(qs[k], ms[k], big_s, s0 + rate * taus[k], inertia, ic), inertia)
+        omega = np.empty(3)
+        for i in range(3):
+            omega[i] = ms[k, i] / inertia[i]
+        out[k] = np.linalg.solve(basis, parameter_forcing(omega, inertia))
 
 
 def free_flow_stm(quaternion, omega, moments, times, parameters=True):
@@ -264,22 +287,27 @@ def free_flow_stm(quaternion, omega, moments, times, parameters=True):
 
 
 def _parameter_sensitivities(q0, m0, inertia, ic, big_s, s0, t, kt):
-    """Ψ(t_k) = K(t_k) [W₀ + N W₁] by Gauss–Legendre panels from 0 to each t_k (module docstring)."""
-    rate = big_s / inertia[0]
+    """Ψ(t_k) = K(t_k) [W₀ + N W₁], W₁ = t W₀ − ∫ τ w dτ, one cumulative quadrature per time direction."""
     shortest = shortest_period(m0, inertia, ic)
     nilpotent = flow_matrix(big_s, inertia[0], 1.0) - np.eye(6)
     psi = np.zeros((t.size, 6, 2))
-    for i, ti in enumerate(t):
-        if ti == 0.0:
+    for sign in (1.0, -1.0):
+        chosen = np.flatnonzero(sign * t > 0.0)
+        if chosen.size == 0:
             continue
-        nodes, weights = _quadrature_grid(ti, shortest)
+        ends = np.unique(sign * t[chosen])
+        nodes, weights, interval = _quadrature_grid(np.concatenate([[0.0], ends]) * sign, shortest)
         qn, mn = torque_free_states(q0, m0, *inertia, nodes, closed_forms=False)
-        w0_sum = np.zeros((6, 2))
-        w1_sum = np.zeros((6, 2))
-        for tau, weight, qk, mk in zip(nodes, weights, qn, mn):
-            k = omega_basis(element_basis(qk, mk, big_s, s0 + rate * tau, inertia, ic), inertia)
-            w = np.linalg.solve(k, parameter_forcing(mk / inertia, inertia))
-            w0_sum += weight * w
-            w1_sum += weight * (ti - tau) * w
-        psi[i] = kt[i] @ (w0_sum + nilpotent @ w1_sum)
+        w = np.empty((nodes.size, 6, 2))
+        node_forcing(qn, mn, nodes, big_s, s0, inertia, ic, w)
+        # integrals over each interval, then running sums up to each breakpoint
+        zeroth = np.zeros((ends.size, 6, 2))
+        first = np.zeros((ends.size, 6, 2))
+        np.add.at(zeroth, interval, weights[:, None, None] * w)
+        np.add.at(first, interval, (weights * nodes)[:, None, None] * w)
+        zeroth, first = np.cumsum(zeroth, axis=0), np.cumsum(first, axis=0)
+        for i in chosen:
+            k = int(np.searchsorted(ends, sign * t[i]))
+            w0_sum, w1_sum = zeroth[k], t[i] * zeroth[k] - first[k]
+            psi[i] = kt[i] @ (w0_sum + nilpotent @ w1_sum)
     return psi

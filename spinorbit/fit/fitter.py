@@ -33,7 +33,7 @@ from astropy import units as u
 from astropy.time import Time
 from scipy.optimize import least_squares
 
-from spinorbit.body import RigidBody
+from spinorbit.body import TRIANGLE_SLACK, RigidBody
 from spinorbit.core.dynamics.equations import make_model
 from spinorbit.core.dynamics.validation import validate_sampled_span
 from spinorbit.core.errors import SingularElementsError
@@ -56,6 +56,10 @@ STATE_NAMES = ("δθx", "δθy", "δθz", "ωx", "ωy", "ωz")
 RATIO_NAMES = ("A/C", "B/C")
 #: least_squares stopping tolerances: far below the noise of any real observation set.
 TOLERANCE = 1e-10
+#: A Jacobian column below this fraction of the largest is rounding, not information (Φ(0) = 1 to ~1e-16).
+BLIND_COLUMN = 1e-12
+#: Largest χ² decrease a further Gauss–Newton step may promise at a converged solution.
+CONVERGENCE_DECREASE = 1e-2
 
 
 def _days_since(epoch, times):
@@ -112,13 +116,15 @@ def _check_inputs(observations, first_guess, epoch, span, sources, backend, fit_
     return observations, times, backend
 
 
-class _Problem:
+class ResidualModel:
     """Residuals and Jacobian of one fit about one reference attitude (cached per parameter vector)."""
 
-    def __init__(self, observations, times, q_ref, big_c, to_principal, fit_moments, ratios0, backend, sources, rtol):
+    def __init__(self, observations, times, q_ref, big_c, to_principal, fit_moments, ratios0, backend, sources, rtol,
+                 physical=True):
         self.observations, self.times, self.q_ref = observations, times, q_ref
         self.big_c, self.to_principal, self.fit_moments = big_c, to_principal, fit_moments
         self.ratios0, self.backend, self.sources, self.rtol = ratios0, backend, sources, rtol
+        self.physical = physical
         self._cached = None
 
     def moments(self, z):
@@ -126,10 +132,26 @@ class _Problem:
         if not (0.0 < ratios[0] < ratios[1] < 1.0):
             raise FitError(f"the moment ratios left the ordered region 0 < A/C < B/C < 1 (A/C = {ratios[0]!r}, "
                            f"B/C = {ratios[1]!r}); start nearer the truth, or fix the moments (fit_moments=False).")
+        if self.physical and ratios[0] + ratios[1] < 1.0 - TRIANGLE_SLACK:
+            raise FitError(f"the moment ratios left the physical region A/C + B/C ≥ 1 (got {ratios[0]!r} + {ratios[1]!r}); "
+                           "no mass distribution has them. Start nearer the truth or fix the moments.")
         return np.array([ratios[0] * self.big_c, ratios[1] * self.big_c, self.big_c])
 
     def attitude(self, z):
         return quat_multiply(self.q_ref, rotation_quaternion(z[:3]))
+
+    def residuals_or_rejection(self, z):
+        """The residuals, or +inf where the model is undefined (moment ratios out of order, J = 0 for the exact
+        STM): least_squares' trust-region step then shrinks (scipy's trf treats a non-finite trial
+        residual as a rejected step), and the Jacobian is only ever asked at accepted, valid points."""
+        try:
+            return self.evaluate(z)[0]
+        except FitError:
+            return np.full(self.size, np.inf)
+
+    @property
+    def size(self):
+        return sum(obs.size for obs in self.observations)
 
     def evaluate(self, z):
         if self._cached is not None and np.array_equal(self._cached[0], z):
@@ -161,8 +183,9 @@ class _Problem:
 def _conditioning(jacobian, names, threshold, where):
     """(condition number, covariance) of a whitened Jacobian, or SingularGeometryError above ``threshold``."""
     norms = np.linalg.norm(jacobian, axis=0)
-    if np.any(norms == 0.0):
-        blind = [names[i] for i in np.flatnonzero(norms == 0.0)]
+    blind_columns = norms <= BLIND_COLUMN * norms.max()
+    if np.any(blind_columns):
+        blind = [names[i] for i in np.flatnonzero(blind_columns)]
         raise SingularGeometryError(f"{where}: the observations do not depend on {', '.join(blind)} at all; add "
                                     "observations that constrain them, or fix them.")
     _, s, vt = np.linalg.svd(jacobian / norms, full_matrices=False)
@@ -250,31 +273,45 @@ def fit_rotation(observations, first_guess, epoch, *, fit_moments=True, sources=
     z0 = np.concatenate([np.zeros(3), omega_guess] + ([ratios0] if fit_moments else []))
 
     def problem_at(q_ref):
-        return _Problem(observations, times, q_ref, big_c, body.to_principal, fit_moments, ratios0, backend,
-                        tuple(sources), rtol)
+        return ResidualModel(observations, times, q_ref, big_c, body.to_principal, fit_moments, ratios0, backend,
+                             tuple(sources), rtol, body.physical)
 
     _conditioning(problem_at(q_guess).evaluate(z0)[1], names, condition_threshold, "at the first guess")
     runs = []
     for k in range(multi_start):
         phase = 2.0 * math.pi * k / multi_start
         problem = problem_at(_phase_turned(q_guess, omega_guess, np.array([big_a, big_b, big_c]), phase))
-        solution = least_squares(lambda z: problem.evaluate(z)[0], z0, jac=lambda z: problem.evaluate(z)[1],
+        solution = least_squares(problem.residuals_or_rejection, z0, jac=lambda z: problem.evaluate(z)[1],
                                  method="trf", x_scale="jac", xtol=TOLERANCE, ftol=TOLERANCE, gtol=TOLERANCE,
                                  max_nfev=max_nfev)
         runs.append((phase, problem, solution))
-    converged = [run for run in runs if run[2].status > 0]
+    # A run counts as converged only if least_squares met a test AND one more Gauss–Newton step about
+    # the solution would lower χ² by less than CONVERGENCE_DECREASE: a run stopped against the edge of
+    # the valid region (moment ratios at A/C + B/C = 1 or B/C = 1) passes scipy's ftol but not this.
+    converged, failures = [], []
+    for phase, problem, solution in runs:
+        if solution.status <= 0:
+            failures.append(f"start at phase {phase:.3f} rad: {solution.message}")
+            continue
+        q_fit = problem.attitude(solution.x)
+        z_fit = np.concatenate([np.zeros(3), solution.x[3:]])
+        residuals, jacobian = problem_at(q_fit).evaluate(z_fit)
+        condition, covariance = _conditioning(jacobian, names, condition_threshold, "at the solution")
+        gradient = jacobian.T @ residuals
+        decrease = float(gradient @ covariance @ gradient)
+        if decrease > CONVERGENCE_DECREASE:
+            failures.append(f"start at phase {phase:.3f} rad stopped where a Gauss–Newton step would still lower χ² "
+                            f"by {decrease:.3g} (at A/C, B/C = {problem.moments(z_fit)[:2] / big_c}: the edge of the "
+                            "valid region?)")
+            continue
+        converged.append((solution.cost, phase, solution, q_fit, z_fit, residuals, condition, covariance))
     if not converged:
         best = min(runs, key=lambda run: run[2].cost)[2]
         raise FitNotConvergedError(
-            f"least_squares did not converge from any of {multi_start} start(s) within max_nfev = {max_nfev} "
-            f"(best cost {best.cost:.4g}: {best.message}); raise max_nfev, improve the first guess or use multi_start.",
-            best)
-    phase, problem, solution = min(converged, key=lambda run: run[2].cost)
-    # re-centre the attitude on the solution, so the covariance's δθ is about the fitted attitude
-    q_fit = problem.attitude(solution.x)
-    z_fit = np.concatenate([np.zeros(3), solution.x[3:]])
-    residuals, jacobian = problem_at(q_fit).evaluate(z_fit)
-    condition, covariance = _conditioning(jacobian, names, condition_threshold, "at the solution")
+            f"no start of {multi_start} converged within max_nfev = {max_nfev}: " + "; ".join(failures)
+            + ". Raise max_nfev, improve the first guess, add observations (sparse sampling aliases the "
+            "spin) or use multi_start.", best)
+    _, phase, solution, q_fit, z_fit, residuals, condition, covariance = min(converged, key=lambda run: run[0])
     sigma = np.sqrt(np.diag(covariance))
     correlation = covariance / np.outer(sigma, sigma)
     unseparated = tuple((names[i], names[j], float(correlation[i, j])) for i in range(len(names))

@@ -33,8 +33,10 @@ Parameter sensitivities (variation of constants over the exact Φ)
     Ψ(t) = K(t) [W₀(t) + N W₁(t)],   W₀ = ∫₀ᵗ w dτ,   W₁ = ∫₀ᵗ (t − τ) w dτ,   w = K(τ)⁻¹ g(τ),
 
 N the nilpotent part of F per unit time. w is smooth and quasi-periodic, so Gauss–Legendre panels
-no longer than 1/16 of the shortest period of the motion (16 nodes each) give it to rounding
-(``tests/test_stm.py`` measures it against 40-digit finite differences).
+no longer than 1/4 of the shortest period of the motion (16 nodes each) give it to rounding: with 2
+panels per period Ψ agrees with 16 panels per period to 1.5e-14 relative (Toutatis over 30 d and two
+states of the body (1, 2, 3) over 69 time units, measured), and ``tests/test_stm.py`` checks it against
+40-digit finite differences.
 
 Not covered: permanent rotations and the exact separatrix (no finite elements), J = 0 exactly (spin
 exactly along C: l and g are separately undefined), and bodies with two equal moments (their free
@@ -69,7 +71,7 @@ PARAMETER_SIZE = 2
 K_ENERGY, K_SCALE, K_PHASE, K_ROTATION = 0, 1, 2, 3
 #: Gauss–Legendre nodes per panel and panels per shortest period of the parameter quadrature.
 QUADRATURE_NODES = 16
-PANELS_PER_PERIOD = 16
+PANELS_PER_PERIOD = 4
 #: A perpendicular momentum below this fraction of G is treated as J = 0 (l and g undefined).
 SMALLEST_SIN_J = 1e-9
 

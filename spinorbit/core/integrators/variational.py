@@ -42,10 +42,10 @@ from spinorbit.core.integrators.dop853 import (
     stats_record,
 )
 from spinorbit.core.integrators.quaternion import (
-    QUATERNION_SIZE,
     default_atol,
     minimum_steps,
-    normalize_quaternion_part,
+    renormalise_after_step,
+    renormalise_output,
 )
 from spinorbit.core.jit import jit
 from spinorbit.core.model.gravity_field import BODY_A, BODY_B, BODY_C, BODY_NMAX
@@ -61,15 +61,21 @@ AUGMENTED_SIZE = Y_PSI + LOCAL_SIZE * PARAMETER_SIZE
 
 
 @jit(inline="always")
+def weighted_body_position(t, q0, q1, q2, q3, model, k):
+    """(x, y, z, 3μ/R⁵) of perturber k: its body-frame position and the weight of its tidal tensor."""
+    row = MODEL_PERTURBERS + 1 + k * PERTURBER_ROW
+    ix, iy, iz = perturber_position_xyz(t, model, row)
+    x, y, z = body_frame_xyz(q0, q1, q2, q3, ix, iy, iz)
+    rr = x * x + y * y + z * z
+    return x, y, z, 3.0 * model[row + 1] / (rr * rr * math.sqrt(rr))
+
+
+@jit(inline="always")
 def tidal_tensor(t, q0, q1, q2, q3, model):
     """(T_xx, T_yy, T_zz, T_yz, T_zx, T_xy) of T = Σ 3μ/R⁵ r rᵀ over the perturbers (body frame)."""
     txx = tyy = tzz = tyz = tzx = txy = 0.0
     for k in range(int(model[MODEL_PERTURBERS])):
-        row = MODEL_PERTURBERS + 1 + k * PERTURBER_ROW
-        ix, iy, iz = perturber_position_xyz(t, model, row)
-        x, y, z = body_frame_xyz(q0, q1, q2, q3, ix, iy, iz)
-        rr = x * x + y * y + z * z
-        w = 3.0 * model[row + 1] / (rr * rr * math.sqrt(rr))
+        x, y, z, w = weighted_body_position(t, q0, q1, q2, q3, model, k)
         txx += w * x * x
         tyy += w * y * y
         tzz += w * z * z
@@ -84,11 +90,7 @@ def tidal_variation(t, q0, q1, q2, q3, model, j):
     """(δT_yz, δT_zx, δT_xy) for a unit body rotation δθ = e_j (δr = r × e_j)."""
     dyz = dzx = dxy = 0.0
     for k in range(int(model[MODEL_PERTURBERS])):
-        row = MODEL_PERTURBERS + 1 + k * PERTURBER_ROW
-        ix, iy, iz = perturber_position_xyz(t, model, row)
-        x, y, z = body_frame_xyz(q0, q1, q2, q3, ix, iy, iz)
-        rr = x * x + y * y + z * z
-        w = 3.0 * model[row + 1] / (rr * rr * math.sqrt(rr))
+        x, y, z, w = weighted_body_position(t, q0, q1, q2, q3, model, k)
         if j == 0:  # r × e_x = (0, z, −y)
             dx, dy, dz = 0.0, z, -y
         elif j == 1:  # r × e_y = (−z, 0, x)
@@ -146,24 +148,10 @@ def variational_rhs_into(t, y, model, dy):
 
 
 @jit
-def renormalise_quaternion_after_step(model, t, y, f, info):
-    """After an accepted step: renormalise q and rescale the FSAL q̇ (q̇ is linear in q; δθ is untouched)."""
-    norm = normalize_quaternion_part(y)
-    for i in range(QUATERNION_SIZE):
-        f[i] /= norm
-    return info, 0
-
-
-@jit
-def renormalise_quaternion_output(row):
-    normalize_quaternion_part(row)
-
-
-@jit
 def integrate_variational_kernel(y0, t0, t_out, model, rtol, atol, max_steps, first_step):
     """DOP853 on the 55-component augmented state (q, ω, Φ, Ψ); returns (ys (n, 55), stats)."""
-    ys, stats, _, _ = dop853_integrate(variational_rhs_into, model, never_singular, renormalise_quaternion_after_step,
-                                       renormalise_quaternion_output, y0, t0, t_out, rtol, atol, max_steps, False,
+    ys, stats, _, _ = dop853_integrate(variational_rhs_into, model, never_singular, renormalise_after_step,
+                                       renormalise_output, y0, t0, t_out, rtol, atol, max_steps, False,
                                        first_step, 0.0)
     return ys, stats
 

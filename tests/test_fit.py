@@ -276,6 +276,15 @@ def test_bad_input_gets_specific_errors():
     start, end = EPOCH, EPOCH + TimeDelta(3 * u.day)
     with pytest.raises(ObservationOutsideSpanError, match="outside the model span"):
         fit_rotation(observations, first_guess(), EPOCH, fit_moments=False, span=(start, end))
+    # a sampled torque source that ends before the last observation
+    from spinorbit.core.model.perturbers import sampled_source
+
+    sample_days = np.linspace(-1.0, 3.0, 9)
+    positions = np.column_stack([np.cos(sample_days), np.sin(sample_days), np.zeros_like(sample_days)])
+    velocities = np.column_stack([-np.sin(sample_days), np.cos(sample_days), np.zeros_like(sample_days)])
+    source = sampled_source(1e-3, sample_days, positions, velocities)
+    with pytest.raises(ObservationOutsideSpanError, match="sampled torque sources"):
+        fit_rotation(observations, first_guess(), EPOCH, fit_moments=False, sources=[source])
     # one body axis seen at one epoch, four times: the rotation about it and the spin are free
     axis_obs = [AxisObservation(EPOCH, [0, 0, 1], [0.2, 0.3, 0.9], 1 * u.deg) for _ in range(4)]
     with pytest.raises(SingularGeometryError, match="condition number|do not depend"):

@@ -37,6 +37,7 @@ from spinorbit.body import TRIANGLE_SLACK, RigidBody
 from spinorbit.core.dynamics.equations import make_model
 from spinorbit.core.dynamics.validation import validate_sampled_span
 from spinorbit.core.errors import SingularElementsError
+from spinorbit.core.integrators.dop853 import IntegrationError
 from spinorbit.core.math.rotations import quat_multiply, quat_to_attitude
 from spinorbit.fit.errors import (
     FitError,
@@ -162,6 +163,8 @@ class ResidualModel:
                                                 self.sources, self.rtol)
         except SingularElementsError as error:
             raise FitError(f"the exact STM is undefined at this iterate ({error}); use backend='dop853'.") from None
+        except IntegrationError as error:
+            raise FitError(f"the DOP853 propagation with its STM stopped at this iterate ({error}).") from None
         rows, jac = [], []
         attitude_chain = right_jacobian(z[:3])
         for k, obs in enumerate(self.observations):

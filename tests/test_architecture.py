@@ -35,6 +35,7 @@ UPPER_LAYERS = (
     ("runs", ("spinorbit.runs",)),
     ("coupling", ("spinorbit.coupling",)),
     ("scene", ("spinorbit.scene",)),
+    ("fit", ("spinorbit.fit",)),
     ("data", ("spinorbit.data",)),
     ("ensemble", ("spinorbit.ensemble",)),
     ("command line", ("spinorbit.cli", "spinorbit.commands", "spinorbit.__main__")),

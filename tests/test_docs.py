@@ -32,6 +32,8 @@ API_NAMES = {
                   "InvalidBodyError", "InvalidStateError", "SingularElementsError"],
     "special": ["ellipj", "am", "ellipk", "ellipf", "ellippi", "pn"],
     "core": ["andoyer_to_canonical", "canonical_to_andoyer"],
+    "fit": ["fit_rotation", "FitResult", "AttitudeObservation", "PeriodObservation", "free_flow_stm",
+            "integrate_variational"],
     "integrators": ["integrate_taylor", "integrate_taylor_fixed_step", "taylor_series", "TaylorFallbackWarning",
                     "integrate_elements_fixed_step"],
     "time": ["tdb_days", "tdb_day_and_fraction", "time_from_tdb_days", "J2000_JD_TDB"],
@@ -45,7 +47,7 @@ API_NAMES = {
                  "torus_mean_rhs", "validity_code"],
 }
 NARRATIVE_PAGES = ["index", "cli", "conventions", "theory", "design", "elliptic", "ephemeris", "performance",
-                   "scenes", "tutorials", "validation", "auto_examples/index"]
+                   "fitting", "scenes", "tutorials", "validation", "auto_examples/index"]
 
 
 #: What sphinx-gallery generates into the source tree (it cannot write elsewhere; git-ignored, rebuilt each build).

@@ -16,6 +16,8 @@ The stable entry points, importable from here (scripts written against them keep
   :func:`kepler_source`, :func:`sampled_source`, :func:`sampled_source_from_callable`;
 - each integrator: :func:`integrate_quaternion`, :func:`integrate_elements`, :func:`integrate_taylor`,
   :func:`integrate_splitting`, :func:`integrate_with_handover`, :func:`propagate_averaged`;
+- state transition matrices and moment-ratio sensitivities: :func:`free_flow_stm` (exact, through
+  the elements) and :func:`integrate_variational` (DOP853 with its variational equations);
 - the errors :class:`SpinorbitError`, :class:`SingularElementsError` and :class:`NonFiniteError`.
 
 They load on first use (PEP 562), so importing one integrator does not import the others.
@@ -39,6 +41,8 @@ _ENTRY_POINTS = {
     "integrate_splitting": "spinorbit.core.integrators.splitting",
     "integrate_with_handover": "spinorbit.core.integrators.handover",
     "propagate_averaged": "spinorbit.core.averaging.propagate",
+    "free_flow_stm": "spinorbit.core.free_motion.stm",
+    "integrate_variational": "spinorbit.core.integrators.variational",
     "SpinorbitError": "spinorbit.core.errors",
     "SingularElementsError": "spinorbit.core.errors",
     "NonFiniteError": "spinorbit.core.errors",

@@ -89,6 +89,11 @@ def _renormalise_output(row):
     normalize_quaternion_part(row)
 
 
+# The same hooks for other DOP853 users whose state starts with (q, ω) (the variational equations).
+renormalise_after_step = _renormalise_after_step
+renormalise_output = _renormalise_output
+
+
 @jit
 def integrate_dop853_kernel(y0, t0, t_out, model, rtol, atol, max_steps, hit_output_times, first_step):
     """Adaptive DOP853 on the quaternion equations from (t0, y0), output at the monotone ``t_out``.

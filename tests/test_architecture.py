@@ -34,6 +34,7 @@ UPPER_LAYERS = (
                 "spinorbit.orbital_elements", "spinorbit.pole")),
     ("runs", ("spinorbit.runs",)),
     ("coupling", ("spinorbit.coupling",)),
+    ("binary", ("spinorbit.binary",)),
     ("scene", ("spinorbit.scene",)),
     ("data", ("spinorbit.data",)),
     ("ensemble", ("spinorbit.ensemble",)),

@@ -83,14 +83,16 @@ def _equations():
 
 
 @functools.lru_cache(maxsize=None)
-def integrator(tol: float, compact_mode: bool = True):
-    """A compiled heyoka integrator of the order-2 binary (double precision), reused across calls."""
+def integrator(tol: float, compact_mode: bool = True, fp_type: str = "double"):
+    """A compiled heyoka integrator of the order-2 binary (double or long double), reused across calls."""
     import heyoka as hy
 
-    state = np.zeros(20)
+    dtype = np.longdouble if fp_type == "longdouble" else np.float64
+    state = np.zeros(20, dtype=dtype)
     state[0] = 1.0
     state[6] = state[13] = 1.0
-    return hy.taylor_adaptive(_equations(), state, pars=np.ones(8), tol=tol, compact_mode=compact_mode)
+    return hy.taylor_adaptive(_equations(), state, pars=np.ones(8, dtype=dtype), tol=dtype(tol),
+                              compact_mode=compact_mode, fp_type=dtype)
 
 
 def scales(masses, r0, g):
@@ -99,18 +101,18 @@ def scales(masses, r0, g):
     return r0, math.sqrt(r0 ** 3 / (g * total)), total
 
 
-def set_state(ta, y_si, masses, moments_a, moments_b, g):
-    """Load the package's SI state and the bodies into heyoka; returns the time unit (s)."""
+def set_state(ta, y_si, masses, moments_a, moments_b, g, dtype=np.float64):
+    """Load the package's SI state and the bodies into heyoka; returns the (length, time) units."""
     length, time, mass = scales(masses, float(np.linalg.norm(y_si[:3])), g)
-    y = np.array(y_si, dtype=float)
+    y = np.array(y_si, dtype=dtype)
     y[0:3] /= length
     y[3:6] *= time / length
     y[10:13] *= time
     y[17:20] *= time
     ta.state[:] = y
-    ta.time = 0.0
+    ta.time = dtype(0.0)
     ta.pars[:] = np.concatenate([[masses[0] / mass, masses[1] / mass], np.asarray(moments_a) / (mass * length ** 2),
-                                 np.asarray(moments_b) / (mass * length ** 2)])
+                                 np.asarray(moments_b) / (mass * length ** 2)]).astype(dtype)
     return length, time
 
 
@@ -123,12 +125,17 @@ def to_si(rows, length, time):
     return out
 
 
-def propagate(y_si, times_s, masses, moments_a, moments_b, g, tol=1e-15, compact_mode=True):
-    """States (n, 20) SI at ``times_s`` (increasing, > 0) from the SI state ``y_si``, quaternions renormalised."""
-    ta = integrator(tol, compact_mode)
-    length, time = set_state(ta, y_si, masses, moments_a, moments_b, g)
-    grid = np.concatenate(([0.0], np.asarray(times_s, dtype=float) / time))
-    out = ta.propagate_grid(grid)[-1][1:]
+def propagate(y_si, times_s, masses, moments_a, moments_b, g, tol=1e-15, compact_mode=True, fp_type="double"):
+    """States (n, 20) SI at ``times_s`` (increasing, > 0) from the SI state ``y_si``, quaternions renormalised.
+
+    With ``fp_type="longdouble"`` the run is in x86 extended precision (ε ≈ 1.1e-19) and the result is
+    rounded to double at the end: a reference for double-precision runs.
+    """
+    dtype = np.longdouble if fp_type == "longdouble" else np.float64
+    ta = integrator(tol, compact_mode, fp_type)
+    length, time = set_state(ta, y_si, masses, moments_a, moments_b, g, dtype)
+    grid = np.concatenate(([0.0], np.asarray(times_s, dtype=float) / time)).astype(dtype)
+    out = ta.propagate_grid(grid)[-1][1:].astype(np.float64)
     out = to_si(out, length, time)
     for offset in (6, 13):
         out[:, offset:offset + 4] /= np.linalg.norm(out[:, offset:offset + 4], axis=1, keepdims=True)

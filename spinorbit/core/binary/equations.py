@@ -27,11 +27,10 @@ import math
 
 import numpy as np
 
-from spinorbit.core.binary.inertia_integrals import INTEGRALS_SIZE, inertia_tensor, rotate_integrals
-from spinorbit.core.binary.monomials import DEGREE_START, MAX_ORDER, N_MONOMIALS
+from spinorbit.core.binary.inertia_integrals import INTEGRALS_SIZE, inertia_tensor, rotate_integrals_into
+from spinorbit.core.binary.monomials import N_MONOMIALS
 from spinorbit.core.binary.mutual_potential import mutual_field, torque_from_weights
 from spinorbit.core.jit import jit
-from spinorbit.core.math.rotations import quat_to_matrix
 
 # State layout.
 POSITION, VELOCITY, QUAT_A, OMEGA_A, QUAT_B, OMEGA_B = 0, 3, 6, 10, 13, 17
@@ -78,37 +77,86 @@ def make_binary_model(g, integrals_a, integrals_b, order, contact_distance):
     return model
 
 
+# Scratch of one field evaluation (one float64 array, allocated once per run: the RHS allocates nothing).
+S_ROTATION = 0  # C = M_Aᵀ M_B, row-major
+S_ROTATED_B = S_ROTATION + 9  # B's integrals on A's axes
+S_DERIVATIVES = S_ROTATED_B + INTEGRALS_SIZE  # ∂^α(1/R), degree ≤ MAX_ORDER + 1
+S_WEIGHTS_A = S_DERIVATIVES + N_MONOMIALS
+S_WEIGHTS_B = S_WEIGHTS_A + INTEGRALS_SIZE
+S_POLY = S_WEIGHTS_B + INTEGRALS_SIZE
+S_SPARE = S_POLY + INTEGRALS_SIZE
+SCRATCH_SIZE = S_SPARE + INTEGRALS_SIZE
+
+
+@jit(inline="always")
+def unit_quaternion_matrix_parts(y, offset):
+    """M(q/|q|) (body → inertial) of the quaternion at y[offset:offset + 4], row-major as a 9-tuple."""
+    norm2 = y[offset] ** 2 + y[offset + 1] ** 2 + y[offset + 2] ** 2 + y[offset + 3] ** 2
+    w, x, yy, z = y[offset], y[offset + 1], y[offset + 2], y[offset + 3]
+    s = 2.0 / norm2  # M(q) for a non-unit q is M(q/|q|) with 2/|q|² in place of 2
+    return (1.0 - s * (yy * yy + z * z), s * (x * yy - w * z), s * (x * z + w * yy),
+            s * (x * yy + w * z), 1.0 - s * (x * x + z * z), s * (yy * z - w * x),
+            s * (x * z - w * yy), s * (yy * z + w * x), 1.0 - s * (x * x + yy * yy))
+
+
 @jit
 def unit_quaternion_matrix(y, offset):
-    """M(q/|q|) of the quaternion at y[offset:offset + 4] (the RHS sees only the direction of q)."""
-    norm = math.sqrt(y[offset] ** 2 + y[offset + 1] ** 2 + y[offset + 2] ** 2 + y[offset + 3] ** 2)
-    q = np.empty(4)
-    for i in range(4):
-        q[i] = y[offset + i] / norm
-    return quat_to_matrix(q)
+    """M(q/|q|) of the quaternion at y[offset:offset + 4] as a (3, 3) array."""
+    parts = unit_quaternion_matrix_parts(y, offset)
+    m = np.empty((3, 3))
+    for k in range(9):
+        m[k // 3, k % 3] = parts[k]
+    return m
+
+
+@jit(inline="always")  # RHS hot path: no call boundary for the arrays to cross
+def field_into(y, model, scratch):
+    """The one field evaluation of state y: U, ∂U/∂R on the inertial axes, N_A on A's axes, N_B on B's axes.
+
+    Returns the 10 floats (U, gx, gy, gz, N_Ax, N_Ay, N_Az, N_Bx, N_By, N_Bz); ``scratch`` has
+    SCRATCH_SIZE floats and is overwritten (nothing is allocated).
+    """
+    order = int(model[M_ORDER])
+    ma = unit_quaternion_matrix_parts(y, QUAT_A)
+    mb = unit_quaternion_matrix_parts(y, QUAT_B)
+    rx, ry, rz = y[POSITION], y[POSITION + 1], y[POSITION + 2]
+    # R on A's axes, M_Aᵀ R, and C = M_Aᵀ M_B (B's axes → A's axes).
+    xa = ma[0] * rx + ma[3] * ry + ma[6] * rz
+    ya = ma[1] * rx + ma[4] * ry + ma[7] * rz
+    za = ma[2] * rx + ma[5] * ry + ma[8] * rz
+    rotation = scratch[S_ROTATION:S_ROTATION + 9]
+    for k in range(3):
+        for j in range(3):
+            rotation[3 * k + j] = ma[k] * mb[j] + ma[3 + k] * mb[3 + j] + ma[6 + k] * mb[6 + j]
+    integrals_a = model[M_INTEGRALS_A:M_INTEGRALS_A + INTEGRALS_SIZE]
+    rotated_b = scratch[S_ROTATED_B:S_ROTATED_B + INTEGRALS_SIZE]
+    rotate_integrals_into(model[M_INTEGRALS_B:M_INTEGRALS_B + INTEGRALS_SIZE], rotation, order, rotated_b,
+                          scratch[S_POLY:S_POLY + INTEGRALS_SIZE], scratch[S_SPARE:S_SPARE + INTEGRALS_SIZE])
+    weights_a = scratch[S_WEIGHTS_A:S_WEIGHTS_A + INTEGRALS_SIZE]
+    weights_b = scratch[S_WEIGHTS_B:S_WEIGHTS_B + INTEGRALS_SIZE]
+    u, gxa, gya, gza = mutual_field(xa, ya, za, model[M_G], integrals_a, rotated_b, order,
+                                    scratch[S_DERIVATIVES:S_DERIVATIVES + N_MONOMIALS], weights_a, weights_b)
+    gx = ma[0] * gxa + ma[1] * gya + ma[2] * gza
+    gy = ma[3] * gxa + ma[4] * gya + ma[5] * gza
+    gz = ma[6] * gxa + ma[7] * gya + ma[8] * gza
+    nax, nay, naz = torque_from_weights(weights_a, integrals_a, order)
+    tx, ty, tz = torque_from_weights(weights_b, rotated_b, order)
+    nbx = rotation[0] * tx + rotation[3] * ty + rotation[6] * tz
+    nby = rotation[1] * tx + rotation[4] * ty + rotation[7] * tz
+    nbz = rotation[2] * tx + rotation[5] * ty + rotation[8] * tz
+    return u, gx, gy, gz, nax, nay, naz, nbx, nby, nbz
 
 
 @jit
 def mutual_state(y, model):
-    """(U, ∂U/∂R inertial, N_A on A's axes, N_B on B's axes, R_A) of the state y: the one field evaluation."""
-    order = int(model[M_ORDER])
+    """(U, ∂U/∂R inertial, N_A on A's axes, N_B on B's axes, R on A's axes) of state y, as arrays.
+
+    The allocating form of :func:`field_into`, for set-up, diagnostics and tests.
+    """
+    u, gx, gy, gz, nax, nay, naz, nbx, nby, nbz = field_into(y, model, np.zeros(SCRATCH_SIZE))
     m_a = unit_quaternion_matrix(y, QUAT_A)
-    m_b = unit_quaternion_matrix(y, QUAT_B)
-    c = m_a.T @ m_b
-    r_a = m_a.T @ y[POSITION:POSITION + 3]
-    integrals_a = model[M_INTEGRALS_A:M_INTEGRALS_A + INTEGRALS_SIZE]
-    rotated_b = np.empty(INTEGRALS_SIZE)
-    rotate_integrals(model[M_INTEGRALS_B:M_INTEGRALS_B + INTEGRALS_SIZE], c, order, rotated_b)
-    derivatives = np.empty(N_MONOMIALS)
-    weights_a = np.empty(INTEGRALS_SIZE)
-    weights_b = np.empty(INTEGRALS_SIZE)
-    u, gx, gy, gz = mutual_field(r_a[0], r_a[1], r_a[2], model[M_G], integrals_a, rotated_b, order,
-                                 derivatives, weights_a, weights_b)
-    grad = m_a @ np.array([gx, gy, gz])
-    nax, nay, naz = torque_from_weights(weights_a, integrals_a, order)
-    nbx, nby, nbz = torque_from_weights(weights_b, rotated_b, order)
-    torque_b = c.T @ np.array([nbx, nby, nbz])
-    return u, grad, np.array([nax, nay, naz]), torque_b, r_a
+    return (u, np.array([gx, gy, gz]), np.array([nax, nay, naz]), np.array([nbx, nby, nbz]),
+            m_a.T @ y[POSITION:POSITION + 3])
 
 
 @jit(inline="always")
@@ -123,16 +171,16 @@ def quaternion_rate_into(y, q_offset, w_offset, out):
 
 
 @jit(inline="always")
-def euler_rate_into(y, w_offset, model, inertia_offset, torque, out):
+def euler_rate_into(y, w_offset, model, inertia_offset, nx, ny, nz, out):
     """ω̇ = I⁻¹((I ω) × ω + N) for a full inertia tensor I (row-major at inertia_offset, inverse after it)."""
     wx, wy, wz = y[w_offset], y[w_offset + 1], y[w_offset + 2]
     i = inertia_offset
     lx = model[i] * wx + model[i + 1] * wy + model[i + 2] * wz
     ly = model[i + 3] * wx + model[i + 4] * wy + model[i + 5] * wz
     lz = model[i + 6] * wx + model[i + 7] * wy + model[i + 8] * wz
-    bx = ly * wz - lz * wy + torque[0]
-    by = lz * wx - lx * wz + torque[1]
-    bz = lx * wy - ly * wx + torque[2]
+    bx = ly * wz - lz * wy + nx
+    by = lz * wx - lx * wz + ny
+    bz = lx * wy - ly * wx + nz
     v = inertia_offset + 9
     out[w_offset] = model[v] * bx + model[v + 1] * by + model[v + 2] * bz
     out[w_offset + 1] = model[v + 3] * bx + model[v + 4] * by + model[v + 5] * bz
@@ -140,17 +188,24 @@ def euler_rate_into(y, w_offset, model, inertia_offset, torque, out):
 
 
 @jit
-def binary_rhs_into(t, y, model, out):
-    """dy/dt of the full two-body problem into out; returns |R| − contact distance (< 0: in contact)."""
-    _, grad, torque_a, torque_b, _ = mutual_state(y, model)
+def binary_rhs_into(t, y, params, out):
+    """dy/dt of the full two-body problem into out; returns |R| − contact distance (< 0: in contact).
+
+    ``params`` = (model, scratch of SCRATCH_SIZE floats), built once per run by the kernels of
+    :mod:`spinorbit.core.binary.propagate`.
+    """
+    model, scratch = params
+    _, gx, gy, gz, nax, nay, naz, nbx, nby, nbz = field_into(y, model, scratch)
     inverse_reduced_mass = 1.0 / model[M_MASS_A] + 1.0 / model[M_MASS_B]
     for i in range(3):
         out[POSITION + i] = y[VELOCITY + i]
-        out[VELOCITY + i] = inverse_reduced_mass * grad[i]
+    out[VELOCITY] = inverse_reduced_mass * gx
+    out[VELOCITY + 1] = inverse_reduced_mass * gy
+    out[VELOCITY + 2] = inverse_reduced_mass * gz
     quaternion_rate_into(y, QUAT_A, OMEGA_A, out)
     quaternion_rate_into(y, QUAT_B, OMEGA_B, out)
-    euler_rate_into(y, OMEGA_A, model, M_INERTIA_A, torque_a, out)
-    euler_rate_into(y, OMEGA_B, model, M_INERTIA_B, torque_b, out)
+    euler_rate_into(y, OMEGA_A, model, M_INERTIA_A, nax, nay, naz, out)
+    euler_rate_into(y, OMEGA_B, model, M_INERTIA_B, nbx, nby, nbz, out)
     distance = math.sqrt(y[POSITION] ** 2 + y[POSITION + 1] ** 2 + y[POSITION + 2] ** 2)
     return distance - model[M_CONTACT]
 
@@ -187,8 +242,3 @@ def binary_angular_momentum(y, model):
         out += unit_quaternion_matrix(y, q_offset) @ (inertia @ y[w_offset:w_offset + 3])
     return out
 
-
-#: The order bound the tables were built for (re-exported for the front ends' checks).
-SUPPORTED_ORDER = MAX_ORDER
-#: Scratch sizes of one field evaluation (for callers that evaluate many states).
-FIELD_SCRATCH = (N_MONOMIALS, int(DEGREE_START[MAX_ORDER + 1]))

@@ -55,7 +55,7 @@ from spinorbit.core.jit import jit
 AXIS_X, AXIS_Y, AXIS_Z = 0, 1, 2
 
 
-@jit
+@jit(inline="always")  # RHS hot path: no call boundary for the arrays to cross
 def inverse_distance_derivatives(x, y, z, max_degree, out):
     """out[α] = ∂^α (1/R) at (x, y, z) for every |α| ≤ max_degree (recurrence of the module docstring)."""
     r2 = x * x + y * y + z * z
@@ -73,7 +73,7 @@ def inverse_distance_derivatives(x, y, z, max_degree, out):
             out[index] = acc / (n * r2)
 
 
-@jit
+@jit(inline="always")  # RHS hot path: no call boundary for the arrays to cross
 def mutual_field(x, y, z, g, integrals_a, integrals_b, order, derivatives, weights_a, weights_b):
     """U, ∂U/∂R and the weights W = ∂U/∂T of both bodies at B's position (x, y, z) on A's axes.
 
@@ -121,7 +121,7 @@ def mutual_field(x, y, z, g, integrals_a, integrals_b, order, derivatives, weigh
     return u, gx, gy, gz
 
 
-@jit
+@jit(inline="always")  # RHS hot path: no call boundary for the arrays to cross
 def torque_from_weights(weights, integrals, order):
     """N = ∂U/∂θ of the body with integrals T and weights W = ∂U/∂T (axes of T), degrees 2..order."""
     nx = 0.0

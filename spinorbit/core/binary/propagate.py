@@ -31,6 +31,7 @@ from spinorbit.core.binary.equations import (
     POSITION,
     QUAT_A,
     QUAT_B,
+    SCRATCH_SIZE,
     VELOCITY,
     binary_rhs_into,
 )
@@ -72,7 +73,7 @@ def normalize_block(y, offset):
 
 
 @jit
-def renormalise_both(model, t, y, f, info):
+def renormalise_both(params, t, y, f, info):
     """After an accepted step: |q_A| = |q_B| = 1, and the FSAL q̇ rescaled with them (no extra RHS call)."""
     for offset in (QUAT_A, QUAT_B):
         norm = normalize_block(y, offset)
@@ -91,7 +92,8 @@ def renormalise_output(row):
 @jit
 def binary_kernel(y0, t0, t_out, model, rtol, atol, max_steps):
     """Adaptive DOP853 on the binary equations: (states at t_out, stats, t of the last accepted step)."""
-    ys, stats, t_stop, _ = dop853_integrate(binary_rhs_into, model, contact_status, renormalise_both,
+    params = (model, np.zeros(SCRATCH_SIZE))
+    ys, stats, t_stop, _ = dop853_integrate(binary_rhs_into, params, contact_status, renormalise_both,
                                             renormalise_output, y0, t0, t_out, rtol, atol, max_steps,
                                             False, 0.0, 0.0)
     return ys, stats, t_stop
@@ -100,7 +102,8 @@ def binary_kernel(y0, t0, t_out, model, rtol, atol, max_steps):
 @jit
 def binary_fixed_step_kernel(y0, t0, t1, n_steps, model):
     """n_steps equal DOP853 steps (order measurements and equal-work benchmarks); (y(t1), status)."""
-    return dop853_fixed_steps(binary_rhs_into, model, contact_status, renormalise_both, y0, t0, t1, n_steps)
+    params = (model, np.zeros(SCRATCH_SIZE))
+    return dop853_fixed_steps(binary_rhs_into, params, contact_status, renormalise_both, y0, t0, t1, n_steps)
 
 
 def check_order(order, supported=MAX_ORDER):

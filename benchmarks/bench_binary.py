@@ -86,20 +86,32 @@ def work_precision(repeats):
                 load=(load_before, load_after))
 
 
+def pareto_front(rows):
+    """(log error, log median time) of the runs no other run beats on both, by increasing error."""
+    points = sorted((e, t.median) for _, e, _, t in rows if e > 0)
+    front = []
+    for error, seconds in reversed(points):  # from the least accurate: keep a run only if it is cheaper
+        if not front or seconds < front[-1][1]:
+            front.append((error, seconds))
+    return [(math.log(e), math.log(t)) for e, t in reversed(front)]
+
+
 def time_at_error(rows, target):
-    """log-log interpolation of the median time at ``target`` error (None outside the measured range)."""
-    points = sorted((math.log(e), math.log(t.median)) for _, e, _, t in rows if e > 0)
-    errors = [p[0] for p in points]
-    if not errors or not errors[0] <= math.log(target) <= errors[-1]:
+    """Median time at ``target`` error by log-log interpolation on the Pareto front (None outside its range).
+
+    A run of a tighter tolerance that came out less accurate than a looser one (heyoka's error is not
+    monotone in tol here) is dominated and left out, so each code is credited with its best runs.
+    """
+    front = pareto_front(rows)
+    if not front or not front[0][0] <= math.log(target) <= front[-1][0]:
         return None
-    # monotone envelope: for each error the cheapest run at least that accurate
-    xs, ys = zip(*points)
+    xs, ys = zip(*front)
     return math.exp(float(np.interp(math.log(target), xs, ys)))
 
 
 def cost_by_order(repeats):
     rows = []
-    for order in range(5):
+    for order in (0, 2, 3, 4):  # order 1 adds no term (degree-1 integrals vanish about the centre of mass)
         model, y0, period = triaxial_pair(order)
         steps = 2000
         binary_fixed_step_kernel(y0, 0.0, period / 100, 10, model)  # compile
@@ -171,7 +183,7 @@ def markdown(wp, orders, dr, repeats):
     for name, rows in (("spinorbit", wp["rows_package"]), ("heyoka", wp["rows_heyoka"])):
         for tol, err, steps, timing in rows:
             lines.append(f"| {name} | {tol:.0e} | {err:.2e} | {steps if steps is not None else '–'} | {timing.text()} |")
-    lines += ["", "At equal accuracy (log-log interpolation of each code's median time):", "",
+    lines += ["", "At equal accuracy (log-log interpolation of each code's median time on its Pareto front):", "",
               "| error / R₀ | spinorbit (ms) | heyoka (ms) | heyoka / spinorbit |", "|---|---|---|---|"]
     for target in TARGET_ERRORS:
         ours, theirs = time_at_error(wp["rows_package"], target), time_at_error(wp["rows_heyoka"], target)

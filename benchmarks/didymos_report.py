@@ -23,7 +23,7 @@ from _report import machine_line, write_section  # noqa: E402
 from test_binary_propagation import linear_libration_frequency  # noqa: E402
 
 from spinorbit.binary import BinaryState, Figure, momentum_impulse, propagate  # noqa: E402
-from spinorbit.binary.run import _strongest_line_away_from  # noqa: E402,PLC2701
+from spinorbit.binary.run import strongest_line  # noqa: E402
 from spinorbit.binary.system import G_SI  # noqa: E402
 from spinorbit.data import didymos  # noqa: E402
 
@@ -76,7 +76,7 @@ def libration_check():
     exact, point_mass = linear_libration_frequency(m_a, m_b, moments, r, n)
     times = np.linspace(0.0, 30 * 2 * math.pi / exact, 1501) * u.s
     phi = propagate(state, times, rtol=1e-13).libration().value
-    measured = _strongest_line_away_from(times.value, phi - phi.mean(), None)
+    measured = strongest_line(times.value, phi - phi.mean(), None)
     big_a, big_b, big_c = moments
     textbook = n * math.sqrt(3 * (big_b - big_a) / big_c)
     return dict(n=n, measured=measured, exact=exact, textbook=textbook, point_mass=point_mass)

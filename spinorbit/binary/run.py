@@ -129,8 +129,8 @@ class BinaryRun:
                              "times; propagate on np.linspace(0, span, n).")
         phi = self.libration().to_value(u.rad)
         n = 2.0 * math.pi / self.mutual_period().to_value(u.s)
-        first = _strongest_line_away_from(t, phi - phi.mean(), None)
-        second = _strongest_line_away_from(t, phi - phi.mean(), first)
+        first = strongest_line(t, phi - phi.mean(), None)
+        second = strongest_line(t, phi - phi.mean(), first)
         forced, free = (first, second) if abs(first - n) <= abs(second - n) else (second, first)
         amplitudes, residual = _fit_lines(t, phi, (free, forced))
         return LibrationComponents(2 * math.pi / free * u.s, amplitudes[0] * u.rad, 2 * math.pi / forced * u.s,
@@ -145,8 +145,9 @@ def _periodogram(t, x, frequency):
     return abs(np.sum(window * x * np.exp(-1j * frequency * t)))
 
 
-def _strongest_line_away_from(t, x, avoided):
-    """Angular frequency of the periodogram's highest peak more than 3 resolutions from ``avoided`` (None: anywhere)."""
+def strongest_line(t, x, avoided=None):
+    """Angular frequency (rad per unit of t) of the highest peak of the Hann-windowed periodogram of x(t),
+    more than 3 resolutions from ``avoided`` (None: anywhere), refined by maximising the periodogram."""
     from scipy.optimize import minimize_scalar
 
     span = t[-1] - t[0]

@@ -44,7 +44,7 @@ def consistency():
 
 def line(label, run):
     parts = run.libration_components()
-    tumbling, excess, p_psi, p_phi = run.tumbling_summary()
+    _, excess, _, _ = run.tumbling_summary()
     return (f"| {label} | {run.mutual_period().to_value(u.h):.4f} | {parts.free_period.to_value(u.h):.3f} | "
             f"{parts.free_amplitude.to_value(u.deg):.3f} | {parts.forced_period.to_value(u.h):.3f} | "
             f"{parts.forced_amplitude.to_value(u.deg):.3f} | {excess:.3g} | {run.energy_drift()[0].max():.1e} | "

@@ -145,7 +145,7 @@ def test_force_and_both_torques_are_derivatives_of_the_potential(order):
     # component leaves a margin of 100 over both.
     model = ellipsoids(order)
     y = state(SEPARATION, M_A, M_B)
-    u, grad, torque_a, torque_b, _ = eq.mutual_state(y, model)
+    _, grad, torque_a, torque_b, _ = eq.mutual_state(y, model)
     h = 1e-3
 
     def potential_moved(k):

@@ -213,3 +213,8 @@ def test_order_two_agrees_with_the_full_two_body_problem_written_in_heyoka():
     assert spin_a <= 2e-12 * np.linalg.norm(y0[eq.OMEGA_A:eq.OMEGA_A + 3])
     assert spin_b <= 2e-12 * np.linalg.norm(y0[eq.OMEGA_B:eq.OMEGA_B + 3])
     assert attitude <= 2e-12
+
+
+def test_unsorted_semi_axes_are_refused_with_the_convention():
+    with pytest.raises(ValueError, match=r"expected semi-axes a ≥ b ≥ c.*got \[50\.0, 100\.0, 40\.0\]"):
+        Figure.ellipsoid("B", [50, 100, 40] * u.m, 2 * u.g / u.cm ** 3)

@@ -40,9 +40,12 @@ class Figure:
     def ellipsoid(cls, name, semi_axes, density):
         """A homogeneous ellipsoid with semi-axes (a, b, c) along its x, y, z axes.
 
+        Raises ValueError for non-positive or unsorted semi-axes or density.
+
         Parameters
         ----------
         semi_axes : Quantity (3,), length
+            a ≥ b ≥ c, so that the principal moments on x, y, z are A ≤ B ≤ C (``docs/conventions.md``).
         density : Quantity, mass density
         """
         axes = value_in("semi_axes", semi_axes, u.m, "[103.16, 79.35, 66.13] * u.m", shape=(3,))
@@ -50,6 +53,9 @@ class Figure:
         if np.any(axes <= 0) or rho <= 0:
             raise ValueError(f"{name}: expected positive semi-axes and density, got semi_axes = {axes.tolist()} m, "
                              f"density = {rho} kg/m³; a figure needs a volume and a mass.")
+        if not axes[0] >= axes[1] >= axes[2]:
+            raise ValueError(f"{name}: expected semi-axes a ≥ b ≥ c along x, y, z (the long axis on x, so that "
+                             f"A ≤ B ≤ C), got {axes.tolist()} m; sort them and turn the attitude to match.")
         mass = rho * 4.0 / 3.0 * math.pi * float(np.prod(axes))
         return cls(name, ellipsoid_integrals(mass, axes), float(axes.max()), tuple(float(a) for a in axes))
 

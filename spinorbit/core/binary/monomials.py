@@ -31,7 +31,8 @@ EXPONENTS = _exponents(MAX_DEGREE)
 N_MONOMIALS = EXPONENTS.shape[0]
 #: Index of the first monomial of each degree (and one past the last degree).
 DEGREE_START = np.array([n * (n + 1) * (n + 2) // 6 for n in range(MAX_DEGREE + 2)], dtype=np.int64)
-#: Number of monomials of degree ≤ n: the size of a body's integral table to order n.
+
+
 def monomials_to_degree(n):
     """Number of monomials of degree ≤ n (the length of an integral table to order n)."""
     return int(DEGREE_START[n + 1])

@@ -23,7 +23,7 @@ PACKAGE = Path(__file__).resolve().parent.parent / "spinorbit"
 FORBIDDEN_IN_CORE = ("astropy", "skyfield", "rebound", "reboundx", "heyoka", "jplephem")
 
 #: The core's folders, lowest first: each may import only itself and those before it.
-CORE_LAYERS = ("math", "model", "dynamics", "elements", "free_motion", "integrators", "averaging")
+CORE_LAYERS = ("math", "model", "dynamics", "elements", "free_motion", "integrators", "averaging", "binary")
 #: Core modules every core folder may use (numba settings, error types).
 CORE_BASE = ("spinorbit.core.jit", "spinorbit.core.errors")
 
@@ -34,6 +34,7 @@ UPPER_LAYERS = (
                 "spinorbit.orbital_elements", "spinorbit.pole")),
     ("runs", ("spinorbit.runs",)),
     ("coupling", ("spinorbit.coupling",)),
+    ("binary", ("spinorbit.binary",)),
     ("scene", ("spinorbit.scene",)),
     ("fit", ("spinorbit.fit",)),
     ("data", ("spinorbit.data",)),

@@ -45,9 +45,11 @@ API_NAMES = {
               "attitude_sensitivity", "dropped_torque_bound"],
     "averaged": ["propagate_averaged", "osculating_to_mean", "mean_to_osculating", "polhode_mean_inertia",
                  "torus_mean_rhs", "validity_code"],
+    "binary": ["propagate", "BinaryRun", "Figure", "BinarySystem", "BinaryState", "momentum_impulse", "ContactError",
+               "UnsupportedOrderError", "mutual_field", "ellipsoid_integrals", "propagate_binary"],
 }
 NARRATIVE_PAGES = ["index", "cli", "conventions", "theory", "design", "elliptic", "ephemeris", "performance",
-                   "fitting", "scenes", "tutorials", "validation", "auto_examples/index"]
+                   "fitting", "scenes", "tutorials", "validation", "auto_examples/index", "binary"]
 
 
 #: What sphinx-gallery generates into the source tree (it cannot write elsewhere; git-ignored, rebuilt each build).

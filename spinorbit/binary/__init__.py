@@ -1,0 +1,15 @@
+"""Binary asteroids with units: two rigid figures, their state, the coupled propagation and what it shows.
+
+- :mod:`.system` — :class:`Figure` (an ellipsoid or a sphere with its inertia integrals),
+  :class:`BinarySystem` (two figures and the expansion order), :class:`BinaryState` (relative orbit,
+  both attitudes and spins), the DART-like impulse;
+- :mod:`.run` — :func:`propagate` and :class:`BinaryRun` (drifts, the secondary's libration and
+  canonical elements, the mutual period and the libration spectrum).
+
+The core below is :mod:`spinorbit.core.binary` (SI floats: m, kg, s, rad).
+"""
+
+from spinorbit.binary.run import BinaryRun, LibrationComponents, propagate
+from spinorbit.binary.system import BinaryState, BinarySystem, Figure, momentum_impulse
+
+__all__ = ["BinaryRun", "BinaryState", "BinarySystem", "Figure", "LibrationComponents", "momentum_impulse", "propagate"]

@@ -1,0 +1,201 @@
+"""The coupled propagation of a binary with units, and what a run shows about the secondary.
+
+:func:`propagate` strips the units once, runs :func:`spinorbit.core.binary.propagate.propagate_binary`
+(DOP853) and returns a :class:`BinaryRun`: the states, the conserved quantities' drifts, the
+secondary's libration angle and canonical elements (:mod:`spinorbit.core.binary.libration`), the
+mutual orbit period and the libration's free and forced components.
+
+How the components are measured (:meth:`BinaryRun.libration_components`): the two strongest lines
+of the periodogram of φ(t) (the second at least three resolutions from the first), each frequency
+refined by maximising the periodogram near its peak, then both amplitudes fitted together by linear
+least squares. The line nearer the mean motion n is the forced libration: it is driven at the
+*anomalistic* frequency of the orbit, which differs from n by the apsidal precession (for the
+Didymos case by ~4 %, measured), so it is found, not assumed at n. The other is the free
+libration. The periodogram resolves two lines 2π/T apart, so the run must cover many libration
+periods (the Didymos run: 100 orbits).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from astropy import units as u
+
+from spinorbit.binary.system import BinaryState
+from spinorbit.core.binary import equations as core
+from spinorbit.core.binary.libration import (
+    COL_ENERGY_RATIO,
+    COL_LIBRATION,
+    COL_MODE,
+    COL_P_PHI,
+    COL_P_PSI,
+    secondary_rotation_table,
+)
+from spinorbit.core.binary.propagate import propagate_binary
+from spinorbit.quantities import value_in
+
+#: Names of the rotation modes of :func:`spinorbit.core.free_motion.summary.mode_code`.
+MODE_NAMES = {1: "SAM", -1: "LAM", 0: "principal-axis", 2: "separatrix"}
+
+
+@dataclass(frozen=True)
+class LibrationComponents:
+    """The secondary's libration split into its free and forced lines (periods and amplitudes)."""
+
+    free_period: u.Quantity
+    free_amplitude: u.Quantity
+    forced_period: u.Quantity
+    forced_amplitude: u.Quantity
+    residual_rms: u.Quantity
+
+
+@dataclass(frozen=True)
+class BinaryRun:
+    """States of a binary run at its output times, with the secondary's rotation read off them."""
+
+    initial: BinaryState
+    times: u.Quantity
+    states: np.ndarray
+    stats: dict
+
+    @property
+    def model(self):
+        return self.initial.system.model()
+
+    def energy(self):
+        """Total energy at each output time (J)."""
+        model = self.model
+        return np.array([core.binary_energy(y, model) for y in self.states]) * u.J
+
+    def angular_momentum(self):
+        """Total angular momentum (inertial axes) at each output time (kg m²/s)."""
+        model = self.model
+        return np.array([core.binary_angular_momentum(y, model) for y in self.states]) * u.kg * u.m ** 2 / u.s
+
+    def energy_drift(self):
+        """(|E − E₀|/|E₀|, |E − E₀|/|U₀|) at each output time: relative to the energy and to the mutual potential.
+
+        The total energy of a fast-spinning primary is mostly its spin; the second ratio measures the
+        drift on the scale of the orbit–figure coupling.
+        """
+        energy = self.energy().to_value(u.J)
+        potential = core.mutual_state(self.states[0], self.model)[0]
+        change = np.abs(energy - energy[0])
+        return change / abs(energy[0]), change / abs(potential)
+
+    def angular_momentum_drift(self):
+        """|H − H₀| / |H₀| at each output time."""
+        h = self.angular_momentum().value
+        return np.linalg.norm(h - h[0], axis=1) / np.linalg.norm(h[0])
+
+    def secondary_rotation(self):
+        """Per output time: libration angle φ (rad), B's canonical elements, mode, E/E0, P_ψ, P_φ (s)."""
+        return secondary_rotation_table(np.ascontiguousarray(self.states), self.model)
+
+    def libration(self):
+        """φ(t), B's long axis from the line to A in B's equator, modulo π (Quantity rad)."""
+        return self.secondary_rotation()[:, COL_LIBRATION] * u.rad
+
+    def secondary_modes(self):
+        """Mode names (SAM, LAM, principal-axis, separatrix) of B's rotation at each output time."""
+        return [MODE_NAMES[int(code)] for code in self.secondary_rotation()[:, COL_MODE]]
+
+    def tumbling_summary(self):
+        """(fraction of output times in SAM or LAM, max E/E0 − 1, median P_ψ, median P_φ (s) over those times)."""
+        table = self.secondary_rotation()
+        tumbling = np.isin(table[:, COL_MODE], (1, -1)) & np.isfinite(table[:, COL_P_PSI])
+        if not np.any(tumbling):
+            return 0.0, float(np.max(table[:, COL_ENERGY_RATIO]) - 1.0), math.inf * u.s, math.inf * u.s
+        return (float(np.mean(tumbling)), float(np.max(table[:, COL_ENERGY_RATIO]) - 1.0),
+                float(np.median(table[tumbling, COL_P_PSI])) * u.s, float(np.median(table[tumbling, COL_P_PHI])) * u.s)
+
+    def orbital_longitude(self):
+        """Unwrapped longitude of B about A in the inertial x-y plane (rad)."""
+        return np.unwrap(np.arctan2(self.states[:, core.POSITION + 1], self.states[:, core.POSITION]))
+
+    def mutual_period(self):
+        """Mean sidereal period of the mutual orbit: 2π over the least-squares slope of the longitude (s)."""
+        t = self.times.to_value(u.s)
+        slope = np.polyfit(t, self.orbital_longitude(), 1)[0]
+        return 2.0 * math.pi / abs(slope) * u.s
+
+    def libration_components(self):
+        """The free and forced lines of φ(t) (module docstring); needs equally spaced output times."""
+        t = self.times.to_value(u.s)
+        if len(t) < 64 or not np.allclose(np.diff(t), t[1] - t[0], rtol=1e-9, atol=0):
+            raise ValueError(f"libration_components: expected ≥ 64 equally spaced output times, got {len(t)} "
+                             "times; propagate on np.linspace(0, span, n).")
+        phi = self.libration().to_value(u.rad)
+        n = 2.0 * math.pi / self.mutual_period().to_value(u.s)
+        first = strongest_line(t, phi - phi.mean(), None)
+        second = strongest_line(t, phi - phi.mean(), first)
+        forced, free = (first, second) if abs(first - n) <= abs(second - n) else (second, first)
+        amplitudes, residual = _fit_lines(t, phi, (free, forced))
+        return LibrationComponents(2 * math.pi / free * u.s, amplitudes[0] * u.rad, 2 * math.pi / forced * u.s,
+                                   amplitudes[1] * u.rad, residual * u.rad)
+
+
+def _periodogram(t, x, frequency):
+    """|Σ w x e^{−iωt}| with the Hann window w: its sidelobes fall as 1/f³, so a second line a few
+    resolutions away shifts the peak by ~1e-6 of its frequency instead of ~1e-4 (measured on the
+    libration test of tests/test_binary_propagation.py)."""
+    window = np.sin(np.pi * np.arange(len(t)) / (len(t) - 1)) ** 2
+    return abs(np.sum(window * x * np.exp(-1j * frequency * t)))
+
+
+def strongest_line(t, x, avoided=None):
+    """Angular frequency (rad per unit of t) of the highest peak of the Hann-windowed periodogram of x(t),
+    more than 3 resolutions from ``avoided`` (None: anywhere), refined by maximising the periodogram."""
+    from scipy.optimize import minimize_scalar
+
+    span = t[-1] - t[0]
+    resolution = 2.0 * math.pi / span
+    grid = np.arange(resolution, math.pi / (t[1] - t[0]), resolution / 4.0)
+    power = np.array([_periodogram(t, x, f) for f in grid])
+    if avoided is not None:
+        power[np.abs(grid - avoided) < 3.0 * resolution] = 0.0
+    peak = grid[int(np.argmax(power))]
+    best = minimize_scalar(lambda f: -_periodogram(t, x, f), bounds=(peak - resolution / 2, peak + resolution / 2),
+                           method="bounded", options={"xatol": resolution * 1e-6})
+    return float(best.x)
+
+
+def _fit_lines(t, x, frequencies):
+    """Amplitudes of the lines at ``frequencies`` and the rms residual (linear least squares with a constant)."""
+    columns = [np.ones_like(t)]
+    for f in frequencies:
+        columns += [np.cos(f * t), np.sin(f * t)]
+    design = np.stack(columns, axis=1)
+    coefficients, *_ = np.linalg.lstsq(design, x, rcond=None)
+    residual = x - design @ coefficients
+    amplitudes = [math.hypot(coefficients[1 + 2 * k], coefficients[2 + 2 * k]) for k in range(len(frequencies))]
+    return amplitudes, float(np.sqrt(np.mean(residual ** 2)))
+
+
+def propagate(state, times, rtol=1e-12, max_steps=100_000_000):
+    """Propagate a :class:`~spinorbit.binary.system.BinaryState` to ``times`` after it (Quantity, time).
+
+    Parameters
+    ----------
+    state : BinaryState
+    times : Quantity (n,), time
+        Output times from the state's instant, strictly monotone, not 0 first unless more follow.
+    rtol : float
+        DOP853's relative tolerance (1e-15 … 1); 1e-12 keeps E and H to ~1e-13 over 10⁴ orbits
+        (docs/binary.md).
+
+    Raises
+    ------
+    ContactError, UnsupportedOrderError, IntegrationError
+        From :func:`spinorbit.core.binary.propagate.propagate_binary`.
+    """
+    t = np.atleast_1d(value_in("times", times, u.s, "np.linspace(0, 10, 1001) * u.day"))
+    y0 = state.core_state()
+    model = state.system.model()
+    first = 1 if t[0] == 0.0 else 0
+    ys, stats = propagate_binary(y0, 0.0, t[first:], model, rtol=rtol, max_steps=max_steps, return_stats=True)
+    if first:
+        ys = np.vstack([y0[None, :], ys])
+    return BinaryRun(state, t * u.s, ys, stats)

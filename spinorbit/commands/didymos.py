@@ -88,8 +88,8 @@ def _report(label, run):
         f"  forced libration         period {parts.forced_period.to_value(u.h):.4f} h, amplitude "
         f"{parts.forced_amplitude.to_value(u.deg):.4f} deg (fit residual {parts.residual_rms.to_value(u.deg):.2g} deg rms)",
         f"  max |libration|          {abs(run.libration()).max().to_value(u.deg):.4f} deg",
-        f"  Dimorphos rotation       {'non-principal-axis (SAM/LAM)' if tumbling else 'principal-axis'} at {100 * tumbling:.0f} % "
-        f"of the output times, max E/E0 - 1 = {energy_excess:.3g}"
+        f"  Dimorphos rotation       non-principal-axis (SAM/LAM) at {100 * tumbling:.0f} % of the output times, "
+        f"principal-axis at the rest, max E/E0 - 1 = {energy_excess:.3g}"
         + (f", P_psi = {p_psi.to_value(u.h):.3f} h, P_phi = {p_phi.to_value(u.h):.3f} h" if tumbling else ""),
         f"  drift                    |dE/E| = {e_rel.max():.2e} (|dE/U| = {e_potential.max():.2e}), "
         f"|dH/H| = {run.angular_momentum_drift().max():.2e}",

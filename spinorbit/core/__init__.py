@@ -4,7 +4,7 @@ Nothing under ``spinorbit.core`` imports astropy, skyfield or rebound (``tests/t
 enforces it), so the core can be called from numba-compiled loops and from REBOUND callbacks without
 Python overhead. Its folders are layers, each importing only the ones before it
 (``docs/architecture.md``): ``math`` → ``model`` → ``dynamics`` → ``elements`` → ``free_motion`` →
-``integrators`` → ``averaging``.
+``integrators`` → ``averaging`` → ``binary``.
 
 The stable entry points, importable from here (scripts written against them keep working):
 
@@ -18,6 +18,8 @@ The stable entry points, importable from here (scripts written against them keep
   :func:`integrate_splitting`, :func:`integrate_with_handover`, :func:`propagate_averaged`;
 - state transition matrices and moment-ratio sensitivities: :func:`free_flow_stm` (exact, through
   the elements) and :func:`integrate_variational` (DOP853 with its variational equations);
+- the full two-body problem of a binary asteroid: :func:`make_binary_model` (the mutual potential's
+  model array) and :func:`propagate_binary` (relative orbit and both attitudes, DOP853);
 - the errors :class:`SpinorbitError`, :class:`SingularElementsError` and :class:`NonFiniteError`.
 
 They load on first use (PEP 562), so importing one integrator does not import the others.
@@ -43,6 +45,8 @@ _ENTRY_POINTS = {
     "propagate_averaged": "spinorbit.core.averaging.propagate",
     "free_flow_stm": "spinorbit.core.free_motion.stm",
     "integrate_variational": "spinorbit.core.integrators.variational",
+    "make_binary_model": "spinorbit.core.binary.equations",
+    "propagate_binary": "spinorbit.core.binary.propagate",
     "SpinorbitError": "spinorbit.core.errors",
     "SingularElementsError": "spinorbit.core.errors",
     "NonFiniteError": "spinorbit.core.errors",

@@ -2,12 +2,13 @@
 
 Sections written (``<!-- BEGIN name -->`` … ``<!-- END name -->`` of docs/cli.md): ``cli_apophis``
 (``spinorbit apophis`` at four spans, which agree after the encounter since the state belongs to its
-epoch), ``cli_toutatis_plan`` (a plan of ``spinorbit toutatis``) and ``cli_asteroid`` (``spinorbit asteroid`` with ``examples/asteroid_scene.toml``). The
+epoch), ``cli_toutatis_plan`` (a plan of ``spinorbit toutatis``), ``cli_asteroid`` (``spinorbit asteroid`` with
+``examples/asteroid_scene.toml``) and ``cli_didymos`` (``spinorbit didymos --impact``). The
 numbers in those sections come from this script only.
 
 Usage::
 
-    PYTHONPATH=$PWD python benchmarks/cli_examples.py            # ≈ 10 s
+    PYTHONPATH=$PWD python benchmarks/cli_examples.py            # ≈ 60 s
 """
 
 from __future__ import annotations
@@ -47,6 +48,7 @@ def main():
             apophis = [(span, printed(["apophis", "--span", span, "d"])) for span in ("4", "4.1", "6", "10")]
             asteroid = printed(["asteroid", "--scene", str(scene)])
             toutatis = printed(["toutatis", "--plan", "--span", "0.01", "d", "--tolerance", "100", "arcsec"])
+            didymos = printed(["didymos", "--impact"])
         finally:
             os.chdir(here)
     blocks = [machine_line(), "`PYTHONPATH=$PWD python benchmarks/cli_examples.py`:", ""]
@@ -59,6 +61,9 @@ def main():
     write_section("cli_toutatis_plan", "\n".join([
         machine_line(), "`PYTHONPATH=$PWD python benchmarks/cli_examples.py`:", "",
         f"```text\n$ spinorbit toutatis --plan --span 0.01 d --tolerance 100 arcsec\n{toutatis}\n```"]), page="cli.md")
+    write_section("cli_didymos", "\n".join([
+        machine_line(), "`PYTHONPATH=$PWD python benchmarks/cli_examples.py`:", "",
+        f"```text\n$ spinorbit didymos --impact\n{didymos}\n```"]), page="cli.md")
     print("\n".join(blocks))
     print(asteroid)
 

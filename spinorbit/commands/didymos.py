@@ -102,7 +102,8 @@ def _table(runs):
     import astropy.units as u
     from astropy.table import QTable
 
-    from spinorbit.core.binary.libration import COL_ENERGY_RATIO, COL_MODE, COL_S
+    from spinorbit.core.binary.equations import POSITION
+    from spinorbit.core.binary.libration import COL_ENERGY_RATIO, COL_LIBRATION, COL_MODE, COL_S
 
     table = QTable()
     for label, run in runs:
@@ -110,8 +111,8 @@ def _table(runs):
         prefix = "" if label == "nominal" else "impact_"
         if not prefix:
             table["time"] = run.times.to(u.h)
-        table[prefix + "separation"] = run.states[:, 0:3] * u.m
-        table[prefix + "libration"] = (rotation[:, 0] * u.rad).to(u.deg)
+        table[prefix + "separation"] = run.states[:, POSITION:POSITION + 3] * u.m
+        table[prefix + "libration"] = (rotation[:, COL_LIBRATION] * u.rad).to(u.deg)
         for j, name in enumerate(("S", "Z", "H", "s", "z", "h")):
             table[prefix + name] = rotation[:, COL_S + j]
         table[prefix + "mode"] = rotation[:, COL_MODE].astype(int)

@@ -212,7 +212,8 @@ def taylor_coefficients_into(t, model, s, n_pert, order, h_bound, orbit_tol, orb
                 s[b + _R2, k] = (_cauchy(s, b + _X, b + _X, k) + _cauchy(s, b + _X + 1, b + _X + 1, k)
                                  + _cauchy(s, b + _X + 2, b + _X + 2, k))
                 if k == 0:
-                    s[b + _S5, 0] = s[b + _R2, 0] ** -2.5
+                    r2 = s[b + _R2, 0]
+                    s[b + _S5, 0] = 1.0 / (r2 * r2 * math.sqrt(r2))  # |r|⁻⁵ without a power function
                 else:
                     s[b + _S5, k] = _power(s, b + _S5, b + _R2, -2.5, k)
                 if int(model[row]) == KIND_KEPLER and k < m:

@@ -39,6 +39,7 @@ def printed(argv):
 
 
 def main():
+    write = "--no-write" not in sys.argv[1:] and "--quick" not in sys.argv[1:]  # --quick: print only
     scene = ROOT / "examples" / "asteroid_scene.toml"
     with tempfile.TemporaryDirectory() as work:
         here = os.getcwd()
@@ -52,6 +53,10 @@ def main():
     blocks = [machine_line(), "`PYTHONPATH=$PWD python benchmarks/cli_examples.py`:", ""]
     for span, text in apophis:
         blocks += [f"```text\n$ spinorbit apophis --span {span} d\n{text}\n```", ""]
+    print("\n".join(blocks))
+    print(asteroid)
+    if not write:
+        return
     write_section("cli_apophis", "\n".join(blocks), page="cli.md")
     write_section("cli_asteroid", "\n".join([machine_line(), "`PYTHONPATH=$PWD python benchmarks/cli_examples.py`:", "",
                                              f"```text\n$ spinorbit asteroid --scene examples/asteroid_scene.toml\n"
@@ -59,8 +64,6 @@ def main():
     write_section("cli_toutatis_plan", "\n".join([
         machine_line(), "`PYTHONPATH=$PWD python benchmarks/cli_examples.py`:", "",
         f"```text\n$ spinorbit toutatis --plan --span 0.01 d --tolerance 100 arcsec\n{toutatis}\n```"]), page="cli.md")
-    print("\n".join(blocks))
-    print(asteroid)
 
 
 if __name__ == "__main__":

@@ -54,6 +54,7 @@ BENCHMARKS = (
     Benchmark("bench_coupling_routes.py"),
     Benchmark("toutatis_validation.py", quick=("--n-times", "50", "--no-write")),
     Benchmark("moon_validation.py"),
+    Benchmark("bench_coupled_outputs.py"),
     Benchmark("cli_examples.py"),
     Benchmark("bad_input.py", quick=("--no-write",)),
     Benchmark("bench_ensemble.py", quick=("--members", "4", "--no-write")),

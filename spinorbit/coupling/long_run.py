@@ -25,7 +25,7 @@ from spinorbit.coupling.rebound import ROTATION_STATE_SIZE, SimulationSnapshot, 
 from spinorbit.coupling.rigid_body import CoupledRigidBody
 from spinorbit.runs.checkpoint import Checkpoint, CheckpointSchedule, fingerprint
 
-__all__ = ["CHUNKED_RUN_KIND", "integrate_to_outputs", "coupled_run"]
+__all__ = ["CHUNKED_RUN_KIND", "OUTPUT_STEP_GROWTH", "integrate_to_outputs", "coupled_run", "reach_in_one_step"]
 
 #: ``kind`` of the checkpoints written by :func:`integrate_to_outputs`.
 CHUNKED_RUN_KIND = "coupled-run"

@@ -134,7 +134,11 @@ REGIONS = (
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--samples", type=int, default=300, help="random inputs per region (default 300)")
+    parser.add_argument("--no-write", action="store_true", help="print only, do not touch docs/elliptic.md")
+    parser.add_argument("--quick", action="store_true", help="5 inputs per region, print only (smoke run)")
     args = parser.parse_args(argv)
+    if args.quick:
+        args.samples, args.no_write = 5, True
     rng = np.random.default_rng(RNG_SEED)
     rows = []
     for function, region, kind, measure in REGIONS:
@@ -151,7 +155,9 @@ def main(argv=None):
         "|---|---|---|",
         *rows,
     ])
-    write_section("accuracy_elliptic", markdown, page="elliptic.md")
+    print(markdown)
+    if not args.no_write:
+        write_section("accuracy_elliptic", markdown, page="elliptic.md")
 
 
 if __name__ == "__main__":

@@ -45,7 +45,15 @@ HEYOKA_SPANS = (1e2, 1e3, 1e4)
 MP_SPANS = (1e2, 1e4, 1e6, 1e7)
 
 
+#: ``--quick`` (benchmarks/run_all.py's smoke run): the first case at the shortest span, print only.
+QUICK_SPANS = (1e2,)
+
+
 def main():
+    global CASES, HEYOKA_SPANS, MP_SPANS
+    quick = "--quick" in sys.argv[1:]
+    if quick:
+        CASES, HEYOKA_SPANS, MP_SPANS = CASES[:1], QUICK_SPANS, QUICK_SPANS
     lines = [
         "## Measured error growth (`benchmarks/accuracy_torque_free.py`)",
         "",
@@ -77,7 +85,8 @@ def main():
             lines.append(f"| {name} | {reference} | " + " | ".join(cells) + " |")
     markdown = "\n".join(lines)
     print(markdown)
-    write_section("accuracy_torque_free", markdown, page="torque_free.md")
+    if not quick and "--no-write" not in sys.argv[1:]:
+        write_section("accuracy_torque_free", markdown, page="torque_free.md")
 
 
 if __name__ == "__main__":

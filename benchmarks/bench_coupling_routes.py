@@ -4,8 +4,10 @@ Runs the Moon from DE421 at J2000 for one year both ways (same forces, same figu
 kernel), prints wall time, the attitude difference against DE421 and between the routes, and the
 Moon's position difference between the routes. Also the conservation of the IAS15 route on the
 artificial system of tests/test_coupling.py. Usage: python benchmarks/bench_coupling_routes.py
+(``--quick``: 10 days and one orbit of the artificial system, a smoke run). Prints only.
 """
 
+import sys
 import time
 
 import numpy as np
@@ -38,7 +40,15 @@ def ias15_moon(model):
     return sim, hooks
 
 
+#: ``--quick`` (benchmarks/run_all.py's smoke run): days of the Moon runs, orbits of the artificial system.
+QUICK_SPAN_DAYS, QUICK_ORBITS = 10.0, 1
+
+
 def main():
+    global YEAR
+    orbits = 10
+    if "--quick" in sys.argv[1:]:
+        YEAR, orbits = QUICK_SPAN_DAYS, QUICK_ORBITS
     for model in ("rigid", "core-corrected"):
         bs = moon_at_de421(model=model, full_field_perturbers=None)  # same field for every perturber
         start = time.perf_counter()
@@ -80,9 +90,9 @@ def main():
         return sim.energy() + kinetic_energy(y, figure) - u, orbital_l + inertial_angular_momentum(y, figure)
 
     e0, l0 = invariants()
-    sim.integrate(10 * 2 * np.pi * np.sqrt(27 / 1.3))
+    sim.integrate(orbits * 2 * np.pi * np.sqrt(27 / 1.3))
     e1, l1 = invariants()
-    print(f"IAS15 route, artificial system, 10 orbits: relative energy error {abs(e1 / e0 - 1):.1e}, "
+    print(f"IAS15 route, artificial system, {orbits} orbits: relative energy error {abs(e1 / e0 - 1):.1e}, "
           f"angular momentum {np.linalg.norm(l1 - l0) / np.linalg.norm(l0):.1e}")
 
 

@@ -155,7 +155,15 @@ def _ns(timing):
     return f"{timing.median:.0f} ({timing.min:.0f}–{timing.max:.0f})"
 
 
+#: ``--quick`` (benchmarks/run_all.py's smoke run): inputs and repeats, print only.
+QUICK_N, QUICK_REPEATS = 2_000, 2
+
+
 def main():
+    global N, REPEATS
+    quick = "--quick" in sys.argv[1:]
+    if quick:
+        N, REPEATS = QUICK_N, QUICK_REPEATS
     rng = np.random.default_rng(2024)
     u = rng.uniform(-50.0, 50.0, N)
     phi = rng.uniform(-1.5, 1.5, N)  # scipy's ellipkinc reduces φ too; keep both in one range
@@ -228,7 +236,7 @@ def main():
         "also returns NaN for m > 1 and loses accuracy near m = 1 (see `docs/elliptic.md`).",
     ])
     print(markdown)
-    if "--no-write" not in sys.argv[1:]:
+    if not quick and "--no-write" not in sys.argv[1:]:
         write_section("bench_elliptic", markdown)
 
 

@@ -127,8 +127,16 @@ def closed_form_section(write=True):
     return rows
 
 
+#: ``--quick`` (benchmarks/run_all.py's smoke run): (N_STATES, N_TIMES, SPAN_PERIODS, EXACT_REPEATS,
+#: N_STATES_HEYOKA), print only.
+QUICK_SIZES = (50, 100, 10.0, 2, 2)
+
+
 def main():
-    write = "--no-write" not in sys.argv[1:]
+    global N_STATES, N_TIMES, SPAN_PERIODS, EXACT_REPEATS, N_STATES_HEYOKA
+    write = "--no-write" not in sys.argv[1:] and "--quick" not in sys.argv[1:]
+    if "--quick" in sys.argv[1:]:
+        N_STATES, N_TIMES, SPAN_PERIODS, EXACT_REPEATS, N_STATES_HEYOKA = QUICK_SIZES
     if "--closed-form-only" in sys.argv[1:]:
         closed_form_section(write)
         return
@@ -159,8 +167,8 @@ def main():
          lambda: torque_free_states_many(quaternions, momenta, MOMENTS, times),
          lambda: torque_free_states_many(quaternions_many, momenta_many, MOMENTS, one_time)],
         EXACT_REPEATS, clock=time.process_time, warm_up=True)
-    rows.append(("spinorbit exact, 1 state × 1000 times", N_TIMES, one_state, error))
-    rows.append((f"spinorbit exact, {N_STATES} states × 1000 times", N_STATES * N_TIMES, many_states, error))
+    rows.append((f"spinorbit exact, 1 state × {N_TIMES} times", N_TIMES, one_state, error))
+    rows.append((f"spinorbit exact, {N_STATES} states × {N_TIMES} times", N_STATES * N_TIMES, many_states, error))
     rows.append((f"spinorbit exact, {many} states × 1 time", many, one_time_each, math.nan))
 
     # heyoka, double precision, Taylor, the package's equations in peers' formulation, its faster mode;
@@ -181,7 +189,7 @@ def main():
     out = run_heyoka()
     error = rotation_angle(q_ref, out[1:, :4]).max()
     mode = "compact" if compact_mode else "non-compact"
-    rows.append((f"heyoka double ({mode}), tol {HEYOKA_TOLERANCE:.1e}, 1 state × 1000 times",
+    rows.append((f"heyoka double ({mode}), tol {HEYOKA_TOLERANCE:.1e}, 1 state × {N_TIMES} times",
                  N_TIMES * N_STATES_HEYOKA, timed(run_heyoka, repeats=3), error))
 
     # scipy DOP853 on the package's right-hand side in plain Python, dense output on the same grid
@@ -193,7 +201,7 @@ def main():
 
     sol = run_scipy()
     error = rotation_angle(q_ref, sol.y[:4].T).max()
-    rows.append((f"scipy DOP853 (pure-Python RHS), rtol=atol={SCIPY_TOLERANCE:.1e}, 1 state × 1000 times",
+    rows.append((f"scipy DOP853 (pure-Python RHS), rtol=atol={SCIPY_TOLERANCE:.1e}, 1 state × {N_TIMES} times",
                  N_TIMES, timed(run_scipy, repeats=3), error))
 
     rates = [count / timing.median for _, count, timing, _ in rows]

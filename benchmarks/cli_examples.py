@@ -40,6 +40,7 @@ def printed(argv):
 
 
 def main():
+    write = "--no-write" not in sys.argv[1:] and "--quick" not in sys.argv[1:]  # --quick: print only
     scene = ROOT / "examples" / "asteroid_scene.toml"
     with tempfile.TemporaryDirectory() as work:
         here = os.getcwd()
@@ -48,12 +49,16 @@ def main():
             apophis = [(span, printed(["apophis", "--span", span, "d"])) for span in ("4", "4.1", "6", "10")]
             asteroid = printed(["asteroid", "--scene", str(scene)])
             toutatis = printed(["toutatis", "--plan", "--span", "0.01", "d", "--tolerance", "100", "arcsec"])
-            didymos = printed(["didymos", "--impact"])
+            didymos = printed(["didymos", "--impact"] + ([] if write else ["--orbits", "10"]))
         finally:
             os.chdir(here)
     blocks = [machine_line(), "`PYTHONPATH=$PWD python benchmarks/cli_examples.py`:", ""]
     for span, text in apophis:
         blocks += [f"```text\n$ spinorbit apophis --span {span} d\n{text}\n```", ""]
+    print("\n".join(blocks))
+    print(asteroid)
+    if not write:
+        return
     write_section("cli_apophis", "\n".join(blocks), page="cli.md")
     write_section("cli_asteroid", "\n".join([machine_line(), "`PYTHONPATH=$PWD python benchmarks/cli_examples.py`:", "",
                                              f"```text\n$ spinorbit asteroid --scene examples/asteroid_scene.toml\n"
@@ -64,8 +69,6 @@ def main():
     write_section("cli_didymos", "\n".join([
         machine_line(), "`PYTHONPATH=$PWD python benchmarks/cli_examples.py`:", "",
         f"```text\n$ spinorbit didymos --impact\n{didymos}\n```"]), page="cli.md")
-    print("\n".join(blocks))
-    print(asteroid)
 
 
 if __name__ == "__main__":

@@ -35,6 +35,8 @@ from spinorbit.coupling.moon import MOON_MODELS, compare_model_with_de421  # noq
 #: (years, output step in days): daily for a year, then coarser so the comparison stays cheap.
 SPANS = ((1, 1.0), (20, 5.0), (100, 10.0))
 YEAR_DAYS = 365.25
+#: ``--quick`` (benchmarks/run_all.py's smoke run): one month, daily.
+QUICK_SPANS = ((30 / YEAR_DAYS, 1.0),)
 #: Yang et al. 2017 (RAA 17, 127, abstract): the wobble's fitted amplitudes in DE430, arcsec. The
 #: kick here sets the size of the model's ellipse; its axis ratio is the model's own.
 YANG_WOBBLE_ARCSEC = (8.19, 3.31)
@@ -98,7 +100,12 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--no-write", action="store_true", help="print only, do not touch docs/validation.md")
     parser.add_argument("--only", choices=("spans", "free-modes"), help="one section only")
+    parser.add_argument("--quick", action="store_true", help="the spans table at 30 d only, print only (smoke run)")
     args = parser.parse_args(argv)
+    if args.quick:
+        global SPANS
+        SPANS = QUICK_SPANS
+        args.only, args.no_write = "spans", True
     sections = {"moon-spans": spans_section, "moon-free-modes": free_modes_section}
     for name, build in sections.items():
         if args.only is not None and not name.endswith(args.only):

@@ -261,3 +261,18 @@ def test_fixed_step_bad_input(kwargs, match):
     args.update(kwargs)
     with pytest.raises(ValueError, match=match):
         integrate_taylor_fixed_step(**args)
+
+
+def test_convergence_radius_is_the_smaller_of_the_two_estimates():
+    """The one-power shortcut gives min(n_prev^(−1/(p−1)), n_last^(−1/p)) whichever is smaller, inf for zero norms."""
+    from spinorbit.core.integrators.taylor import convergence_radius
+
+    rng = np.random.default_rng(18)
+    for _ in range(2000):
+        order = int(rng.integers(2, 40))
+        n_prev, n_last = 10.0 ** rng.uniform(-30, 5, size=2)
+        expected = min(n_prev ** (-1.0 / (order - 1)), n_last ** (-1.0 / order))
+        assert convergence_radius(n_prev, n_last, order) == pytest.approx(expected, rel=1e-14)
+    assert convergence_radius(0.0, 1e-8, 9) == 1e-8 ** (-1.0 / 9)
+    assert convergence_radius(1e-8, 0.0, 9) == 1e-8 ** (-1.0 / 8)
+    assert math.isinf(convergence_radius(0.0, 0.0, 9))

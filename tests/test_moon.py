@@ -263,3 +263,30 @@ def test_hundred_years_against_de421(model):
     assert comparison.max_difference_arcsec < HUNDRED_YEAR_BOUNDS_ARCSEC[model]
     # The table's angles stay on DE421's branch for a century (ψ has turned 1337 times).
     assert np.max(np.abs(comparison.angles_model - comparison.angles_de421)) < 1e-3
+
+
+#: BS tolerances 1e-12 … 1e-15 move the one-year difference by < 1e-4″ (module docstring): a step
+#: sequence that reaches each output in one step must agree with the cut one within that.
+STEP_SEQUENCE_SPREAD_ARCSEC = 1e-4
+
+
+def test_daily_outputs_take_one_bs_step_a_day(monkeypatch):
+    """REBOUND restores dt to the last full step after an output; without the growth of
+    ``long_run.reach_in_one_step`` every day took a full and a cut step (measured 2 per day)."""
+    import spinorbit.coupling.long_run as long_run
+
+    days = 30
+
+    def run():
+        moon = moon_at_de421(model="rigid")
+        start = moon.sim.steps_done
+        comparison = compare_with_de421(moon, days, step_days=1.0)
+        return moon.sim.steps_done - start, comparison
+
+    steps, comparison = run()
+    monkeypatch.setattr(long_run, "OUTPUT_STEP_GROWTH", 1.0)  # the former behaviour: no growth
+    steps_cut, comparison_cut = run()
+    assert steps_cut >= 2 * days - 2
+    assert steps <= days + 8  # the first day's steps from the 0.001-day starting step, then one a day
+    difference = np.abs(comparison.attitude_difference_arcsec - comparison_cut.attitude_difference_arcsec)
+    assert 0.0 < np.max(difference) < STEP_SEQUENCE_SPREAD_ARCSEC

@@ -1,0 +1,133 @@
+"""Every benchmark in one command: the published figures (full), or a smoke run of each (``--quick``).
+
+::
+
+    PYTHONPATH=$PWD python benchmarks/run_all.py            # regenerate every section of docs/
+    PYTHONPATH=$PWD python benchmarks/run_all.py --quick    # each script on small inputs, print only
+    PYTHONPATH=$PWD python benchmarks/run_all.py --quick --only bench_state_table.py
+
+Each script runs in its own process (``sys.executable``, ``PYTHONPATH`` = this checkout), one after
+the other, so a failure in one is reported and the others still run. The summary gives each script's
+wall time and exit status; the exit status is 1 if any failed. A quick run never writes docs/: each
+quick argument list makes its script print only (``tests/test_benchmarks.py`` checks that every
+script in benchmarks/ is listed here, and runs the quick mode).
+
+Two scripts compare this checkout with another revision and need it named: ``before_after.py``
+(``--base OLD_CHECKOUT``) runs in full mode only when ``--base`` is given here; ``bench_startup.py``
+measures this checkout alone unless ``--before REV`` is given. Their quick runs use this checkout as
+its own base.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+HERE = Path(__file__).resolve().parent
+
+
+@dataclass(frozen=True)
+class Benchmark:
+    """One script: its arguments for the published run and for the smoke run (which must not write)."""
+
+    script: str
+    full: tuple = ()
+    quick: tuple = ("--quick",)
+
+
+#: Every runnable script of benchmarks/, in the order they run (cheap ones first).
+BENCHMARKS = (
+    Benchmark("bench_state_table.py", quick=("--repeat", "1", "--no-write")),
+    Benchmark("bench_scene_skips.py", quick=("--repeat", "1", "--no-write")),
+    Benchmark("bench_rebound_forces.py", quick=("--no-write",)),
+    Benchmark("bench_elliptic.py"),
+    Benchmark("accuracy_elliptic.py"),
+    Benchmark("accuracy_symmetric_permanent.py", quick=("--no-write",)),
+    Benchmark("accuracy_torque_free.py"),
+    Benchmark("bench_torque_free.py"),
+    Benchmark("bench_coupling_routes.py"),
+    Benchmark("toutatis_validation.py", quick=("--n-times", "50", "--no-write")),
+    Benchmark("moon_validation.py"),
+    Benchmark("bench_coupled_outputs.py"),
+    Benchmark("cli_examples.py"),
+    Benchmark("bad_input.py", quick=("--no-write",)),
+    Benchmark("bench_ensemble.py", quick=("--members", "4", "--no-write")),
+    Benchmark("bench_averaged.py"),
+    Benchmark("stability.py"),
+    Benchmark("work_precision.py", full=("--averaged",)),
+    Benchmark("bench_startup.py", quick=("--repeat", "1", "--cold-repeat", "0", "--no-write")),
+    Benchmark("before_after.py", quick=("--base", str(ROOT), "--rounds", "1", "--repeat", "1", "--no-write")),
+)
+#: Modules of benchmarks/ that other scripts import and that measure nothing themselves.
+LIBRARY_MODULES = ("_report.py", "peers.py", "scenes.py", "chaotic.py", "run_all.py")
+
+
+def arguments(benchmark: Benchmark, quick: bool, base: str | None, before: str | None):
+    """The script's argument list for this mode, or None when it cannot run (with no revision to compare)."""
+    if quick:
+        return list(benchmark.quick)
+    if benchmark.script == "before_after.py":
+        return None if base is None else ["--base", base]
+    if benchmark.script == "bench_startup.py" and before is not None:
+        return ["--before", before]
+    return list(benchmark.full)
+
+
+def run(names=None, quick: bool = False, base: str | None = None, before: str | None = None, stream=sys.stdout):
+    """Run the chosen scripts; returns [(script, status or None if skipped, wall seconds)]."""
+    chosen = [b for b in BENCHMARKS if names is None or b.script in names]
+    unknown = set(names or ()) - {b.script for b in BENCHMARKS}
+    if unknown:
+        raise SystemExit(f"run_all: unknown benchmark(s) {sorted(unknown)}; expected some of "
+                         f"{[b.script for b in BENCHMARKS]}.")
+    environment = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    results = []
+    for benchmark in chosen:
+        argv = arguments(benchmark, quick, base, before)
+        if argv is None:
+            print(f"== {benchmark.script}: skipped (give --base OLD_CHECKOUT to compare with it)", file=stream,
+                  flush=True)
+            results.append((benchmark.script, None, 0.0))
+            continue
+        print(f"== {benchmark.script} {' '.join(argv)}", file=stream, flush=True)
+        begin = time.perf_counter()
+        status = subprocess.run([sys.executable, str(HERE / benchmark.script), *argv], cwd=ROOT,
+                                env=environment).returncode
+        results.append((benchmark.script, status, time.perf_counter() - begin))
+    return results
+
+
+def summary(results) -> str:
+    lines = ["| script | status | wall (s) |", "|---|---|---:|"]
+    for script, status, wall in results:
+        text = "skipped" if status is None else ("ok" if status == 0 else f"failed ({status})")
+        lines.append(f"| {script} | {text} | {wall:.1f} |")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="small inputs, print only (a smoke test)")
+    parser.add_argument("--only", nargs="+", metavar="SCRIPT", help="run only these scripts (file names)")
+    parser.add_argument("--base", help="old checkout for before_after.py (full mode)")
+    parser.add_argument("--before", help="git revision bench_startup.py also measures (full mode)")
+    parser.add_argument("--list", action="store_true", help="list the scripts and their arguments, run nothing")
+    args = parser.parse_args(argv)
+    if args.list:
+        for benchmark in BENCHMARKS:
+            argv_ = arguments(benchmark, args.quick, args.base, args.before)
+            print(benchmark.script, "(skipped)" if argv_ is None else " ".join(argv_))
+        return 0
+    results = run(args.only, args.quick, args.base, args.before)
+    print(summary(results))
+    return 1 if any(status not in (0, None) for _, status, _ in results) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

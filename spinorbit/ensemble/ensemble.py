@@ -8,7 +8,7 @@ samples of one orbit (:meth:`Scene.sharing_samples`), so the table is the same b
 executor ran it. A worker builds its members' Scenes itself: only ``make_scene`` (picklable: a
 module-level function) and the parameter rows travel. Members with no perturbers and no orbit are
 not shipped: their outcomes are constants of the free motion, taken per chunk in one vectorised
-call in this process (:func:`~spinorbit.ensemble.outcomes.torque_free_rows`).
+call in this process (:func:`~spinorbit.ensemble.free.torque_free_rows`).
 
 Completed chunks are checkpointed (:class:`~spinorbit.ensemble.store.ChunkStore`); a resumed run
 runs only the chunks without a file. A member that raises is recorded (index, parameters, exception
@@ -36,8 +36,8 @@ from spinorbit.ensemble.outcomes import (
     TIMED_COLUMNS,
     days_of,
     outcome_row,
-    torque_free_rows,
 )
+from spinorbit.ensemble.free import torque_free_rows
 from spinorbit.ensemble.samplers import SEED_COLUMNS, sample_parameters
 from spinorbit.ensemble.store import ChunkStore
 

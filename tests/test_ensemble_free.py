@@ -116,3 +116,23 @@ def test_bad_members_are_refused_with_the_reason():
         free_members_table(moments, quaternions, omegas[:1], 1.0)
     with pytest.raises(EnsembleError, match="finite"):
         free_members_table(moments, quaternions, omegas, [1.0, np.nan])
+    with pytest.raises(EnsembleError, match="beyond the free flow's domain"):
+        free_members_table(moments, quaternions, omegas, 1e16, attitudes=True)
+
+
+def _permuted_member(phase):
+    """A body whose axes are not its principal axes in increasing order (C, A, B along x, y, z)."""
+    body = RigidBody([1.0, 0.61, 0.965])
+    return Scene(state_at_phase(RotationState(body, [1.0, 0.0, 0.0, 0.0], [2.0, 0.3, 0.1]), phase), EPOCH,
+                 EPOCH + 2.0 * u.day)
+
+
+def test_a_body_off_its_principal_order_is_turned_to_it_and_agrees_with_its_scene():
+    table = Ensemble(_permuted_member, [dict(phase=p) for p in (0.0, 0.3, 0.7)]).run(executor="serial")
+    for i, phase in enumerate((0.0, 0.3, 0.7)):
+        alone = _permuted_member(phase).run().table
+        assert table["mode"][i] == alone["mode"][-1] == "SAM"
+        for name in ("energy_ratio", "P_psi", "P_phi", "sidereal_period"):
+            assert u.Quantity(table[name][i]).value == pytest.approx(u.Quantity(alone[name][-1]).value, rel=1e-13)
+        for name in ("pole_ra", "pole_dec", "pole_lon", "pole_lat"):
+            assert table[name][i].to_value(u.deg) == pytest.approx(alone[name][-1].to_value(u.deg), abs=1e-10)

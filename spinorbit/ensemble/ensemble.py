@@ -137,6 +137,17 @@ def torque_free(scene):
     return not scene.named and not scene.fixed and not scene.moving and scene.orbit is None
 
 
+def free_rows(free, at_days, rows, failures):
+    """Add to ``rows`` the outcome rows of torque-free members ``free`` [(index, Scene, parameters)] (one
+    vectorised call), or to ``failures`` a record for each of them if that call raises."""
+    if not free:
+        return
+    try:
+        rows.update(zip((i for i, _, _ in free), torque_free_rows([s for _, s, _ in free], at_days)))
+    except Exception as error:  # noqa: BLE001 — recorded like a worker's failure
+        failures.update({i: failure_record(i, p, error) for i, _, p in free})
+
+
 def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None):
     """Run one chunk of members in this process (what a worker does): (rows, failures, tables).
 
@@ -170,11 +181,7 @@ def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None)
                 tables[index] = result.table
         except Exception as error:  # noqa: BLE001 — a member's failure is recorded, the chunk goes on
             failures[index] = failure_record(index, parameters, error)
-    if free:
-        try:
-            rows.update(zip((i for i, _, _ in free), torque_free_rows([s for _, s, _ in free], at_days)))
-        except Exception as error:  # noqa: BLE001
-            failures.update({i: failure_record(i, p, error) for i, _, p in free})
+    free_rows(free, at_days, rows, failures)
     return rows, failures, tables
 
 
@@ -306,11 +313,7 @@ class Ensemble:
             else:
                 shipped.append((index, parameters))
                 scenes[index] = scene
-        if free:
-            try:
-                rows.update(zip((i for i, _, _ in free), torque_free_rows([s for _, s, _ in free], self.at_days)))
-            except Exception as error:  # noqa: BLE001
-                failures.update({i: failure_record(i, p, error) for i, _, p in free})
+        free_rows(free, self.at_days, rows, failures)
         return rows, failures, shipped, scenes
 
     def _first_is_torque_free(self, chunk):
@@ -372,7 +375,8 @@ class Ensemble:
         with open_executor(executor) as (pool, description):
             # On an executor, the members are built where they run (once each), unless the first member is
             # torque-free: then the members are built here to keep the torque-free ones here (not shipped).
-            classify_here = pool is None or (bool(pending) and not keep_tables and self._first_is_torque_free(pending[0]))
+            classify_here = pool is None or (bool(pending) and not keep_tables
+                                             and self._first_is_torque_free(pending[0]))
             partial, futures = {}, {}
             for chunk in pending:
                 members = self.chunk_members(chunk)

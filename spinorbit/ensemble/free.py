@@ -31,7 +31,7 @@ from spinorbit.core.math.rotations import attitude_to_quat
 from spinorbit.ensemble.errors import EnsembleError
 from spinorbit.ensemble.outcomes import OUTCOME_UNITS, TIMED_COLUMNS, time_rows
 from spinorbit.pole import angle_between_deg, pole_angles_deg
-from spinorbit.state import MODE_NAMES
+from spinorbit.state import MAX_FLOW_PHASE, MODE_NAMES
 from spinorbit.state_table import QUATERNION_COLUMNS
 
 __all__ = ["FREE_TIMED_COLUMNS", "free_members_table", "free_outcome_columns", "free_table_columns",
@@ -184,6 +184,13 @@ def free_members_table(moments, quaternions, angular_velocities, elapsed, parame
     days = np.broadcast_to(np.atleast_1d(days), (n, np.atleast_1d(days).shape[-1])) if np.ndim(days) < 2 else days
     if days.shape[0] != n or not np.all(np.isfinite(days)):
         raise EnsembleError(f"elapsed expects finite times of shape (), (K,) or ({n}, K); got {np.shape(days)}.")
+    if attitudes:  # the flow's domain, as RotationState.propagate_torque_free checks it
+        phase = np.sqrt(np.sum(momenta * momenta, axis=1)) / inertia[:, 0] * np.max(np.abs(days), axis=1)
+        if not np.all(phase <= MAX_FLOW_PHASE):
+            bad = int(np.argmax(phase))
+            raise EnsembleError(f"elapsed: member {bad}'s fastest angle turns by {phase[bad]:.3g} rad > "
+                                f"{MAX_FLOW_PHASE:g} rad by its last time, beyond the free flow's domain (one ulp of the "
+                                "time moves the attitude by more than 0.1 rad there); shorten the times.")
     columns = free_outcome_columns(q, momenta, inertia, np.ascontiguousarray(days), attitudes)
     table = QTable() if parameters is None else parameters.copy()
     if len(table) not in (0, n):

@@ -43,7 +43,11 @@ def pole_angles_deg(directions):
     """
     unit = _unit_rows(directions, "the pole")
     ra, dec = _lon_lat_deg(unit)
-    lon, lat = _lon_lat_deg(unit @ icrf_to_ecliptic_matrix().T)
+    # the rotation written out (no BLAS product): a row's angles do not depend on the rows beside it
+    m = icrf_to_ecliptic_matrix()
+    x, y, z = unit[:, 0], unit[:, 1], unit[:, 2]
+    ecliptic = np.stack([m[j, 0] * x + m[j, 1] * y + m[j, 2] * z for j in range(3)], axis=1)
+    lon, lat = _lon_lat_deg(ecliptic)
     return ra, dec, lon, lat
 
 

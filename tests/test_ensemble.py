@@ -19,7 +19,8 @@ from spinorbit.ensemble import member_seed, sample_parameters
 from spinorbit.ensemble import state_at_phase
 from spinorbit.ensemble.store import ChunkStore
 from spinorbit.runs.checkpoint import CheckpointError
-from spinorbit.scene import FixedPerturber
+from spinorbit.ensemble.ensemble import clear_process_samplings
+from spinorbit.scene import EphemerisPerturber, FixedPerturber
 
 BODY = RigidBody([0.61, 0.965, 1.0])
 EPOCH = Time("2029-04-08T00:00:00", scale="tdb")
@@ -295,3 +296,39 @@ def test_the_embedded_dask_cluster_gives_the_serial_bits(serial):
     embedded = Ensemble(member, phases(), chunk_size=CHUNK)
     assert_same_bits(serial, embedded.run(executor="dask"))
     assert "embedded Dask LocalCluster" in embedded.last_run["executor"]
+
+
+def _earth_states(days):
+    """An Earth-mass point circling the body at 40 000 km in 1 day (relative ICRF states, au and au/day)."""
+    SAMPLED_DAYS.append(np.size(days))
+    radius, rate = (40000.0 * u.km).to_value(u.au), 2.0 * np.pi
+    angle = rate * (np.asarray(days, dtype=float) - 10690.0)
+    positions = radius * np.stack([np.cos(angle), np.sin(angle), 0.0 * angle], axis=1)
+    velocities = radius * rate * np.stack([-np.sin(angle), np.cos(angle), 0.0 * angle], axis=1)
+    return positions, velocities
+
+
+SAMPLED_DAYS = []
+MOVING_EARTH = EphemerisPerturber("earth", EARTH_GM, _earth_states, relative=True)
+
+
+def moving_member(phase):
+    state = state_at_phase(RotationState(BODY, [1.0, 0.0, 0.0, 0.0], [0.3, 0.1, 2.0]), phase)
+    return Scene(state, EPOCH, END, perturbers=(MOVING_EARTH,))
+
+
+def test_a_process_samples_a_shared_orbit_once_across_chunks_with_the_bits_of_a_fresh_sampling():
+    clear_process_samplings()
+    SAMPLED_DAYS.clear()
+    calls_after_chunk = []
+    ensemble = Ensemble(moving_member, [dict(phase=p) for p in np.linspace(0.0, 0.875, 8)], chunk_size=2)
+    table = ensemble.run(executor="serial", progress=lambda done, total: calls_after_chunk.append(len(SAMPLED_DAYS)))
+    assert set(table["route"]) == {"one-way"} and not any(table["error"])
+    # the first chunk samples the orbit; the three others reuse it (before: each chunk sampled again)
+    assert calls_after_chunk[1] > 0 and calls_after_chunk[1:] == [calls_after_chunk[1]] * 4
+    for i in (0, 5):  # each member alone samples afresh: the same bits
+        alone = moving_member(float(table["phase"][i])).run()
+        assert table["P_psi"][i] == alone.table["P_psi"][-1] and table["pole_ra"][i] == alone.table["pole_ra"][-1]
+    with concurrent.futures.ProcessPoolExecutor(max_workers=2) as pool:
+        pooled = Ensemble(moving_member, [dict(phase=p) for p in np.linspace(0.0, 0.875, 8)], chunk_size=2)
+        assert_same_bits(table, pooled.run(executor=pool))

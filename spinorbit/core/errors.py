@@ -26,6 +26,8 @@ class WorkLimitError(SpinorbitError, ValueError):
 
 def require_finite(name, values, expected="finite numbers"):
     """Raise :class:`NonFiniteError` naming ``name`` if any of ``values`` (a number or a sequence) is NaN/inf."""
+    if getattr(getattr(values, "dtype", None), "kind", "") == "f" and math.isfinite(values.sum()):
+        return  # a finite sum has no NaN or inf in it: the common case at array speed (sampled orbits)
     flat = values.ravel().tolist() if hasattr(values, "ravel") else values
     items = flat if isinstance(flat, (list, tuple)) else [flat]
     try:

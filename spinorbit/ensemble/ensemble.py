@@ -6,9 +6,12 @@ whose size depends on the ensemble alone (its member count, or ``chunk_size``), 
 executor or the number of workers; a chunk runs in one process, its members sharing the perturber
 samples of one orbit (:meth:`Scene.sharing_samples`), so the table is the same bits whichever
 executor ran it. A worker builds its members' Scenes itself: only ``make_scene`` (picklable: a
-module-level function) and the parameter rows travel. Members with no perturbers and no orbit are
-not shipped: their outcomes are constants of the free motion, taken per chunk in one vectorised
-call in this process (:func:`~spinorbit.ensemble.outcomes.torque_free_rows`).
+module-level function) and the parameter rows travel, and each member is built once, where it
+runs; a worker keeps its samplings of an orbit across the chunks it runs (exact requests only, so
+the numbers do not depend on which chunks it ran). Members with no perturbers and no orbit need no
+integration: their outcomes come from one vectorised call per chunk
+(:func:`~spinorbit.ensemble.free.torque_free_rows`), in this process when the first member is
+torque-free (then they are not shipped).
 
 Completed chunks are checkpointed (:class:`~spinorbit.ensemble.store.ChunkStore`); a resumed run
 runs only the chunks without a file. A member that raises is recorded (index, parameters, exception
@@ -36,12 +39,12 @@ from spinorbit.ensemble.outcomes import (
     TIMED_COLUMNS,
     days_of,
     outcome_row,
-    torque_free_rows,
 )
+from spinorbit.ensemble.free import torque_free_rows
 from spinorbit.ensemble.samplers import SEED_COLUMNS, sample_parameters
 from spinorbit.ensemble.store import ChunkStore
 
-__all__ = ["Ensemble", "EnsembleError", "EnsembleInterrupted", "run_chunk"]
+__all__ = ["Ensemble", "EnsembleError", "EnsembleInterrupted", "clear_process_samplings", "run_chunk", "torque_free"]
 
 #: Most members in a default chunk; the default is ceil(n / 32) up to this (chunks few enough to
 #: spread over many workers, large enough that a chunk's shared sampling pays).
@@ -106,20 +109,71 @@ def _sharing_key(scene):
             tuple(id(p) for p in scene.moving), scene.sample_tolerance)
 
 
-def run_chunk(make_scene, members, at_days=None, keep_tables=False):
+#: Most sharing keys whose samplings a worker process keeps across chunks (an ensemble has one or a few).
+MEMO_KEYS = 8
+#: {sharing key: (orbit, moving perturbers, memo)}: this process's samplings, kept across chunks. The
+#: orbit and ephemerides are held, so the ids in the key stay theirs while the entry lives.
+_PROCESS_SAMPLINGS = {}
+
+
+def clear_process_samplings():
+    """Forget the samplings this process keeps across chunks (e.g. after changing an orbit in place)."""
+    _PROCESS_SAMPLINGS.clear()
+
+
+def _process_memo(scene):
+    """The memo of this process's samplings for the scene's orbit, span and ephemerides (SharedSamples(memo))."""
+    key = _sharing_key(scene)
+    entry = _PROCESS_SAMPLINGS.get(key)
+    if entry is None or entry[0] is not scene.orbit:
+        if len(_PROCESS_SAMPLINGS) >= MEMO_KEYS:
+            _PROCESS_SAMPLINGS.pop(next(iter(_PROCESS_SAMPLINGS)))
+        entry = _PROCESS_SAMPLINGS[key] = (scene.orbit, tuple(scene.moving), {})
+    return entry[2]
+
+
+def torque_free(scene):
+    """The member needs no integration: no perturbers and no orbit."""
+    return not scene.named and not scene.fixed and not scene.moving and scene.orbit is None
+
+
+def free_rows(free, at_days, rows, failures):
+    """Add to ``rows`` the outcome rows of torque-free members ``free`` [(index, Scene, parameters)] (one
+    vectorised call), or to ``failures`` a record for each of them if that call raises."""
+    if not free:
+        return
+    try:
+        rows.update(zip((i for i, _, _ in free), torque_free_rows([s for _, s, _ in free], at_days)))
+    except Exception as error:  # noqa: BLE001 — recorded like a worker's failure
+        failures.update({i: failure_record(i, p, error) for i, _, p in free})
+
+
+def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None):
     """Run one chunk of members in this process (what a worker does): (rows, failures, tables).
 
-    ``members`` is a list of (index, parameter dict); rows and failures are dicts by index, tables
-    the members' result tables when ``keep_tables``.
+    ``members`` is a list of (index, parameter dict); ``scenes`` optionally ``{index: Scene}`` of
+    members already built in this process (each member is built once, where it runs). Rows and
+    failures are dicts by index, tables the members' result tables when ``keep_tables``.
+
+    Members of one orbit, span and ephemerides share their perturber samples: within the chunk
+    (:meth:`Scene.sharing_samples`), and across the chunks this process runs through an exact-request
+    memo (:class:`~spinorbit.scene.sampling.SharedSamples`), so a worker samples the orbit once, and
+    every chunk's numbers are those it gives alone. Torque-free members (unless ``keep_tables``) take
+    one vectorised call for the chunk (:func:`~spinorbit.ensemble.free.torque_free_rows`; the same
+    bits in any process or batch).
     """
     from spinorbit.scene.sampling import SharedSamples
 
-    rows, failures, tables, shared = {}, {}, {}, {}
+    rows, failures, tables, shared, free = {}, {}, {}, {}, []
+    scenes = scenes or {}
     for index, parameters in members:
         try:
-            scene = build_member(make_scene, parameters)
+            scene = scenes[index] if index in scenes else build_member(make_scene, parameters)
+            if not keep_tables and torque_free(scene):
+                free.append((index, scene, parameters))
+                continue
             # the scene stays referenced with its samples, so an id() in the key is never reused in the chunk
-            _, samples = shared.setdefault(_sharing_key(scene), (scene, SharedSamples()))
+            _, samples = shared.setdefault(_sharing_key(scene), (scene, SharedSamples(_process_memo(scene))))
             with scene.sharing_samples(samples):
                 result = scene.run()
             rows[index] = outcome_row(scene, result, at_days)
@@ -127,11 +181,8 @@ def run_chunk(make_scene, members, at_days=None, keep_tables=False):
                 tables[index] = result.table
         except Exception as error:  # noqa: BLE001 — a member's failure is recorded, the chunk goes on
             failures[index] = failure_record(index, parameters, error)
+    free_rows(free, at_days, rows, failures)
     return rows, failures, tables
-
-
-def _torque_free(scene):
-    return not scene.named and not scene.fixed and not scene.moving and scene.orbit is None
 
 
 class Ensemble:
@@ -143,8 +194,10 @@ class Ensemble:
         ``make_scene(**parameters) -> Scene`` (one body). A module-level function, so that worker
         processes can import it; an expensive orbit it needs should be cached in its module
         (e.g. ``functools.cache``), so each process builds it once and members share its samples.
-        It is also called once per member in this process, to find the torque-free members, which
-        are not shipped (so this process builds the cached orbit once too).
+        Each member is built once, where its chunk runs. On an executor, this process builds the
+        first member too, to see whether the members are torque-free; if it is, every member is
+        built here, and the torque-free ones are not shipped (so this process may build the cached
+        orbit once too).
     parameters : QTable or list of dict
         One row per member; the columns are make_scene's keyword arguments (except the seed columns
         ``seed_entropy`` and ``seed_spawn_key`` of :func:`~spinorbit.ensemble.samplers.sample_parameters`,
@@ -240,8 +293,14 @@ class Ensemble:
         return restored
 
     def _split(self, members):
-        """(in-process rows, in-process failures, members to ship) of a list of member indices."""
-        local, rows, failures, shipped = [], {}, {}, []
+        """(in-process rows, in-process failures, members to run, their Scenes) of a list of member indices.
+
+        Every member is built here; the torque-free ones are evaluated at once (one vectorised call),
+        the others are returned as (index, parameters) with their Scenes ``{index: Scene}`` (used when
+        they run in this process, so that no member is built twice here).
+        """
+        rows, failures, shipped, scenes = {}, {}, [], {}
+        free = []
         for index in members:
             parameters = self.member_parameters(index)
             try:
@@ -249,14 +308,20 @@ class Ensemble:
             except Exception as error:  # noqa: BLE001 — recorded like a worker's failure
                 failures[index] = failure_record(index, parameters, error)
                 continue
-            (local if _torque_free(scene) else shipped).append((index, scene, parameters))
-        if local:
-            try:
-                for (index, _, _), row in zip(local, torque_free_rows([s for _, s, _ in local], self.at_days)):
-                    rows[index] = row
-            except Exception as error:  # noqa: BLE001
-                failures.update({i: failure_record(i, p, error) for i, _, p in local})
-        return rows, failures, [(index, parameters) for index, _, parameters in shipped]
+            if torque_free(scene):
+                free.append((index, scene, parameters))
+            else:
+                shipped.append((index, parameters))
+                scenes[index] = scene
+        free_rows(free, self.at_days, rows, failures)
+        return rows, failures, shipped, scenes
+
+    def _first_is_torque_free(self, chunk):
+        """Whether the chunk's first member is torque-free (built here once to see; a failure counts as no)."""
+        try:
+            return torque_free(build_member(self.make_scene, self.member_parameters(self.chunk_members(chunk)[0])))
+        except Exception:  # noqa: BLE001 — the member's failure is recorded where it runs
+            return False
 
     def run(self, executor=None, checkpoint=None, progress=None, keep_tables=False):
         """Run every member not yet done (none restored from ``checkpoint``) and return the outcome table.
@@ -308,35 +373,35 @@ class Ensemble:
 
         lost = {}
         with open_executor(executor) as (pool, description):
-            partial, shipped = {}, {}
+            # On an executor, the members are built where they run (once each), unless the first member is
+            # torque-free: then the members are built here to keep the torque-free ones here (not shipped).
+            classify_here = pool is None or (bool(pending) and not keep_tables
+                                             and self._first_is_torque_free(pending[0]))
+            partial, futures = {}, {}
             for chunk in pending:
                 members = self.chunk_members(chunk)
-                if keep_tables:
-                    rows, failures, ship = {}, {}, [(i, self.member_parameters(i)) for i in members]
+                if keep_tables or not classify_here:
+                    rows, failures, ship, scenes = {}, {}, [(i, self.member_parameters(i)) for i in members], {}
                 else:
-                    rows, failures, ship = self._split(members)
+                    rows, failures, ship, scenes = self._split(members)
                 stats["members_in_process"] += len(members) - len(ship)
                 stats["members_run"] += len(members)
-                partial[chunk] = (rows, failures)
-                if ship:
-                    shipped[chunk] = ship
-                else:
+                if not ship:
                     finish(chunk, rows, failures, {})
-            if pool is None:
-                for chunk, ship in shipped.items():
-                    rows, failures, tables = run_chunk(self.make_scene, ship, self.at_days, keep_tables)
-                    finish(chunk, {**partial[chunk][0], **rows}, {**partial[chunk][1], **failures}, tables)
-            else:
-                futures = {pool.submit(run_chunk, self.make_scene, ship, self.at_days, keep_tables): chunk
-                           for chunk, ship in shipped.items()}
-                for future in concurrent.futures.as_completed(futures):
-                    chunk = futures[future]
-                    try:
-                        rows, failures, tables = future.result()
-                    except Exception as error:  # noqa: BLE001 — the executor lost it: kept for the message
-                        lost[chunk] = error
-                        continue
-                    finish(chunk, {**partial[chunk][0], **rows}, {**partial[chunk][1], **failures}, tables)
+                elif pool is None:
+                    more_rows, more_failures, tables = run_chunk(self.make_scene, ship, self.at_days, keep_tables, scenes)
+                    finish(chunk, {**rows, **more_rows}, {**failures, **more_failures}, tables)
+                else:  # submitted at once: the workers start while the next chunks are prepared
+                    partial[chunk] = (rows, failures)
+                    futures[pool.submit(run_chunk, self.make_scene, ship, self.at_days, keep_tables)] = chunk
+            for future in concurrent.futures.as_completed(futures):
+                chunk = futures[future]
+                try:
+                    rows, failures, tables = future.result()
+                except Exception as error:  # noqa: BLE001 — the executor lost it: kept for the message
+                    lost[chunk] = error
+                    continue
+                finish(chunk, {**partial[chunk][0], **rows}, {**partial[chunk][1], **failures}, tables)
         stats.update(wall_seconds=_time.perf_counter() - clock, executor=description)
         self.last_run = stats
         if lost:
@@ -369,10 +434,11 @@ class Ensemble:
         results = []
         with open_executor(executor) as (pool, description):
             for index in indices:  # each alone, by the same path as in run(): torque-free ones in this process
-                rows, failures, ship = self._split([index])
+                rows, failures, ship, scenes = self._split([index])
                 if ship:
                     job = (pool.submit(run_chunk, self.make_scene, ship, self.at_days) if pool is not None else None)
-                    rows, failures, _ = job.result() if job is not None else run_chunk(self.make_scene, ship, self.at_days)
+                    rows, failures, _ = (job.result() if job is not None else
+                                         run_chunk(self.make_scene, ship, self.at_days, scenes=scenes))
                 results.append((rows, failures, {}))
         for index, (rows, failures, _) in zip(indices, results):
             self._rows.pop(index, None)

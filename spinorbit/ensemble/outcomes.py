@@ -11,11 +11,8 @@ With named times every time-dependent column is suffixed ``_t0``, ``_t1``, …
 A row is a dict of plain floats, strings and booleans (units in :data:`OUTCOME_UNITS`), so that a
 chunk's rows cross process boundaries and checkpoints as numbers, bit for bit.
 
-Torque-free members (no perturbers, no orbit) need no integration: mode, E/E0, the periods and the
-pole are constants of the motion, so :func:`torque_free_rows` takes them for all such members of
-one body at once from their initial states (:func:`spinorbit.state_table.table_columns`, one
-compiled loop), in place of the Scene's propagation (whose end pole differs from the initial one by
-the rounding of the propagated momentum only; ``tests/test_ensemble.py``).
+Torque-free members (no perturbers, no orbit) need no integration: their rows come from the exact
+free flow in one vectorised call (:mod:`spinorbit.ensemble.free`), in place of the Scene's run.
 """
 
 from __future__ import annotations
@@ -25,10 +22,10 @@ from astropy import units as u
 
 from spinorbit.ensemble.errors import EnsembleError
 from spinorbit.pole import angle_between_deg, directions_from_ra_dec_deg
-from spinorbit.state_table import MOTION_COLUMNS, POLE_COLUMNS, table_columns
+from spinorbit.state_table import MOTION_COLUMNS, POLE_COLUMNS
 from spinorbit.time import tdb_days
 
-__all__ = ["OUTCOME_UNITS", "TIMED_COLUMNS", "outcome_row", "time_rows", "torque_free_rows"]
+__all__ = ["OUTCOME_UNITS", "TIMED_COLUMNS", "days_of", "outcome_row", "time_rows"]
 
 #: Columns that depend on the time of the outcome, in order.
 TIMED_COLUMNS = (*MOTION_COLUMNS, *POLE_COLUMNS, "obliquity", "pole_shift")
@@ -89,42 +86,6 @@ def outcome_row(scene, result, at=None):
     row.update(error_estimate=float(result.error_estimate.to_value(u.arcsec)), tolerance_met=bool(result.tolerance_met),
                route=str(result.plan.route))
     return row
-
-
-def torque_free_rows(scenes, at=None):
-    """Outcome rows of torque-free single-body members without orbits, one vectorised call per body.
-
-    Returns a list of dicts in the order of ``scenes``.
-    """
-    groups = {}
-    for position, scene in enumerate(scenes):
-        body = scene.state.body
-        key = (body.moment_values.tobytes(), body.to_principal.tobytes())
-        groups.setdefault(key, []).append(position)
-    rows = [None] * len(scenes)
-    for positions in groups.values():
-        body = scenes[positions[0]].state.body
-        quaternions = np.array([scenes[p].state.quaternion for p in positions])
-        # angular_velocity is in rad/day by construction: .value skips a unit conversion per member
-        omegas = np.array([scenes[p].state.angular_velocity.value for p in positions])
-        columns = table_columns(body, quaternions, omegas, omega=False, motion="rows")
-        plain = {name: (np.asarray(value) if name == "mode" else
-                        u.Quantity(value).to_value(OUTCOME_UNITS[name]) if name in OUTCOME_UNITS else np.asarray(value))
-                 for name, value in columns.items() if name in TIMED_COLUMNS}
-        timed = at is not None
-        for j, p in enumerate(positions):
-            values = {name: (str(plain[name][j]) if name == "mode" else float(plain[name][j]))
-                      for name in TIMED_COLUMNS[:-2]}
-            values["pole_shift"] = 0.0  # the angular momentum is fixed in free rotation
-            row = {}
-            for k in range(len(time_rows(scenes[p], at)) if timed else 1):
-                row.update({_suffix(name, k, timed): value for name, value in values.items()})
-            # constants of the motion: the initial values are the same numbers
-            row.update(P_psi_initial=values["P_psi"], P_phi_initial=values["P_phi"],
-                       sidereal_period_initial=values["sidereal_period"], energy_ratio_initial=values["energy_ratio"],
-                       error_estimate=0.0, tolerance_met=True, route="torque-free")
-            rows[p] = row
-    return rows
 
 
 def days_of(times):

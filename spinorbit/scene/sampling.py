@@ -87,21 +87,35 @@ def subset_samples(samples, names):
 
 
 class SharedSamples:
-    """Samples already taken, by (source, tolerance): a request for some of their perturbers reuses them."""
+    """Samples already taken, by (source, tolerance): a request for some of their perturbers reuses them.
 
-    def __init__(self):
+    ``memo`` (optional, a dict the caller keeps across several SharedSamples of scenes with the same
+    orbit, span and ephemerides) answers a request it holds *exactly* (same source, tolerance and
+    names in the same order) and is given every new sampling. A sampling is a pure function of that
+    request, so a hit there is the bits a fresh sampling would give: what a SharedSamples returns
+    does not depend on what the memo saw before (the ensemble's chunks share one sampling per worker
+    process this way, and the table does not depend on which worker ran which chunk).
+    """
+
+    def __init__(self, memo=None):
         self._taken = []
+        self._memo = memo
 
     def find(self, source, names, tolerance):
         """The samples of ``names`` from ``source`` at ``tolerance`` if taken already (their columns), else None."""
         for taken_source, taken_tolerance, taken in self._taken:
             if taken_source == source and taken_tolerance == tolerance and set(names) <= set(taken.names):
                 return taken if tuple(names) == taken.names else subset_samples(taken, names)
-        return None
+        remembered = None if self._memo is None else self._memo.get((source, tolerance, tuple(names)))
+        if remembered is not None:
+            self._taken.append((source, tolerance, remembered))
+        return remembered
 
     def add(self, source, tolerance, samples):
-        """Keep ``samples`` for later requests."""
+        """Keep ``samples`` for later requests (and in the memo, by the exact request)."""
         self._taken.append((source, tolerance, samples))
+        if self._memo is not None:
+            self._memo[(source, tolerance, tuple(samples.names))] = samples
 
 
 class NoSamples:

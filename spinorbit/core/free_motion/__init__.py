@@ -5,5 +5,6 @@
 - :mod:`.flow` — the free flow of any triaxial body in every mode (eq. 12: one angle linear in time),
   evaluated at each time and looped over states and times;
 - :mod:`.regular_precession` — axisymmetric bodies in closed form;
-- :mod:`.summary` — mode, sense, periods and energy ratio of a free motion.
+- :mod:`.summary` — mode, sense, periods and energy ratio of a free motion;
+- :mod:`.members` — many members at once, each with its own moments and times (ensembles).
 """

@@ -74,7 +74,7 @@ def dask_client():
 
     # a task on a worker that dies fails at once (KilledWorker) instead of being retried: the resume test
     with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
-        cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
+        cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0")
         client = distributed.Client(cluster)
         try:
             yield client

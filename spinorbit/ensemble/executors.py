@@ -8,7 +8,7 @@ into a :class:`concurrent.futures.Executor` (or None: in this process) for the l
 - ``"serial"``: in this process;
 - an ``int`` K: a ``ProcessPoolExecutor`` of K workers;
 - ``"dask"``: an embedded ``dask.distributed.LocalCluster(processes=True)`` (one single-threaded
-  worker per core, no dashboard) and its ``Client``, closed after the run;
+  worker per core, its dashboard on a free port) and its ``Client``, closed after the run;
 - a ``dask.distributed.Client`` (e.g. one connected to a scheduler address, or to a dask-jobqueue
   cluster), through :class:`DaskExecutor`;
 - any other ``concurrent.futures.Executor`` (e.g. mpi4py's ``MPIPoolExecutor``): used as it is.
@@ -87,8 +87,10 @@ def dask_client(address=None, workers=None):
                             "pip install 'spinorbit[distributed]'") from None
     if address is not None:
         return Client(address)
+    # The scheduler's HTTP server starts whatever dashboard_address says; None means the default port
+    # 8787, which another cluster on the machine may hold (then the start fails). ':0' takes a free one.
     cluster = LocalCluster(n_workers=workers or available_cores(), threads_per_worker=1, processes=True,
-                           dashboard_address=None)
+                           dashboard_address=":0")
     return Client(cluster)
 
 

@@ -3,7 +3,8 @@
 The layer between the core's polyhedron kernels (:mod:`spinorbit.core.model.polyhedron`, plain
 floats) and the rest of the package: a :class:`Shape` with a length unit, checked once; the readers
 and writers of :mod:`spinorbit.shape.files`; the generated shapes of :mod:`spinorbit.shape.mesh`; and
-the constant-density mass properties and :class:`~spinorbit.RigidBody` of :mod:`spinorbit.shape.mass`.
+the constant-density mass properties and :class:`~spinorbit.RigidBody` of :mod:`spinorbit.shape.mass`;
+and sunlight's recoil torque in model units, :mod:`spinorbit.shape.thermal`.
 """
 
 from spinorbit.core.model.polyhedron import InvalidMeshError
@@ -17,10 +18,12 @@ from spinorbit.shape.mass import (
     shape_mass_properties,
 )
 from spinorbit.shape.mesh import Shape, ellipsoid_shape, gaussian_random_sphere, icosphere
+from spinorbit.shape.thermal import principal_facets, thermal_block
 
 __all__ = [
     "Shape", "InvalidMeshError", "ShapeFileError", "InertiaMismatchError", "ShapeMassProperties",
     "read_obj", "write_obj", "read_icq", "write_icq", "icq_grid", "icq_mesh",
     "ellipsoid_shape", "gaussian_random_sphere", "icosphere",
     "shape_mass_properties", "rigid_body_from_shape", "principal_shape", "check_moments",
+    "thermal_block", "principal_facets",
 ]

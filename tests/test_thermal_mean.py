@@ -16,6 +16,7 @@ from astropy import units as u
 
 from spinorbit.core.averaging.propagate import propagate_averaged
 from spinorbit.core.averaging.thermal_mean import (
+    SeparatrixReachedError,
     mean_thermal_rates,
     orbital_period,
     propagate_mean_thermal,
@@ -113,6 +114,12 @@ def test_bad_input_to_the_mean_yorp():
         propagate_mean_thermal(el0, 0.0, [1.0], model, ORBIT_FRAME, step=0.0)
     with pytest.raises(ValueError, match="six finite"):
         propagate_mean_thermal(el0[:5], 0.0, [1.0], model, ORBIT_FRAME, step=1.0)
+    omega = 2 * math.pi / 0.25
+    near_separatrix = np.array([*y0[:4], 1e-5 * omega, omega, 1e-5 * omega])  # about B, the unstable axis
+    el_sep = elements_of_state(near_separatrix, model, ORBIT_FRAME)
+    with pytest.raises(SeparatrixReachedError, match="separatrix") as caught:
+        propagate_mean_thermal(el_sep, 0.0, [1.0, 2.0], model, ORBIT_FRAME, step=1.0)
+    assert caught.value.elements.shape == (0, 6) and caught.value.time == 0.0
     fixed, _, _ = tumbler(ellipsoid_shape([0.2, 0.15, 0.12] * u.km, subdivisions=1), fixed_source(1.0, [1.0, 0, 0]))
     with pytest.raises(ValueError, match="Kepler orbit"):
         orbital_period(fixed)

@@ -30,7 +30,8 @@ import numpy as np
 
 from spinorbit.core.averaging.mean_equations import degree2_mean_rhs, mean_constants, torus_frequencies
 from spinorbit.core.dynamics.equations import MODEL_PERTURBERS
-from spinorbit.core.elements.canonical import inertia_constants
+from spinorbit.core.elements.canonical import MO_MODE, MO_PARAM_C, MODE_UNIFORM, inertia_constants, motion_from_elements
+from spinorbit.core.errors import SpinorbitError
 from spinorbit.core.elements.equations import elements_rhs_into
 from spinorbit.core.integrators.dop853 import dop853_scratch, dop853_step, landing_step
 from spinorbit.core.jit import jit
@@ -39,7 +40,24 @@ from spinorbit.core.model.perturbers import K_MEAN_MOTION, PERTURBER_ROW
 from spinorbit.core.model.thermal import TH_SUN_ROW
 
 __all__ = ["recoil_only_model", "orbital_period", "mean_thermal_rates", "propagate_mean_thermal",
-           "THERMAL_POINTS_S", "THERMAL_POINTS_Z", "THERMAL_POINTS_ORBIT"]
+           "THERMAL_POINTS_S", "THERMAL_POINTS_Z", "THERMAL_POINTS_ORBIT", "SeparatrixReachedError"]
+
+#: Closest approach to the separatrix (1 − m) a mean step may start from: there the period of s
+#: grows without bound and the torus average stops being a time average (the averaged propagator's
+#: own threshold, :data:`spinorbit.core.averaging.propagate.MIN_SEPARATRIX_DISTANCE`).
+MIN_SEPARATRIX_DISTANCE = 1e-3
+
+
+class SeparatrixReachedError(SpinorbitError, ValueError):
+    """YORP drove the mean motion to the separatrix (a change of rotation mode), where the mean run stops.
+
+    Attributes ``times`` and ``elements`` hold the outputs computed before it (possibly none), and
+    ``time`` the time of the last step's start.
+    """
+
+    def __init__(self, message, times, elements, time):
+        super().__init__(message)
+        self.times, self.elements, self.time = times, elements, time
 
 #: Default grid: points per period of s, per 2π of z, per orbit (measured convergence in
 #: tests/test_thermal_mean.py: 16 × 8 × 16 agrees with 32 × 16 × 32 to < 1e-6 of the rates).
@@ -141,10 +159,14 @@ def _slow_kernel(el0, t0, t_out, step, model, recoil_model, frame, n_s, n_z, n_o
     scratch = np.empty(4)
     params = (model, recoil_model, frame, n_s, n_z, n_orbit, period_orbit, with_gravity, scratch)
     steps = 0
+    ic = inertia_constants(model[BODY_A], model[BODY_B], model[BODY_C])
     for i in range(t_out.shape[0]):
         target = t_out[i]
         direction = 1.0 if target > t else -1.0
         while t != target:
+            mo = motion_from_elements(abs(y[EL_S]), y[EL_Z], ic)
+            if mo[MO_MODE] == MODE_UNIFORM or not mo[MO_PARAM_C] >= MIN_SEPARATRIX_DISTANCE:
+                return i, t, steps
             remaining = abs(target - t)
             h = landing_step(step, remaining)
             dop853_step(_slow_rhs, params, t, y, direction * h, k, tmp, y_new)
@@ -154,7 +176,7 @@ def _slow_kernel(el0, t0, t_out, step, model, recoil_model, frame, n_s, n_z, n_o
             steps += 1
         for c in range(6):
             out[i, c] = y[c]
-    return steps
+    return t_out.shape[0], t, steps
 
 
 def propagate_mean_thermal(el0, t0, t_out, model, frame, step, n_s=THERMAL_POINTS_S, n_z=THERMAL_POINTS_Z,
@@ -185,6 +207,13 @@ def propagate_mean_thermal(el0, t0, t_out, model, frame, step, n_s=THERMAL_POINT
     -------
     elements : ndarray (n, 6)
     steps : int
+
+    Raises
+    ------
+    SeparatrixReachedError
+        The motion reached the separatrix (1 − m below MIN_SEPARATRIX_DISTANCE) before the last output.
+    ValueError
+        A model without a thermal block or without the Sun on a Kepler orbit, bad elements or step.
     """
     el0 = np.array(el0, dtype=float)
     t_out = np.atleast_1d(np.asarray(t_out, dtype=float))
@@ -198,6 +227,13 @@ def propagate_mean_thermal(el0, t0, t_out, model, frame, step, n_s=THERMAL_POINT
     recoil = recoil_only_model(model)
     period_orbit = orbital_period(model)
     out = np.empty((t_out.size, 6))
-    steps = _slow_kernel(el0, float(t0), t_out, float(step), model, recoil, np.ascontiguousarray(frame, dtype=float),
+    written, t_stop, steps = _slow_kernel(el0, float(t0), t_out, float(step), model, recoil, np.ascontiguousarray(frame, dtype=float),
                          int(n_s), int(n_z), int(n_orbit), float(period_orbit), bool(with_gravity), out)
+    if written < t_out.size:
+        raise SeparatrixReachedError(
+            f"propagate_mean_thermal: at t = {t_stop!r} the mean motion is within 1 − m < {MIN_SEPARATRIX_DISTANCE:g} "
+            "of the separatrix (or a permanent rotation), where the torus average is undefined; the "
+            f"{written} outputs before it are in the error's .times and .elements. Continue across it with a "
+            "full integrator (integrate_quaternion) and restart the mean run on the other side.",
+            t_out[:written].copy(), out[:written].copy(), float(t_stop))
     return out, steps

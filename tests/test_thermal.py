@@ -14,6 +14,7 @@ import pytest
 from astropy import units as u
 
 from spinorbit.core.dynamics.equations import MODEL_PERTURBERS, force_function_and_torque_xyz, make_model
+from spinorbit.core.dynamics.python_reference import make_rhs
 from spinorbit.core.integrators.elements import integrate_elements
 from spinorbit.core.integrators.quaternion import integrate_quaternion
 from spinorbit.core.integrators.taylor import TaylorFallbackWarning, integrate_taylor
@@ -199,3 +200,6 @@ def test_bad_thermal_input_is_refused():
     block = pack_thermal(normals, areas, centroids, 4, 1.0, 1.0)
     with pytest.raises(ValueError, match="thermal_sun"):
         make_model([1.0, 2.0, 3.0], [], thermal=block)
+    sun = kepler_source(GM_SUN, 1.0, 0.1, 0.0, 0.0, 0.0, 0.0, sign=-1.0)
+    with pytest.raises(ValueError, match="no transcription of the thermal"):
+        make_rhs(make_model([1.0, 2.0, 3.0], [sun], thermal=block))

@@ -19,9 +19,8 @@ from spinorbit.shape.mesh import Shape
 
 __all__ = ["thermal_block", "principal_facets", "DEFAULT_THERMAL_DEGREE"]
 
-#: Degree of the default representation: the spin-averaged torque agrees with the facet sum to
-#: ~3e-4 of the instantaneous amplitude at degree 8 (docs/thermal.md, written by
-#: benchmarks/thermal_validation.py), and an evaluation costs ~0.2 µs.
+#: Degree of the default representation: its spin-averaged torque's error against the facet sum and
+#: its cost per evaluation, degree by degree, are in docs/thermal.md (benchmarks/thermal_validation.py).
 DEFAULT_THERMAL_DEGREE = 8
 SECONDS_PER_DAY = 86400.0
 METRES_PER_KM = 1000.0

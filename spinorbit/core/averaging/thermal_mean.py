@@ -28,6 +28,7 @@ import math
 
 import numpy as np
 
+from spinorbit.core.averaging.dissipation import damping_rate_of_s
 from spinorbit.core.averaging.mean_equations import degree2_mean_rhs, mean_constants, torus_frequencies
 from spinorbit.core.dynamics.equations import MODEL_PERTURBERS
 from spinorbit.core.elements.canonical import MO_MODE, MO_PARAM_C, MODE_UNIFORM, inertia_constants, motion_from_elements
@@ -133,9 +134,14 @@ def mean_thermal_rates(t, elements, recoil_model, frame, ic, n_s, n_z, n_orbit, 
 @jit
 def _slow_rhs(t, y, params, dy):
     """d(S, Z, H, s, z, h)/dt of the slow system; s and z held (their rates zero)."""
-    model, recoil_model, frame, n_s, n_z, n_orbit, period_orbit, with_gravity, scratch = params
+    model, recoil_model, frame, n_s, n_z, n_orbit, period_orbit, with_gravity, damping_constant, scratch = params
     ic = inertia_constants(model[BODY_A], model[BODY_B], model[BODY_C])
-    mean_thermal_rates(t, y, recoil_model, frame, ic, n_s, n_z, n_orbit, period_orbit, scratch)
+    if recoil_model[FIG_THERMAL] > 0.0:
+        mean_thermal_rates(t, y, recoil_model, frame, ic, n_s, n_z, n_orbit, period_orbit, scratch)
+    else:
+        for i in range(4):
+            scratch[i] = 0.0
+    scratch[0] += damping_rate_of_s(y[EL_S], y[EL_Z], ic, damping_constant)
     gravity_h = 0.0
     if with_gravity:
         moments = np.array([model[BODY_A], model[BODY_B], model[BODY_C]])
@@ -153,21 +159,22 @@ def _slow_rhs(t, y, params, dy):
 
 @jit
 def _slow_kernel(el0, t0, t_out, step, model, recoil_model, frame, n_s, n_z, n_orbit, period_orbit, with_gravity,
-                 out):
+                 damping_constant, out):
     y = el0.copy()
     t = t0
     k, tmp, y_new = dop853_scratch(6)
     scratch = np.empty(4)
-    params = (model, recoil_model, frame, n_s, n_z, n_orbit, period_orbit, with_gravity, scratch)
+    params = (model, recoil_model, frame, n_s, n_z, n_orbit, period_orbit, with_gravity, damping_constant, scratch)
     steps = 0
     ic = inertia_constants(model[BODY_A], model[BODY_B], model[BODY_C])
     for i in range(t_out.shape[0]):
         target = t_out[i]
         direction = 1.0 if target > t else -1.0
         while t != target:
-            mo = motion_from_elements(abs(y[EL_S]), y[EL_Z], ic)
-            if mo[MO_MODE] == MODE_UNIFORM or not mo[MO_PARAM_C] >= MIN_SEPARATRIX_DISTANCE:
-                return i, t, steps
+            if recoil_model[FIG_THERMAL] > 0.0:  # the torus average needs a torus; damping alone does not
+                mo = motion_from_elements(abs(y[EL_S]), y[EL_Z], ic)
+                if mo[MO_MODE] == MODE_UNIFORM or not mo[MO_PARAM_C] >= MIN_SEPARATRIX_DISTANCE:
+                    return i, t, steps
             remaining = abs(target - t)
             h = landing_step(step, remaining)
             dop853_step(_slow_rhs, params, t, y, direction * h, k, tmp, y_new)
@@ -181,8 +188,8 @@ def _slow_kernel(el0, t0, t_out, step, model, recoil_model, frame, n_s, n_z, n_o
 
 
 def propagate_mean_thermal(el0, t0, t_out, model, frame, step, n_s=THERMAL_POINTS_S, n_z=THERMAL_POINTS_Z,
-                           n_orbit=THERMAL_POINTS_ORBIT, with_gravity=True):
-    """Mean (S, Z, H, h) under sunlight's recoil (and gravity's mean precession) over long spans.
+                           n_orbit=THERMAL_POINTS_ORBIT, with_gravity=True, damping_constant=0.0):
+    """Mean (S, Z, H, h) under sunlight's recoil, nutation damping and gravity's mean precession.
 
     Parameters
     ----------
@@ -203,6 +210,10 @@ def propagate_mean_thermal(el0, t0, t_out, model, frame, step, n_s=THERMAL_POINT
         Quadrature grid (:func:`mean_thermal_rates`).
     with_gravity : bool
         Add the gravitational mean precession dh/dt (degree 2, orbit-averaged).
+    damping_constant : float
+        k = μQ/(ρ K₃² R²) (time⁻²) of the nutation damping, τ_D = k/ω³
+        (:mod:`spinorbit.core.averaging.dissipation`); 0: no damping. With damping the model need
+        not have a thermal block.
 
     Returns
     -------
@@ -224,12 +235,18 @@ def propagate_mean_thermal(el0, t0, t_out, model, frame, step, n_s=THERMAL_POINT
         raise ValueError(f"step: expected a finite positive step (time unit); got {step!r}.")
     if not (min(n_s, n_z, n_orbit) >= 1):
         raise ValueError(f"n_s, n_z, n_orbit: expected positive grid sizes; got {n_s}, {n_z}, {n_orbit}.")
+    if not (math.isfinite(damping_constant) and damping_constant >= 0.0):
+        raise ValueError(f"damping_constant: expected k = μQ/(ρ K₃² R²) ≥ 0 (time⁻²); got {damping_constant!r}.")
     model = np.ascontiguousarray(model, dtype=float)
-    recoil = recoil_only_model(model)
-    period_orbit = orbital_period(model)
+    if model[FIG_THERMAL] > 0.0 or damping_constant == 0.0:
+        recoil = recoil_only_model(model)  # refuses a model with neither recoil nor damping
+        period_orbit = orbital_period(model)
+    else:
+        recoil, period_orbit = model, 1.0  # damping alone: no orbit average needed
     out = np.empty((t_out.size, 6))
     written, t_stop, steps = _slow_kernel(el0, float(t0), t_out, float(step), model, recoil, np.ascontiguousarray(frame, dtype=float),
-                         int(n_s), int(n_z), int(n_orbit), float(period_orbit), bool(with_gravity), out)
+                         int(n_s), int(n_z), int(n_orbit), float(period_orbit), bool(with_gravity),
+                         float(damping_constant), out)
     if written < t_out.size:
         raise SeparatrixReachedError(
             f"propagate_mean_thermal: at t = {t_stop!r} the mean motion is within 1 − m < {MIN_SEPARATRIX_DISTANCE:g} "

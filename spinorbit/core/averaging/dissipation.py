@@ -3,13 +3,13 @@
 Internal friction conserves the angular momentum L (so Z, H and h are constant) and removes the
 rotational energy E = ½ a S² (the free Hamiltonian, eq. 10: S = √(d/a) Z, 2E = d Z²) down to the
 minimum E_min = ½ c Z² of rotation about C. The published time scale is Burns & Safronov's
-(1973, MNRAS 165, 403, eq. 25; used by Harris 1994, Icarus 107, 209, eq. 1, and discussed by
-Sharma, Burns & Hui 2005, MNRAS 359, 79)::
+(1973, MNRAS 165, 403; used by Harris 1994, Icarus 107, 209, and revisited by Sharma, Burns & Hui
+2005, MNRAS 359, 79)::
 
     τ_D = μ Q / (ρ K₃² R² ω³)
 
 with μ the rigidity, Q the quality factor, ρ the density, R the mean radius, ω the spin rate and
-K₃² a shape factor (Burns & Safronov give ≈ 0.01 for near-spheres to ≈ 0.1 for elongated bodies).
+K₃² Burns & Safronov's dimensionless shape factor.
 It is the e-folding time of the nutation angle θ; the energy above E_min goes as θ², so here
 
     d(E − E_min)/dt = −2 (E − E_min) / τ_D,   dS/dt = (dE/dt) / (a S)    (Z, H, h fixed),

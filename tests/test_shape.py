@@ -24,6 +24,7 @@ from spinorbit.core.model.polyhedron import (
 )
 from spinorbit.shape import (
     InertiaMismatchError,
+    box_shape,
     Shape,
     ShapeFileError,
     check_moments,
@@ -48,21 +49,9 @@ SEMI_AXES = (1.0, 0.8, 0.6)
 
 
 def box_mesh(hx, hy, hz, offset=(0.0, 0.0, 0.0)):
-    """A box |x| ≤ hx, |y| ≤ hy, |z| ≤ hz as 12 outward triangles."""
-    vertices = np.array([[sx * hx, sy * hy, sz * hz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
-    faces = []
-    for axis in range(3):
-        first, second = [k for k in range(3) if k != axis]
-        for sign in (-1, 1):
-            corners = []
-            for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
-                signs = [0, 0, 0]
-                signs[axis], signs[first], signs[second] = sign, a, b
-                corners.append(4 * (signs[0] > 0) + 2 * (signs[1] > 0) + (signs[2] > 0))
-            if np.cross(np.eye(3)[first], np.eye(3)[second])[axis] * sign < 0:
-                corners.reverse()
-            faces += [corners[:3], [corners[0], corners[2], corners[3]]]
-    return vertices + np.array(offset), np.array(faces)
+    """A box |x| ≤ hx, |y| ≤ hy, |z| ≤ hz as 12 outward triangles (plain km arrays)."""
+    shape = box_shape([hx, hy, hz] * u.km)
+    return shape.vertices_km + np.array(offset), shape.faces
 
 
 def box_moment(p, q, r, h):
@@ -188,20 +177,10 @@ def test_obj_round_trip_is_exact(tmp_path):
 
 
 def test_obj_reader_takes_quads_slashes_and_negative_indices(tmp_path):
-    vertices, _ = box_mesh(1.0, 1.0, 1.0)
+    vertices, faces = box_mesh(1.0, 1.0, 1.0)
     text = "".join(f"v {x} {y} {z}\n" for x, y, z in vertices)
-    quads = []
-    for axis in range(3):
-        first, second = [k for k in range(3) if k != axis]
-        for sign in (-1, 1):
-            corners = []
-            for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
-                signs = [0, 0, 0]
-                signs[axis], signs[first], signs[second] = sign, a, b
-                corners.append(4 * (signs[0] > 0) + 2 * (signs[1] > 0) + (signs[2] > 0))
-            if np.cross(np.eye(3)[first], np.eye(3)[second])[axis] * sign < 0:
-                corners.reverse()
-            quads.append(corners)
+    # box_shape's faces 2j, 2j + 1 are (c0, c1, c2), (c0, c2, c3) of side j: the quads back
+    quads = [[first[0], first[1], first[2], second[2]] for first, second in zip(faces[0::2], faces[1::2])]
     text += "vn 0 0 1\n# a comment\n"
     text += "".join(f"f {q[0] + 1}/1/1 {q[1] + 1}//1 {q[2] - 8} {q[3] + 1}\n" for q in quads)
     path = tmp_path / "cube.obj"

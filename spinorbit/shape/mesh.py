@@ -24,7 +24,7 @@ from astropy import units as u
 from spinorbit.core.model.polyhedron import check_closed_mesh, regular_solid_harmonics
 from spinorbit.quantities import value_in
 
-__all__ = ["Shape", "ellipsoid_shape", "gaussian_random_sphere", "icosphere", "directions_to_shape"]
+__all__ = ["Shape", "box_shape", "ellipsoid_shape", "gaussian_random_sphere", "icosphere", "directions_to_shape"]
 
 #: Highest icosphere subdivision: 20·4^7 = 327 680 faces, already far past what a torque needs.
 MAX_SUBDIVISIONS = 7
@@ -123,6 +123,39 @@ def _midpoint(vertices, cache, i, j):
 def directions_to_shape(directions, faces, radii, name=None):
     """A star-shaped Shape: vertex k at radii[k] · directions[k] (km)."""
     return Shape(directions * np.asarray(radii, dtype=float)[..., None] * u.km, faces, name=name)
+
+
+def box_shape(half_sides, name=None):
+    """A rectangular box |x| ≤ h_x, |y| ≤ h_y, |z| ≤ h_z as 12 outward triangles.
+
+    Parameters
+    ----------
+    half_sides : Quantity, shape (3,)
+        h_x, h_y, h_z (length).
+
+    Returns
+    -------
+    Shape
+        Vertex k at (±h_x, ±h_y, ±h_z) with the signs of the bits of k (4: x, 2: y, 1: z); faces 2j
+        and 2j + 1 are the two triangles (c0, c1, c2), (c0, c2, c3) of the box's j-th side c0..c3.
+    """
+    half = value_in("half_sides", half_sides, u.km, "[1.5, 1.0, 0.7] * u.km", plain_unit=u.km, shape=(3,))
+    if np.any(half <= 0):
+        raise ValueError(f"half_sides: expected three positive lengths; got {half.tolist()} km.")
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
+    faces = []
+    for axis in range(3):
+        first, second = [k for k in range(3) if k != axis]
+        for sign in (-1, 1):
+            corners = []
+            for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
+                corner = np.zeros(3)
+                corner[axis], corner[first], corner[second] = sign, a, b
+                corners.append(int(4 * (corner[0] > 0) + 2 * (corner[1] > 0) + (corner[2] > 0)))
+            if np.cross(np.eye(3)[first], np.eye(3)[second])[axis] * sign < 0:  # counter-clockwise from outside
+                corners.reverse()
+            faces += [corners[:3], [corners[0], corners[2], corners[3]]]
+    return Shape(signs * half * u.km, np.array(faces, dtype=np.int64), name=name or "box")
 
 
 def ellipsoid_shape(semi_axes, subdivisions=3, name=None):

@@ -203,21 +203,15 @@ def thermal_force_torque_xyz(sx, sy, sz, distance, block, base):
                 prev_re, prev_im, cur_re, cur_im = cur_re, cur_im, a * cur_re - b * prev_re, a * cur_im - b * prev_im
             if n >= 3 and n % 2 == 1:
                 continue
-            row = coef + 6 * k
-            tx += block[row] * cur_re
-            ty += block[row + 1] * cur_re
-            tz += block[row + 2] * cur_re
-            fx += block[row + 3] * cur_re
-            fy += block[row + 4] * cur_re
-            fz += block[row + 5] * cur_re
-            if m > 0:
-                row += 6
-                tx += block[row] * cur_im
-                ty += block[row + 1] * cur_im
-                tz += block[row + 2] * cur_im
-                fx += block[row + 3] * cur_im
-                fy += block[row + 4] * cur_im
-                fz += block[row + 5] * cur_im
+            for part in range(2 if m > 0 else 1):  # cos mλ, then sin mλ (the next harmonic's row)
+                value = cur_re if part == 0 else cur_im
+                row = coef + 6 * (k + part)
+                tx += block[row] * value
+                ty += block[row + 1] * value
+                tz += block[row + 2] * value
+                fx += block[row + 3] * value
+                fy += block[row + 4] * value
+                fz += block[row + 5] * value
     ratio = block[base + TH_DISTANCE] / distance
     scale = -block[base + TH_PRESSURE] * ratio * ratio
     return scale * fx, scale * fy, scale * fz, scale * tx, scale * ty, scale * tz

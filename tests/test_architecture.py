@@ -33,6 +33,7 @@ UPPER_LAYERS = (
                 "spinorbit.frames", "spinorbit.ephemeris", "spinorbit.lunar_librations", "spinorbit.special",
                 "spinorbit.orbital_elements", "spinorbit.pole")),
     ("runs", ("spinorbit.runs",)),
+    ("shape", ("spinorbit.shape",)),
     ("coupling", ("spinorbit.coupling",)),
     ("binary", ("spinorbit.binary",)),
     ("scene", ("spinorbit.scene",)),

@@ -56,7 +56,7 @@ from spinorbit.core.elements.canonical import (
 from spinorbit.core.dynamics.equations import MODEL_PERTURBERS
 from spinorbit.core.dynamics.validation import check_step_budget, validate_sampled_span, validate_state
 from spinorbit.core.elements.equations import attitude_and_momentum, inertial_quaternion, reduce_phase
-from spinorbit.core.model.gravity_field import BODY_NMAX
+from spinorbit.core.model.gravity_field import BODY_NMAX, FIG_THERMAL
 from spinorbit.core.integrators.elements import (
     ACTION_S,
     ACTION_Z,
@@ -489,6 +489,10 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
     t_out = validate_output_times(t0, t_out)
     model = np.ascontiguousarray(model, dtype=float)
     validate_sampled_span(model, t0, t_out)
+    if model[FIG_THERMAL] > 0.0:  # its mean equations hold S and Z constant, which sunlight's recoil does not
+        raise ValueError("model: propagate_averaged averages conservative torques only (its mean S and Z are constant); "
+                         "sunlight's recoil changes them. Use spinorbit.core.averaging.thermal_mean."
+                         "propagate_mean_thermal for the mean YORP evolution, or a full integrator.")
     span = abs(t_out[-1] - t0)
     if max_step is None:
         max_step = span / 64.0 if orbit_averaged else span

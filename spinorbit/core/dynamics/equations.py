@@ -21,7 +21,8 @@ atomic reference-count updates per array at every numba call boundary, measured 
 with eight arrays, more than the whole torque-free RHS)::
 
     model = concatenate([figure (FIGURE_SIZE floats, gravity_field.make_body),
-                         perturber block (perturbers.pack_perturbers, at offset MODEL_PERTURBERS)])
+                         perturber block (perturbers.pack_perturbers, at offset MODEL_PERTURBERS),
+                         thermal block (thermal.pack_thermal, optional; its offset in figure[FIG_THERMAL])])
 
 Build it with :func:`make_model`. Any other integrator (the canonical-element equations, a splitting
 scheme) takes the same array and calls :func:`force_function_and_torque_xyz` (scalars, no allocation)
@@ -41,6 +42,7 @@ from spinorbit.core.model.gravity_field import (
     BODY_B,
     BODY_C,
     BODY_MASS,
+    FIG_THERMAL,
     FIGURE_SIZE,
     figure_field_without_monopole_xyz,
     make_body,
@@ -72,6 +74,7 @@ from spinorbit.core.model.perturbers import (
     perturber_position_xyz,
     sampled_velocity_xyz,
 )
+from spinorbit.core.model.thermal import TH_SUN_ROW, thermal_force_torque_xyz
 
 STATE_SIZE = 7
 
@@ -80,7 +83,7 @@ MODEL_PERTURBERS = FIGURE_SIZE
 
 
 def make_model(moments, sources=(), mass=0.0, reference_radius=1.0, stokes_c=None, stokes_s=None,
-               normalized=False):
+               normalized=False, thermal=None, thermal_sun=0):
     """Build the model array from a body description and a list of perturber sources.
 
     Parameters
@@ -89,14 +92,29 @@ def make_model(moments, sources=(), mass=0.0, reference_radius=1.0, stokes_c=Non
         As in :func:`spinorbit.core.model.gravity_field.make_body`.
     sources : sequence
         Perturber sources from :mod:`spinorbit.core.model.perturbers` (may be empty: torque-free).
+    thermal : ndarray, optional
+        A thermal block (:func:`spinorbit.core.model.thermal.pack_thermal`, in the model's units):
+        sunlight's recoil torque joins the torque sum, with the Sun at ``sources[thermal_sun]``.
+    thermal_sun : int
+        Index of the Sun among ``sources``.
 
     Returns
     -------
     model : ndarray (float64, 1-d)
-        [figure, number of perturbers, perturber rows, samples] (see the module docstring).
+        [figure, number of perturbers, perturber rows, samples, thermal block] (see the module docstring).
     """
     figure = make_body(moments, mass, reference_radius, stokes_c, stokes_s, normalized)
-    return np.ascontiguousarray(np.concatenate([figure, pack_perturbers(sources, base=MODEL_PERTURBERS)]))
+    sources = list(sources)
+    parts = [figure, pack_perturbers(sources, base=MODEL_PERTURBERS)]
+    if thermal is not None:
+        if not 0 <= thermal_sun < len(sources):
+            raise ValueError(f"thermal_sun: expected the index of the Sun among the {len(sources)} sources; got "
+                             f"{thermal_sun!r}. Sunlight's recoil needs the Sun's position: add it as a source.")
+        block = np.array(thermal, dtype=float)
+        block[TH_SUN_ROW] = MODEL_PERTURBERS + 1 + thermal_sun * PERTURBER_ROW
+        figure[FIG_THERMAL] = sum(part.size for part in parts)
+        parts.append(block)
+    return np.ascontiguousarray(np.concatenate(parts))
 
 
 def perturber_count(model):
@@ -160,7 +178,23 @@ def force_function_and_torque_xyz(t, q0, q1, q2, q3, model):
         nx += nx_k
         ny += ny_k
         nz += nz_k
+    if model[FIG_THERMAL] > 0.0:  # sunlight's recoil (YORP): a torque without a force function
+        tx, ty, tz = thermal_torque_xyz(t, q0, q1, q2, q3, model)
+        nx += tx
+        ny += ty
+        nz += tz
     return u, nx, ny, nz
+
+
+@jit(inline="always")
+def thermal_torque_xyz(t, q0, q1, q2, q3, model):
+    """Body-frame recoil torque of the model's thermal block (:mod:`spinorbit.core.model.thermal`), Sun
+    at its perturber row."""
+    base = int(model[FIG_THERMAL])
+    ix, iy, iz = perturber_position_xyz(t, model, int(model[base + TH_SUN_ROW]))
+    x, y, z = body_frame_xyz(q0, q1, q2, q3, ix, iy, iz)
+    _, _, _, tx, ty, tz = thermal_force_torque_xyz(x, y, z, math.sqrt(x * x + y * y + z * z), model, base)
+    return tx, ty, tz
 
 
 @jit

@@ -40,6 +40,7 @@ from spinorbit.core.model.gravity_field import (
     BODY_RADIUS,
     FIG_STOKES_C,
     FIG_STOKES_S,
+    FIG_THERMAL,
     STOKES_SIZE,
 )
 from spinorbit.core.model.perturbers import (
@@ -266,6 +267,9 @@ def make_rhs(model):
         ``fun(t, y)`` with y = (q, ω) (7 floats, q need not be unit); usable as scipy's ``fun``.
     """
     model = np.asarray(model, dtype=float)
+    if model[FIG_THERMAL] > 0.0:
+        raise ValueError("model: the pure-Python baseline has no transcription of the thermal (YORP) block; "
+                         "use the compiled rhs (spinorbit.core.dynamics.equations.rhs) for this model.")
     a_mom, b_mom, c_mom = float(model[BODY_A]), float(model[BODY_B]), float(model[BODY_C])
     trace = a_mom + b_mom + c_mom
     mass, radius, n_max = float(model[BODY_MASS]), float(model[BODY_RADIUS]), int(model[BODY_NMAX])

@@ -57,7 +57,7 @@ from spinorbit.core.integrators.taylor_recurrences import (
 )
 from spinorbit.core.integrators.taylor_recurrences import taylor_series  # noqa: F401 (part of this integrator's API)
 from spinorbit.core.jit import jit
-from spinorbit.core.model.gravity_field import BODY_NMAX
+from spinorbit.core.model.gravity_field import BODY_NMAX, FIG_THERMAL
 
 #: Highest Taylor order (tol ≥ 1e-16 with order_factor ≤ 2 needs ≤ 40).
 MAX_ORDER = 48
@@ -251,7 +251,13 @@ def _validate_order_factor(order_factor):
 
 
 def _needs_fallback(model):
-    return int(model[BODY_NMAX]) > 2
+    return int(model[BODY_NMAX]) > 2 or model[FIG_THERMAL] > 0.0  # no recurrence for either
+
+
+def _fallback_reason(model):
+    if model[FIG_THERMAL] > 0.0:
+        return "a thermal (YORP) block"
+    return f"degree-{int(model[BODY_NMAX])} Stokes terms"
 
 
 #: Default raise of the order over heyoka's rule: higher orders take fewer steps but give larger errors
@@ -318,7 +324,7 @@ def integrate_taylor(y0, t0, t_out, model, tol=1e-10, order_factor=DEFAULT_ORDER
                       "shorten the span")
     if _needs_fallback(model):
         warnings.warn(
-            f"integrate_taylor: the figure has degree-{int(model[BODY_NMAX])} Stokes terms, for which there "
+            f"integrate_taylor: the model has {_fallback_reason(model)}, for which there "
             "is no Taylor recurrence; integrating with DOP853 (integrate_quaternion, rtol = tol) instead.",
             TaylorFallbackWarning, stacklevel=2)
         return integrate_quaternion(y0, t0, t_out, model, rtol=tol, return_stats=return_stats)
@@ -343,6 +349,7 @@ def integrate_taylor_fixed_step(y0, t0, t1, n_steps, model, order, max_steps=DEF
     if not (1 <= int(order) <= MAX_ORDER):
         raise ValueError(f"order: expected an order in [1, {MAX_ORDER}], got {order!r}.")
     if _needs_fallback(np.asarray(model)):
-        raise ValueError("model: the fixed-step Taylor mode has no degree-3/4 field; use integrate_fixed_step.")
+        raise ValueError(f"model: the fixed-step Taylor mode has no recurrence for {_fallback_reason(np.asarray(model))}; "
+                         "use integrate_fixed_step.")
     return integrate_taylor_fixed_kernel(y0, t0, t1, n_steps,
                                          np.ascontiguousarray(model, dtype=float), int(order))

@@ -40,6 +40,8 @@ atomic reference-count updates, measured at ~130 ns per RHS call with an 8-array
     figure[0:6]   = [A, B, C, m_b, R_ref, n_max]
     figure[6:31]  = C_nm (unnormalised), row-major [n, m], n, m < STOKES_SIZE
     figure[31:56] = S_nm
+    figure[56]    = absolute offset of the thermal block in the model array, 0 for none
+                    (:mod:`spinorbit.core.model.thermal`; written by ``make_model``)
 
 ``n_max`` ∈ {2, 3, 4} is the highest degree evaluated. Any array that *starts* with a figure is
 accepted (the dynamics' model array does), so the kernels take the model directly.
@@ -63,7 +65,9 @@ BODY_A, BODY_B, BODY_C, BODY_MASS, BODY_RADIUS, BODY_NMAX = 0, 1, 2, 3, 4, 5
 BODY_SIZE = 6
 FIG_STOKES_C = BODY_SIZE  # C_nm at FIG_STOKES_C + n·STOKES_SIZE + m
 FIG_STOKES_S = FIG_STOKES_C + STOKES_SIZE * STOKES_SIZE
-FIGURE_SIZE = FIG_STOKES_S + STOKES_SIZE * STOKES_SIZE
+#: Where the model array's thermal block starts (0: no sunlight recoil); make_body leaves it at 0.
+FIG_THERMAL = FIG_STOKES_S + STOKES_SIZE * STOKES_SIZE
+FIGURE_SIZE = FIG_THERMAL + 1
 
 
 def normalization_factor(n, m):
@@ -205,7 +209,7 @@ def make_body(moments, mass=0.0, reference_radius=1.0, stokes_c=None, stokes_s=N
                     f"mass: Stokes coefficients of degree {n_max} need the body mass m_b > 0, got {mass!r}."
                 )
     body = np.array([a_mom, b_mom, c_mom, float(mass), float(reference_radius), float(n_max)])
-    return np.concatenate([body, c_out.ravel(), s_out.ravel()])
+    return np.concatenate([body, c_out.ravel(), s_out.ravel(), [0.0]])
 
 
 def pack_stokes(stokes_c, stokes_s, mass=1.0, reference_radius=1.0):
@@ -221,7 +225,7 @@ def pack_stokes(stokes_c, stokes_s, mass=1.0, reference_radius=1.0):
     c[: given_c.shape[0], : given_c.shape[1]] = given_c
     s[: given_s.shape[0], : given_s.shape[1]] = given_s
     head = np.array([0.0, 0.0, 0.0, float(mass), float(reference_radius), float(STOKES_MAX_DEGREE)])
-    return np.concatenate([head, c.ravel(), s.ravel()])
+    return np.concatenate([head, c.ravel(), s.ravel(), [0.0]])
 
 
 @jit

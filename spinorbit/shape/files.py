@@ -1,0 +1,233 @@
+"""Shape files: Wavefront OBJ and the implicitly connected quadrilateral (ICQ) format.
+
+- **OBJ**: ``v x y z`` lines (km) and ``f i j k …`` lines counting vertices from 1 (negative indices
+  count back from the last vertex; ``i/t/n`` forms keep the vertex index). Polygons with more than
+  three vertices are split into a fan of triangles. Other records (``vn``, ``vt``, ``g``, ``o``,
+  ``s``, ``usemtl``, comments) are ignored.
+- **ICQ** (Gaskell's SPC format, used by the PDS Small Bodies Node; https://sbib.psi.edu/spc_wiki/SHAPE.TXT):
+  a first line with q, then 6 (q + 1)² lines of x y z (km): six faces of a cube, each a (q + 1) × (q + 1)
+  grid listed row by row (j outer, i inner). Vertices on shared cube edges are written once per cube
+  face with the same coordinates; they are merged here, leaving 6 q² + 2 vertices and 12 q² triangles.
+  Each grid cell (i, j)–(i + 1, j)–(i + 1, j + 1)–(i, j + 1) becomes two triangles; the six cube
+  faces have the same handedness, so the orientation is fixed by the sign of the volume.
+
+Every reading error names the file and line, says what was expected and what arrived.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+from astropy import units as u
+
+from spinorbit.core.errors import SpinorbitError
+from spinorbit.core.model.polyhedron import InvalidMeshError
+from spinorbit.runs.atomic import atomic_path
+from spinorbit.shape.mesh import Shape
+
+__all__ = ["ShapeFileError", "read_obj", "write_obj", "read_icq", "write_icq", "icq_mesh", "icq_grid"]
+
+#: The cube-face frames of the ICQ grid: centre c, i-direction e1, j-direction e2 (e1 × e2 = c on every
+#: face), the one assignment for which the shared edges of SHAPE.TXT coincide
+#: (v(I,0,1) = v(I,Q,0), v(I,0,2) = v(0,I,0), …, with faces counted from 0).
+ICQ_FACE_FRAMES = (
+    ((0, 0, 1), (1, 0, 0), (0, 1, 0)),
+    ((0, 1, 0), (1, 0, 0), (0, 0, -1)),
+    ((-1, 0, 0), (0, 1, 0), (0, 0, -1)),
+    ((0, -1, 0), (-1, 0, 0), (0, 0, -1)),
+    ((1, 0, 0), (0, -1, 0), (0, 0, -1)),
+    ((0, 0, -1), (1, 0, 0), (0, -1, 0)),
+)
+ICQ_CUBE_FACES = 6
+
+
+class ShapeFileError(SpinorbitError, ValueError):
+    """A shape file that cannot be read: unknown records, wrong counts, numbers that are not numbers."""
+
+
+def read_obj(path, name=None) -> Shape:
+    """Read a Wavefront OBJ file (vertices in km) into a :class:`Shape`.
+
+    Raises
+    ------
+    ShapeFileError
+        A ``v`` line without three numbers, an ``f`` line with fewer than three indices or an index
+        out of range, or a file with no faces.
+    InvalidMeshError
+        The surface is not closed and outward oriented (see :class:`Shape`).
+    """
+    vertices, faces = [], []
+    with open(path, encoding="utf-8") as stream:
+        for number, line in enumerate(stream, start=1):
+            words = line.split("#", 1)[0].split()
+            if not words:
+                continue
+            if words[0] == "v":
+                vertices.append(_obj_vertex(path, number, words))
+            elif words[0] == "f":
+                faces += _obj_face(path, number, words, len(vertices))
+    if not faces:
+        raise ShapeFileError(f"{path}: expected 'v x y z' and 'f i j k' lines of a Wavefront OBJ shape; found "
+                             f"{len(vertices)} vertices and no faces. Is this an OBJ file (an ICQ file is read "
+                             "with read_icq)?")
+    return _shape(path, np.array(vertices), np.array(faces, dtype=np.int64), name)
+
+
+def _obj_vertex(path, number, words):
+    try:
+        if len(words) < 4:
+            raise ValueError
+        return [float(w) for w in words[1:4]]
+    except ValueError:
+        raise ShapeFileError(f"{path}, line {number}: expected 'v x y z' with three numbers; got "
+                             f"{' '.join(words)!r}.") from None
+
+
+def _obj_face(path, number, words, vertex_count):
+    try:
+        indices = [int(w.split("/")[0]) for w in words[1:]]
+    except ValueError:
+        raise ShapeFileError(f"{path}, line {number}: expected 'f i j k' with integer vertex indices; got "
+                             f"{' '.join(words)!r}.") from None
+    if len(indices) < 3:
+        raise ShapeFileError(f"{path}, line {number}: a face needs at least three vertices; got {len(indices)}.")
+    resolved = []
+    for index in indices:
+        position = index - 1 if index > 0 else vertex_count + index
+        if index == 0 or not 0 <= position < vertex_count:
+            raise ShapeFileError(f"{path}, line {number}: vertex index {index} does not name one of the "
+                                 f"{vertex_count} vertices read so far (OBJ counts from 1; negative counts back).")
+        resolved.append(position)
+    return [(resolved[0], resolved[k], resolved[k + 1]) for k in range(1, len(resolved) - 1)]
+
+
+def _shape(path, vertices, faces, name):
+    try:
+        return Shape(vertices * u.km, faces, name=name or os.path.splitext(os.path.basename(path))[0])
+    except InvalidMeshError as error:
+        raise InvalidMeshError(f"{path}: {error}") from None
+
+
+def write_obj(path, shape: Shape) -> None:
+    """Write a Shape as a Wavefront OBJ file (km, 17 significant digits, atomically)."""
+    lines = [f"# {shape.name or 'shape'}: {shape.vertices_km.shape[0]} vertices, {len(shape)} faces, km\n"]
+    lines += [f"v {x!r} {y!r} {z!r}\n" for x, y, z in shape.vertices_km.tolist()]
+    lines += [f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in shape.faces.tolist()]
+    with atomic_path(path) as temporary, open(temporary, "w", encoding="utf-8") as stream:
+        stream.writelines(lines)
+
+
+def read_icq(path, name=None) -> Shape:
+    """Read an ICQ shape file (km) into a :class:`Shape`.
+
+    Raises
+    ------
+    ShapeFileError
+        No integer q ≥ 1 on the first line, a line without three numbers, or a vertex count other
+        than 6 (q + 1)².
+    InvalidMeshError
+        Shared cube-edge vertices that do not coincide, or a surface that is not closed.
+    """
+    with open(path, encoding="utf-8") as stream:
+        lines = stream.read().splitlines()
+    try:
+        q = int(lines[0].split()[0]) if lines else 0
+    except (ValueError, IndexError):
+        q = 0
+    if q < 1:
+        raise ShapeFileError(f"{path}, line 1: expected the ICQ resolution q (a positive integer); got "
+                             f"{(lines[0] if lines else '')!r}. Is this an ICQ file (OBJ files are read with read_obj)?")
+    rows = [line for line in lines[1:] if line.strip()]
+    expected = ICQ_CUBE_FACES * (q + 1) ** 2
+    if len(rows) != expected:
+        raise ShapeFileError(f"{path}: an ICQ file with q = {q} has 6 (q + 1)² = {expected} vertex lines after the "
+                             f"first; got {len(rows)}. The file is truncated or q is wrong.")
+    grid = np.empty((expected, 3))
+    for k, row in enumerate(rows):
+        words = row.split()
+        try:
+            if len(words) != 3:
+                raise ValueError
+            grid[k] = [float(w) for w in words]
+        except ValueError:
+            raise ShapeFileError(f"{path}, vertex line {k + 1}: expected three numbers 'x y z'; got {row!r}.") from None
+    vertices, faces = icq_mesh(grid.reshape(ICQ_CUBE_FACES, q + 1, q + 1, 3), source=str(path))
+    return _shape(path, vertices, faces, name)
+
+
+def icq_mesh(grid, source="ICQ grid"):
+    """Vertices and outward triangles of an ICQ grid, shared cube-edge vertices merged.
+
+    Parameters
+    ----------
+    grid : ndarray (6, q + 1, q + 1, 3)
+        grid[f, j, i] is vertex (i, j) of cube face f (km).
+
+    Returns
+    -------
+    vertices : ndarray (6 q² + 2, 3)
+    faces : ndarray (12 q², 3) int
+    """
+    q = grid.shape[1] - 1
+    flat = grid.reshape(-1, 3)
+    vertices, inverse = np.unique(flat, axis=0, return_inverse=True)
+    inverse = inverse.reshape(ICQ_CUBE_FACES, q + 1, q + 1)
+    expected = 6 * q * q + 2
+    if vertices.shape[0] != expected:
+        raise InvalidMeshError(f"{source}: an ICQ grid with q = {q} has {expected} distinct vertices once the shared "
+                               f"cube edges are merged; got {vertices.shape[0]}. The shared edge vertices must repeat "
+                               "the same coordinates on each cube face (or two distinct vertices coincide).")
+    corner = inverse[:, :-1, :-1]
+    right = inverse[:, :-1, 1:]
+    up = inverse[:, 1:, :-1]
+    diagonal = inverse[:, 1:, 1:]
+    faces = np.concatenate([np.stack([corner, right, diagonal], axis=-1).reshape(-1, 3),
+                            np.stack([corner, diagonal, up], axis=-1).reshape(-1, 3)])
+    a, b, c = (vertices[faces[:, k]] for k in range(3))
+    if np.einsum("ij,ij->i", a, np.cross(b, c)).sum() < 0:  # the file's cube is mirrored: reverse every face
+        faces = faces[:, ::-1]
+    return vertices, np.ascontiguousarray(faces)
+
+
+def icq_grid(radius_function, q):
+    """An ICQ grid of a star-shaped body: vertex (i, j) of face f at radius_function(direction) · direction.
+
+    Parameters
+    ----------
+    radius_function : callable
+        Unit directions (k, 3) → radii (k,) in km.
+    q : int
+        Resolution (q × q cells per cube face).
+
+    Returns
+    -------
+    ndarray (6, q + 1, q + 1, 3)
+        km, in the layout of :func:`write_icq`.
+    """
+    steps = -1.0 + 2.0 * np.arange(q + 1) / q
+    grid = np.empty((ICQ_CUBE_FACES, q + 1, q + 1, 3))
+    for f, (centre, e1, e2) in enumerate(ICQ_FACE_FRAMES):
+        cube = (np.array(centre, float) + steps[None, :, None] * np.array(e1, float)
+                + steps[:, None, None] * np.array(e2, float))
+        directions = cube / np.linalg.norm(cube, axis=-1, keepdims=True)
+        grid[f] = directions * np.asarray(radius_function(directions.reshape(-1, 3))).reshape(q + 1, q + 1, 1)
+    # Shared edges: the same float on every cube face (the cube coordinates are ±1 and k/q exactly
+    # for each face, but the normalisation may differ in the last bit: take one face's value).
+    vertices, inverse = np.unique(np.round(grid.reshape(-1, 3), 12), axis=0, return_inverse=True)
+    first = np.full(vertices.shape[0], -1)
+    flat = grid.reshape(-1, 3)
+    for k, group in enumerate(inverse.ravel()):
+        if first[group] < 0:
+            first[group] = k
+    return flat[first[inverse.ravel()]].reshape(grid.shape)
+
+
+def write_icq(path, grid) -> None:
+    """Write an ICQ grid (6, q + 1, q + 1, 3) in km as an ICQ file (atomically)."""
+    grid = np.asarray(grid, dtype=float)
+    if grid.ndim != 4 or grid.shape[0] != ICQ_CUBE_FACES or grid.shape[1] != grid.shape[2] or grid.shape[3] != 3:
+        raise ValueError(f"grid: expected shape (6, q + 1, q + 1, 3) (cube face, j, i, xyz); got {grid.shape}.")
+    lines = [f"{grid.shape[1] - 1:>8d}\n"] + [f"{x!r} {y!r} {z!r}\n" for x, y, z in grid.reshape(-1, 3).tolist()]
+    with atomic_path(path) as temporary, open(temporary, "w", encoding="utf-8") as stream:
+        stream.writelines(lines)

@@ -8,7 +8,9 @@ the body (A, B, C) = (1, 2, 3) in a short-axis mode (ω = (0.3, 0.2, 1)) and a l
    integrator (``tests/_mp_rigid_body.py``);
 2. the DOP853 variational equations at rtol 1e-13 without torque against the exact STM at t = 3, 20;
 3. the DOP853 variational equations with a perturber's degree-2 torque against Richardson-extrapolated
-   central differences of ``integrate_quaternion`` at rtol 1e-14.
+   central differences of ``integrate_quaternion`` at rtol 1e-14;
+4. the Taylor variational recurrences at tol 1e-14, without torque against the exact STM and with the
+   torque against Richardson differences of ``integrate_taylor`` at tol 1e-14.
 
 Usage::
 
@@ -34,6 +36,8 @@ from _report import machine_line, write_section  # noqa: E402
 from spinorbit.core.dynamics.equations import make_model  # noqa: E402
 from spinorbit.core.free_motion.stm import free_flow_stm  # noqa: E402
 from spinorbit.core.integrators.quaternion import integrate_quaternion  # noqa: E402
+from spinorbit.core.integrators.taylor import integrate_taylor  # noqa: E402
+from spinorbit.core.integrators.taylor_variational import integrate_taylor_variational  # noqa: E402
 from spinorbit.core.integrators.variational import integrate_variational  # noqa: E402
 from spinorbit.core.math.rotations import quat_conjugate, quat_multiply  # noqa: E402
 from spinorbit.core.model.perturbers import kepler_source  # noqa: E402
@@ -45,13 +49,21 @@ STATES = {"SAM": np.array([0.3, 0.2, 1.0]), "LAM": np.array([1.0, 0.2, 0.1])}
 PERTURBER = kepler_source(2.0, 3.0, 0.2, 0.4, 0.3, 0.1, 0.0)
 
 
-def richardson_of_integrator(omega, times, ys, h=2e-4):
+def quaternion_reference(y0, times, model):
+    return integrate_quaternion(y0, 0.0, times, model, rtol=1e-14)
+
+
+def taylor_reference(y0, times, model):
+    return integrate_taylor(y0, 0.0, times, model, tol=1e-14)
+
+
+def richardson_of_integrator(omega, times, ys, integrate=quaternion_reference, h=2e-4):
     def model(dp):
         return make_model(MOMENTS + np.array([dp[0], dp[1], 0.0]) * MOMENTS[2], [PERTURBER])
 
     def run(delta, dp=(0.0, 0.0)):
         y0 = np.concatenate([quat_multiply(Q0, rotation_quaternion(delta[:3])), omega + delta[3:]])
-        y = integrate_quaternion(y0, 0.0, times, model(dp), rtol=1e-14)
+        y = integrate(y0, times, model(dp))
         return np.array([np.concatenate([rotation_vector(quat_multiply(quat_conjugate(ys[k, :4]), y[k, :4])),
                                          y[k, 4:]]) for k in range(times.size)])
 
@@ -83,6 +95,19 @@ def measure():
     fd, fd_p = richardson_of_integrator(omega, times, ys)
     rows.append(("DOP853 variational, SAM, degree-2 torque, t ≤ 20",
                  "Richardson differences of integrate_quaternion (rtol 1e-14)",
+                 np.abs(phi - fd).max(), np.abs(psi - fd_p).max(), max(np.abs(phi).max(), np.abs(psi).max())))
+    for mode, omega in STATES.items():
+        _, phi, psi = integrate_taylor_variational(np.concatenate([Q0, omega]), 0.0, times, make_model(MOMENTS),
+                                                   tol=1e-14)
+        _, _, phi_e, psi_e = free_flow_stm(Q0, omega, MOMENTS, times)
+        rows.append((f"Taylor variational, {mode}, no torque, t ≤ 20", "the exact STM",
+                     np.abs(phi - phi_e).max(), np.abs(psi - psi_e).max(), max(np.abs(phi_e).max(), np.abs(psi_e).max())))
+    omega = STATES["SAM"]
+    ys, phi, psi = integrate_taylor_variational(np.concatenate([Q0, omega]), 0.0, times,
+                                                make_model(MOMENTS, [PERTURBER]), tol=1e-14)
+    fd, fd_p = richardson_of_integrator(omega, times, ys, integrate=taylor_reference)
+    rows.append(("Taylor variational, SAM, degree-2 torque, t ≤ 20",
+                 "Richardson differences of integrate_taylor (tol 1e-14)",
                  np.abs(phi - fd).max(), np.abs(psi - fd_p).max(), max(np.abs(phi).max(), np.abs(psi).max())))
     return rows
 

@@ -6,10 +6,10 @@ do not depend on the angles s and z, and S, Z are constant in the mean. So with 
     Φ̇ = J(t, x) Φ,   J = ∂ẋ/∂x,   Φ(t₀) = 1,
 
 with the columns of J in s and z zero and its rows in S and Z zero. The four live columns (S, Z, H, h)
-are central differences of the closed-form right-hand side (relative steps :data:`ACTION_STEP` in S, Z,
+are central differences of the closed-form right-hand side (relative step :data:`ACTION_STEP` in S, Z,
 with the polhode constants Q, ∂Q/∂S recomputed there; :data:`ANGLE_STEP` in H/Z and h). Why differences
 and not second derivatives written out: ∂Q/∂S is itself a difference of polhode quadratures, so its
-derivative has no closed form here. Their error, ~1e-8 relative in the torque's part of J (the
+derivative has no closed form here. Their error, ~1e-9 relative in Φ (the
 measured agreement with differences of the propagator is in ``docs/fitting.md``), is far below the
 first-order theory's own error ~ε² (ε ≳ 1e-3 where averaging pays).
 
@@ -51,9 +51,15 @@ from spinorbit.core.integrators.elements import ACTION_H, ACTION_S, ACTION_Z, AN
 from spinorbit.core.jit import jit
 from spinorbit.core.model.gravity_field import BODY_NMAX
 
-#: Relative step of the central differences of the right-hand side in S and Z (truncation ~1e-8,
-#: rounding of ∂Q/∂S, itself a difference with step 1e-6, ~1e-10/1e-4 = 1e-6 of the torque's ∂²Q/∂S²).
-ACTION_STEP = 1e-4
+#: Relative step of the central differences of the right-hand side in S and Z. Measured in the
+#: Apophis-like test scene: Φ(s, S) changes by 2.5e-8 relative from 1e-4 to 1e-5 and by 2e-10 from 1e-5
+#: to 1e-6 (truncation ∝ step²; the rounding of ∂Q/∂S, a difference with step 1e-6, enters only the
+#: torque's small share).
+ACTION_STEP = 1e-5
+#: Relative step of the central difference of the reduction's shift N (P, Δg) in S and Z: P and Δg are
+#: closed-form elliptic integrals (rounding ~1e-16/1e-7), and near the separatrix they curve strongly
+#: (P'' S/P' ~ 1e2 in the Apophis-like test scene), so a larger step errs by ~(step · 1e2)².
+REDUCTION_STEP = 1e-7
 #: Step of the central differences in H (relative to Z) and in h (rad): truncation and rounding ~1e-10.
 ANGLE_STEP = 1e-5
 #: Rows of the augmented state: the elements, then Φ (6 × 6, row-major).
@@ -137,14 +143,15 @@ def _wrapped(delta):
     return delta - 2.0 * math.pi * np.rint(delta / (2.0 * math.pi))
 
 
-def _reduced_with_jacobian(elements, ic, steps):
+def _reduced_with_jacobian(elements, ic):
     """(reduced elements, R = ∂reduced/∂unreduced) of :func:`reduce_phase` at its own number of periods."""
     reduced = elements.copy()
     periods = reduce_phase(reduced, ic)
     jac = np.eye(ELEMENT_SIZE)
     if periods == 0.0:
         return reduced, jac
-    for c, step in ((ACTION_S, steps[0]), (ACTION_Z, steps[1])):
+    for c in (ACTION_S, ACTION_Z):
+        step = REDUCTION_STEP * abs(elements[ACTION_Z])
         shifted = []
         for sign in (1.0, -1.0):
             work = elements.copy()
@@ -232,6 +239,6 @@ def mean_elements_stm(mean0, t0, t_out, model, frame, orbit_averaged=False, max_
     mean = np.empty((t_out.size, ELEMENT_SIZE))
     phi = np.empty((t_out.size, ELEMENT_SIZE, ELEMENT_SIZE))
     for i in range(written):
-        mean[i], reduction = _reduced_with_jacobian(out[i, :ELEMENT_SIZE], ic, steps)
+        mean[i], reduction = _reduced_with_jacobian(out[i, :ELEMENT_SIZE], ic)
         phi[i] = reduction @ out[i, Y_PHI:].reshape(ELEMENT_SIZE, ELEMENT_SIZE)
     return mean, phi

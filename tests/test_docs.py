@@ -33,7 +33,7 @@ API_NAMES = {
     "special": ["ellipj", "am", "ellipk", "ellipf", "ellippi", "pn"],
     "core": ["andoyer_to_canonical", "canonical_to_andoyer"],
     "fit": ["fit_rotation", "FitResult", "AttitudeObservation", "PeriodObservation", "free_flow_stm",
-            "integrate_variational", "integrate_taylor_variational"],
+            "integrate_variational", "integrate_taylor_variational", "mean_elements_stm"],
     "integrators": ["integrate_taylor", "integrate_taylor_fixed_step", "taylor_series", "TaylorFallbackWarning",
                     "integrate_elements_fixed_step"],
     "time": ["tdb_days", "tdb_day_and_fraction", "time_from_tdb_days", "J2000_JD_TDB"],

@@ -28,7 +28,11 @@ import math
 
 import numpy as np
 
-from spinorbit.core.averaging.mean_equations import degree2_mean_rhs, mean_constants, moments_of
+from spinorbit.core.averaging.mean_equations import (
+    degree2_mean_rhs,
+    mean_constants,
+    moments_of,
+)
 from spinorbit.core.averaging.propagate import (
     INVALID_PERTURBATION,
     INVALID_RESONANCE,
@@ -39,15 +43,32 @@ from spinorbit.core.averaging.propagate import (
     RADIAL_STEP_FRACTION,
     STEPS_PER_TURN,
     VALID,
+    checked_max_step,
     free_motion_numbers,
     perturber_numbers,
     validity_code,
 )
-from spinorbit.core.dynamics.validation import check_step_budget, validate_output_times, validate_sampled_span
+from spinorbit.core.dynamics.validation import (
+    validate_output_times,
+    validate_sampled_span,
+)
 from spinorbit.core.elements.canonical import inertia_constants
 from spinorbit.core.elements.equations import reduce_phase
-from spinorbit.core.integrators.dop853 import DEFAULT_MAX_STEPS, dop853_scratch, dop853_step, landing_step
-from spinorbit.core.integrators.elements import ACTION_H, ACTION_S, ACTION_Z, ANGLE_H, ANGLE_S, ANGLE_Z, ELEMENT_SIZE
+from spinorbit.core.integrators.dop853 import (
+    DEFAULT_MAX_STEPS,
+    dop853_scratch,
+    dop853_step,
+    landing_step,
+)
+from spinorbit.core.integrators.elements import (
+    ACTION_H,
+    ACTION_S,
+    ACTION_Z,
+    ANGLE_H,
+    ANGLE_S,
+    ANGLE_Z,
+    ELEMENT_SIZE,
+)
 from spinorbit.core.jit import jit
 from spinorbit.core.model.gravity_field import BODY_NMAX
 
@@ -211,12 +232,7 @@ def mean_elements_stm(mean0, t0, t_out, model, frame, orbit_averaged=False, max_
     t0 = float(t0)
     t_out = validate_output_times(t0, t_out)
     validate_sampled_span(model, t0, t_out)
-    span = abs(t_out[-1] - t0)
-    if max_step is None:
-        max_step = span / 64.0 if orbit_averaged else span
-    if not (math.isfinite(max_step) and max_step > 0.0):
-        raise ValueError(f"max_step: expected a finite step > 0 (time unit of the model), got {max_step!r}.")
-    check_step_budget("mean_elements_stm", span / max_step, max_steps, "raise max_step or shorten the span")
+    max_step = checked_max_step("mean_elements_stm", t0, t_out, max_step, orbit_averaged, max_steps)
     moments = moments_of(model)
     ic = inertia_constants(*moments)
     big_s, big_z = mean0[ACTION_S], mean0[ACTION_Z]

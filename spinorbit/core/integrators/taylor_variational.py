@@ -311,13 +311,8 @@ def integrate_taylor_variational(y0, t0, t_out, model, tol=1e-10, max_steps=DEFA
 
     Parameters
     ----------
-    y0 : array_like (7,)
-        (q, ω): scalar-first quaternion (principal axes → inertial, normalised here) and body angular
-        velocity on the principal axes (rad per time unit of the model).
-    t0 : float
-        Initial time.
-    t_out : array_like (n,)
-        Output times, strictly monotone away from t0.
+    y0, t0, t_out
+        As in :func:`spinorbit.core.integrators.variational.integrate_variational`.
     model : ndarray
         :func:`spinorbit.core.dynamics.equations.make_model`; any perturbers act through the degree-2
         torque (a degree-3/4 figure with perturbers, or a lunar interior, is refused).

@@ -11,8 +11,9 @@ the body (A, B, C) = (1, 2, 3) in a short-axis mode (ω = (0.3, 0.2, 1)) and a l
    central differences of ``integrate_quaternion`` at rtol 1e-14;
 4. the Taylor variational recurrences at tol 1e-14, without torque against the exact STM and with the
    torque against Richardson differences of ``integrate_taylor`` at tol 1e-14;
-5. the averaged propagator's mean-element STM (Apophis-like scene, solar torque × 10, t = 10, 30 d)
-   against central differences of ``propagate_averaged`` (step 1e-7).
+5. the averaged propagator's mean-element STM (Apophis-like scene, solar torque × 10, t = 10, 30 d;
+   doubly averaged t = 100, 400 d) against central differences of ``propagate_averaged`` (step 1e-7),
+   and its osculating-element STM against differences of its osculating output (step 1e-6).
 
 Usage::
 
@@ -37,10 +38,12 @@ from _report import machine_line, write_section  # noqa: E402
 
 from test_stm import apophis_mean_problem  # noqa: E402
 
-from spinorbit.core.averaging.mean_variational import mean_elements_stm  # noqa: E402
-from spinorbit.core.averaging.propagate import propagate_averaged  # noqa: E402
+from spinorbit.core.averaging.mean_equations import moments_of  # noqa: E402
+from spinorbit.core.averaging.mean_variational import mean_elements_stm, osculating_elements_stm  # noqa: E402
+from spinorbit.core.averaging.propagate import propagate_averaged, state_of_elements  # noqa: E402
 from spinorbit.core.dynamics.equations import make_model  # noqa: E402
 from spinorbit.core.free_motion.stm import free_flow_stm  # noqa: E402
+from spinorbit.core.integrators.elements import elements_of_state  # noqa: E402
 from spinorbit.core.integrators.quaternion import integrate_quaternion  # noqa: E402
 from spinorbit.core.integrators.taylor import integrate_taylor  # noqa: E402
 from spinorbit.core.integrators.taylor_variational import integrate_taylor_variational  # noqa: E402
@@ -115,28 +118,52 @@ def measure():
     rows.append(("Taylor variational, SAM, degree-2 torque, t ≤ 20",
                  "Richardson differences of integrate_taylor (tol 1e-14)",
                  np.abs(phi - fd).max(), np.abs(psi - fd_p).max(), max(np.abs(phi).max(), np.abs(psi).max())))
-    rows.append(averaged_row())
+    rows.extend(averaged_rows())
     return rows
 
 
-def averaged_row(step=1e-7):
-    y0, model, frame, mean0 = apophis_mean_problem()
-    times = np.array([10.0, 30.0])
-    _, phi = mean_elements_stm(mean0, 0.0, times, model, frame)
-
-    def run(m0):
-        return propagate_averaged(y0, 0.0, times, model, frame=frame, mean0=m0, hand_over=False).mean_elements
-
-    fd = np.zeros_like(phi)
+def differences(run, x0, step):
+    """Central differences of run (6 elements in, (n, 6) out) in each element, z and h mod 2π."""
+    columns = []
     for j in range(6):
-        h = step * (abs(mean0[1]) if j < 3 else 1.0)
+        h = step * (abs(x0[1]) if j < 3 else 1.0)
         delta = np.zeros(6)
         delta[j] = h
-        diff = run(mean0 + delta) - run(mean0 - delta)
+        diff = run(x0 + delta) - run(x0 - delta)
         diff[:, 4:] -= 2 * np.pi * np.rint(diff[:, 4:] / (2 * np.pi))  # z, h are angles
-        fd[:, :, j] = diff / (2 * h)
-    return ("averaged mean elements, Apophis-like (Sun × 10), t ≤ 30 d", "central differences of propagate_averaged",
-            np.abs(phi - fd).max(), None, np.abs(phi).max())
+        columns.append(diff / (2 * h))
+    return np.stack(columns, axis=-1)
+
+
+def averaged_rows():
+    y0, model, frame, mean0 = apophis_mean_problem()
+    rows = []
+    for orbit_averaged, times, label in ((False, np.array([10.0, 30.0]), "t ≤ 30 d"),
+                                         (True, np.array([100.0, 400.0]), "doubly averaged, t ≤ 400 d")):
+        _, phi = mean_elements_stm(mean0, 0.0, times, model, frame, orbit_averaged=orbit_averaged)
+
+        def run(m0, times=times, orbit_averaged=orbit_averaged):
+            return propagate_averaged(y0, 0.0, times, model, frame=frame, mean0=m0, hand_over=False,
+                                      orbit_averaged=orbit_averaged).mean_elements
+
+        fd = differences(run, mean0, 1e-7)
+        rows.append((f"averaged mean elements, Apophis-like (Sun × 10), {label}",
+                     "central differences of propagate_averaged", np.abs(phi - fd).max(), None, np.abs(phi).max()))
+    moments = moments_of(model)
+    osc0 = elements_of_state(y0, model, frame)
+    times = np.array([10.0, 30.0])
+    _, phi = osculating_elements_stm(osc0, 0.0, times, model, frame)
+
+    def run_osculating(x0):
+        res = propagate_averaged(state_of_elements(x0, frame, moments), 0.0, times, model, frame=frame,
+                                 hand_over=False, osculating=True)
+        return np.array([elements_of_state(state, model, frame) for state in res.states])
+
+    fd = differences(run_osculating, osc0, 1e-6)
+    rows.append(("averaged osculating elements, Apophis-like (Sun × 10), t ≤ 30 d",
+                 "central differences of propagate_averaged's osculating output", np.abs(phi - fd).max(), None,
+                 np.abs(phi).max()))
+    return rows
 
 
 def markdown(rows):

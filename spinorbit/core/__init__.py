@@ -19,7 +19,8 @@ The stable entry points, importable from here (scripts written against them keep
 - state transition matrices and moment-ratio sensitivities: :func:`free_flow_stm` (exact, through
   the elements), :func:`integrate_variational` (DOP853 with its variational equations) and
   :func:`integrate_taylor_variational` (the Taylor method with the recurrences of its variational equations),
-  and :func:`mean_elements_stm` (the averaged propagator's mean elements);
+  and :func:`mean_elements_stm`, :func:`osculating_elements_stm` (the averaged propagator's mean and
+  osculating elements);
 - the errors :class:`SpinorbitError`, :class:`SingularElementsError` and :class:`NonFiniteError`.
 
 They load on first use (PEP 562), so importing one integrator does not import the others.
@@ -47,6 +48,7 @@ _ENTRY_POINTS = {
     "integrate_variational": "spinorbit.core.integrators.variational",
     "integrate_taylor_variational": "spinorbit.core.integrators.taylor_variational",
     "mean_elements_stm": "spinorbit.core.averaging.mean_variational",
+    "osculating_elements_stm": "spinorbit.core.averaging.mean_variational",
     "SpinorbitError": "spinorbit.core.errors",
     "SingularElementsError": "spinorbit.core.errors",
     "NonFiniteError": "spinorbit.core.errors",

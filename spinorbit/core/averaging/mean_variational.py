@@ -1,4 +1,4 @@
-"""STM of the averaged propagator: ∂(mean elements at t)/∂(mean elements at t₀), by variational equations.
+"""STM of the averaged propagator: ∂(mean elements at t)/∂(mean elements at t₀) by variational equations, and the osculating one.
 
 The mean equations with the closed-form degree-2 ⟨U⟩ (:func:`spinorbit.core.averaging.mean_equations.degree2_mean_rhs`)
 do not depend on the angles s and z, and S, Z are constant in the mean. So with x = (S, Z, H, s, z, h)
@@ -19,9 +19,11 @@ unreduced on the way and reduced at each output by :func:`spinorbit.core.element
 whose shift of N periods, s → s − N P(S, Z), z → z + N Δg(S, Z), adds N ∂(P, Δg)/∂(S, Z) to the
 rows of s and z (a central difference of the shift at fixed N).
 
+The osculating elements' STM (:func:`osculating_elements_stm`) chains Φ with the Jacobians of the
+short-period maps at both ends (explicit maps, by central differences).
+
 Scope: the degree-2 closed form (figures of degree 2), without hand-over: a run that meets an invalid
-stretch is refused. Not covered: the short-period map to the osculating state, and sensitivities to
-the moment ratios.
+stretch is refused. Not covered: sensitivities to the moment ratios.
 """
 
 import math
@@ -48,6 +50,7 @@ from spinorbit.core.averaging.propagate import (
     perturber_numbers,
     validity_code,
 )
+from spinorbit.core.averaging.short_period import mean_to_osculating, osculating_to_mean
 from spinorbit.core.dynamics.validation import (
     validate_output_times,
     validate_sampled_span,
@@ -164,6 +167,29 @@ def _wrapped(delta):
     return delta - 2.0 * math.pi * np.rint(delta / (2.0 * math.pi))
 
 
+def element_map_jacobian(function, elements, relative_step):
+    """∂function(x)/∂x at x = ``elements`` by central differences, for a map between element sets.
+
+    Steps: ``relative_step`` × Z in (S, Z, H), ``relative_step`` rad in (s, z, h); differences of z, h
+    are taken mod 2π. A map whose reduction of s changes inside ±step (a jump of a whole period)
+    is refused rather than differenced across the jump.
+    """
+    elements = np.asarray(elements, dtype=float)
+    jac = np.empty((ELEMENT_SIZE, ELEMENT_SIZE))
+    for c in range(ELEMENT_SIZE):
+        step = relative_step * (abs(elements[ACTION_Z]) if c < ANGLE_S else 1.0)
+        plus, minus = elements.copy(), elements.copy()
+        plus[c] += step
+        minus[c] -= step
+        diff = np.asarray(function(plus), dtype=float) - np.asarray(function(minus), dtype=float)
+        diff[ANGLE_Z:] = _wrapped(diff[ANGLE_Z:])
+        if not np.all(np.abs(diff) < 1e3 * step):
+            raise ValueError("the reduction of s jumps by a period within the difference step at this point; "
+                             "move the time or the state slightly.")
+        jac[:, c] = diff / (2.0 * step)
+    return jac
+
+
 def _reduced_with_jacobian(elements, ic):
     """(reduced elements, R = ∂reduced/∂unreduced) of :func:`reduce_phase` at its own number of periods."""
     reduced = elements.copy()
@@ -258,3 +284,53 @@ def mean_elements_stm(mean0, t0, t_out, model, frame, orbit_averaged=False, max_
         mean[i], reduction = _reduced_with_jacobian(out[i, :ELEMENT_SIZE], ic)
         phi[i] = reduction @ out[i, Y_PHI:].reshape(ELEMENT_SIZE, ELEMENT_SIZE)
     return mean, phi
+
+
+#: Relative step of the central differences of the short-period map and its inverse. The map drops
+#: harmonics below HARMONIC_NOISE = 1e-11 (``short_period.py``), so its Jacobian errs by ~1e-11/step
+#: = 1e-6 absolute on entries ~1; the first-order theory itself errs by ~ε² ≳ 1e-6.
+SHORT_PERIOD_STEP = 1e-5
+
+
+def osculating_elements_stm(osc0, t0, t_out, model, frame, **options):
+    """Osculating elements at t_out and ∂osc(t)/∂osc(t0) of the averaged propagator, through its short-period map.
+
+    osc(t) = mean_to_osculating(t, x(t)), x(t0) = osculating_to_mean(t0, osc0), as in
+    :func:`spinorbit.core.averaging.propagate.propagate_averaged`, so the STM is
+    M(t) Φ(t) ∂x(t0)/∂osc0, with Φ from :func:`mean_elements_stm` and the two Jacobians of the
+    short-period maps by central differences (:data:`SHORT_PERIOD_STEP`: they are explicit maps, not
+    flows, so a difference has no error growth with t).
+
+    Parameters
+    ----------
+    osc0 : array_like (6,)
+        Osculating elements at t0 in ``frame`` (e.g. ``elements_of_state(y0, model, frame)``).
+    t0, t_out, model, frame, options
+        As in :func:`mean_elements_stm`.
+
+    Returns
+    -------
+    osc : (n, 6) ndarray
+        Osculating elements at t_out.
+    phi : (n, 6, 6) ndarray
+        ∂osc(t)/∂osc(t0).
+    """
+    osc0 = np.asarray(osc0, dtype=float)
+    if osc0.shape != (ELEMENT_SIZE,) or not np.all(np.isfinite(osc0)):
+        raise ValueError(f"osc0: expected 6 finite osculating elements (S, Z, H, s, z, h), got {osc0!r}.")
+    model = np.ascontiguousarray(model, dtype=float)
+    frame = np.ascontiguousarray(frame, dtype=float)
+    ic = inertia_constants(*moments_of(model))
+    t0 = float(t0)
+    mean0 = osculating_to_mean(t0, osc0, model, frame, ic)
+    into_mean = element_map_jacobian(lambda x: osculating_to_mean(t0, x, model, frame, ic), osc0, SHORT_PERIOD_STEP)
+    mean, phi = mean_elements_stm(mean0, t0, t_out, model, frame, **options)
+    t_out = validate_output_times(t0, t_out)
+    osc = np.empty_like(mean)
+    phi_osc = np.empty_like(phi)
+    for i, t in enumerate(t_out):
+        osc[i] = mean_to_osculating(float(t), mean[i], model, frame, ic)
+        out_of_mean = element_map_jacobian(lambda x, t=float(t): mean_to_osculating(t, x, model, frame, ic), mean[i],
+                                           SHORT_PERIOD_STEP)
+        phi_osc[i] = out_of_mean @ phi[i] @ into_mean
+    return osc, phi_osc

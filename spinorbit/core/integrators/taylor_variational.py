@@ -326,12 +326,9 @@ def integrate_taylor_variational(y0, t0, t_out, model, tol=1e-10, max_steps=DEFA
 
     Returns
     -------
-    ys : (n, 7) ndarray
-        (q, ω) at t_out.
-    phi : (n, 6, 6) ndarray
-        ∂(δθ, ω)(t)/∂(δθ, ω)(t0) (``docs/conventions.md``).
-    psi : (n, 6, 2) ndarray
-        ∂(δθ, ω)(t)/∂(A/C, B/C) at fixed C and fixed initial state.
+    ys, phi, psi : ndarray
+        (q, ω) (n, 7), Φ (n, 6, 6) and Ψ (n, 6, 2) at t_out, as from
+        :func:`spinorbit.core.integrators.variational.integrate_variational`.
     stats : dict, optional
 
     Raises

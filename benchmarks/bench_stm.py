@@ -7,6 +7,11 @@ the STM is ∂(δθ, ω)/∂(δθ₀, ω₀) and Ψ = ∂/∂(A/C, B/C) (``docs/
 - exact flow: :func:`torque_free_states` against :func:`free_flow_stm` without and with Ψ;
 - DOP853 at rtol 1e-10: :func:`integrate_quaternion` against :func:`integrate_variational` (Φ and Ψ in one
   55-component state), torque-free and with a perturber's degree-2 torque;
+- Taylor at tol 1e-10: :func:`integrate_taylor` against :func:`integrate_taylor_variational` (the
+  recurrences of Φ and Ψ along the state's series), torque-free and with the same perturber;
+- averaged (a different problem, the Apophis-like scene of tests/test_stm.py with the solar torque × 10,
+  30 days, 2 outputs): :func:`propagate_averaged` from mean elements against :func:`mean_elements_stm`
+  (the mean equations' variational equations, stepped in time);
 - heyoka (double precision, compact mode, tol 1e-10): the same 7 equations in (q, ω) with the ratios as
   runtime parameters, plain and through ``var_ode_sys`` with respect to the 7 variables and the 2
   parameters (70 components), ``propagate_grid`` on the same times.
@@ -21,6 +26,7 @@ Usage::
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -31,10 +37,14 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from _report import interleaved_timings, machine_line, repeat_main  # noqa: E402
 
+from spinorbit.core.averaging.mean_variational import mean_elements_stm  # noqa: E402
+from spinorbit.core.averaging.propagate import propagate_averaged  # noqa: E402
 from spinorbit.core.dynamics.equations import make_model  # noqa: E402
 from spinorbit.core.free_motion.flow import torque_free_states  # noqa: E402
 from spinorbit.core.free_motion.stm import free_flow_stm  # noqa: E402
 from spinorbit.core.integrators.quaternion import integrate_quaternion  # noqa: E402
+from spinorbit.core.integrators.taylor import integrate_taylor  # noqa: E402
+from spinorbit.core.integrators.taylor_variational import integrate_taylor_variational  # noqa: E402
 from spinorbit.core.integrators.variational import integrate_variational  # noqa: E402
 from spinorbit.core.model.perturbers import kepler_source  # noqa: E402
 from spinorbit.data.asteroids import toutatis_rotation_state  # noqa: E402
@@ -105,6 +115,19 @@ def local_from_quaternion_stm(rows, q0):
     return np.array(phis), np.array(psis)
 
 
+def averaged_row(repeat):
+    """The averaged propagator on its own problem (the Apophis-like scene of tests/test_stm.py)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+    from test_stm import apophis_mean_problem
+
+    y0, model, frame, mean0 = apophis_mean_problem()
+    times = np.array([10.0, 30.0])
+    pair = [lambda: propagate_averaged(y0, 0.0, times, model, frame=frame, mean0=mean0, hand_over=False),
+            lambda: mean_elements_stm(mean0, 0.0, times, model, frame)]
+    timings, _ = interleaved_timings(pair, repeat, warm_up=True)
+    return ("averaged, Apophis-like (Sun × 10), 30 d", "Φ of the mean elements", timings[0], timings[1], "–")
+
+
 def measure(repeat):
     y0, moments = problem()
     q0, w0 = y0[:4], y0[4:]
@@ -130,6 +153,13 @@ def measure(repeat):
         timings, results = interleaved_timings(pair, repeat, warm_up=True)
         accuracy = f"{error(*results[1][1:]):.1e}" if model is free else "–"
         rows.append((label, "Φ and Ψ", timings[0], timings[1], accuracy))
+    for label, model in ((f"Taylor tol {RTOL:g}, torque-free", free), (f"Taylor tol {RTOL:g}, degree-2 torque", torqued)):
+        pair = [lambda model=model: integrate_taylor(y0, 0.0, TIMES, model, tol=RTOL),
+                lambda model=model: integrate_taylor_variational(y0, 0.0, TIMES, model, tol=RTOL)]
+        timings, results = interleaved_timings(pair, repeat, warm_up=True)
+        accuracy = f"{error(*results[1][1:]):.1e}" if model is free else "–"
+        rows.append((label, "Φ and Ψ", timings[0], timings[1], accuracy))
+    rows.append(averaged_row(repeat))
     try:
         plain, variational, size = heyoka_pair(y0, moments)
     except ImportError:
@@ -144,9 +174,10 @@ def markdown(measured, repeat):
     rows, scale = measured
     lines = ["## The cost of an STM (`benchmarks/bench_stm.py`)", "",
              f"Toutatis (Takahashi et al. 2013 state), {SPAN_DAYS:g} days, {TIMES.size} output times; "
-             f"DOP853 at rtol {RTOL:g}, heyoka at tol {RTOL:g} (double, compact mode). Wall time in ms: median "
+             f"DOP853 at rtol {RTOL:g}, Taylor and heyoka at tol {RTOL:g} (heyoka in double, compact mode). Wall time in ms: median "
              f"(min–max) of {repeat} interleaved repeats after a warm-up call. The machine's 2 cores were shared "
-             "with other work while this ran, so the spread is wide; the ratios of interleaved calls are the "
+             f"with other work while this ran (load average {os.getloadavg()[0]:.1f} when the table was written), "
+             "so the spread is wide; the ratios of interleaved calls are the "
              "robust numbers.", "",
              "| back end | sensitivities | plain propagation (ms) | with STM (ms) | ratio (median) | "
              "max \\|Δ(Φ, Ψ)\\| against the exact STM |",
@@ -158,8 +189,10 @@ def markdown(measured, repeat):
               "one over all output times (the largest entry is " + (f"{scale:.0f}" if scale else "–") + "); heyoka's rows ∂(q, ω)/∂(q₀, ω₀) are "
               "mapped with δq₀ = ½ q₀ ⊗ (0, δθ₀) and δθ = 2 vec(q⁻¹ ⊗ δq).", "", "The exact STM costs one section-4 Jacobian and a 6 × 6 product per output time over the flow; "
               "Ψ adds a Gauss–Legendre quadrature over the whole span (16 nodes per 1/4 of the shortest period), "
-              "which dominates. Not measured: the Taylor integrator and the averaged propagator, which have no "
-              "variational equations yet.", "", machine_line()]
+              "which dominates. The Taylor STM's recurrences cost O(p²) per step and column like the state's own, "
+              "for 8 columns (Φ and Ψ). The averaged row is a different problem (2 outputs): "
+              "its STM's right-hand side costs 9 evaluations of the mean one (central differences in S, Z, H, h), "
+              "and the plain run steps in the Sun's true anomaly, the STM in time.", "", machine_line()]
     return "\n".join(lines)
 
 

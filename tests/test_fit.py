@@ -101,7 +101,7 @@ def mixed_observations(rng):
     return observations
 
 
-@pytest.mark.parametrize("backend", ["exact", "dop853"])
+@pytest.mark.parametrize("backend", ["exact", "dop853", "taylor"])
 def test_the_analytic_jacobian_matches_central_differences_of_the_residuals(backend):
     # Every observation kind, both sides of the epoch, at a point off the truth (δθ ≠ 0 exercises
     # J_r). Reference: central differences with h = 1e-6 (relative to each parameter's scale), whose
@@ -109,7 +109,7 @@ def test_the_analytic_jacobian_matches_central_differences_of_the_residuals(back
     rng = np.random.default_rng(3)
     observations = mixed_observations(rng)
     days = np.array([(obs.epoch.tdb - EPOCH.tdb).to_value(u.day) for obs in observations])
-    sources = (PERTURBER,) if backend == "dop853" else ()
+    sources = (PERTURBER,) if backend in ("dop853", "taylor") else ()
     problem = ResidualModel(observations, days, CORE[:4], MOMENTS[2], P, True, TRUE_Z[6:], backend, sources, 1e-13)
     z = TRUE_Z + np.array([0.02, -0.01, 0.03, 0.01, -0.01, 0.02, 0.01, -0.005])
     _, jacobian = problem.evaluate(z)

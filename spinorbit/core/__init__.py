@@ -17,7 +17,10 @@ The stable entry points, importable from here (scripts written against them keep
 - each integrator: :func:`integrate_quaternion`, :func:`integrate_elements`, :func:`integrate_taylor`,
   :func:`integrate_splitting`, :func:`integrate_with_handover`, :func:`propagate_averaged`;
 - state transition matrices and moment-ratio sensitivities: :func:`free_flow_stm` (exact, through
-  the elements) and :func:`integrate_variational` (DOP853 with its variational equations);
+  the elements), :func:`integrate_variational` (DOP853 with its variational equations) and
+  :func:`integrate_taylor_variational` (the Taylor method with the recurrences of its variational equations),
+  and :func:`mean_elements_stm`, :func:`osculating_elements_stm` (the averaged propagator's mean and
+  osculating elements);
 - the full two-body problem of a binary asteroid: :func:`make_binary_model` (the mutual potential's
   model array) and :func:`propagate_binary` (relative orbit and both attitudes, DOP853);
 - the errors :class:`SpinorbitError`, :class:`SingularElementsError` and :class:`NonFiniteError`.
@@ -45,6 +48,9 @@ _ENTRY_POINTS = {
     "propagate_averaged": "spinorbit.core.averaging.propagate",
     "free_flow_stm": "spinorbit.core.free_motion.stm",
     "integrate_variational": "spinorbit.core.integrators.variational",
+    "integrate_taylor_variational": "spinorbit.core.integrators.taylor_variational",
+    "mean_elements_stm": "spinorbit.core.averaging.mean_variational",
+    "osculating_elements_stm": "spinorbit.core.averaging.mean_variational",
     "make_binary_model": "spinorbit.core.binary.equations",
     "propagate_binary": "spinorbit.core.binary.propagate",
     "SpinorbitError": "spinorbit.core.errors",

@@ -164,7 +164,7 @@ class ResidualModel:
         except SingularElementsError as error:
             raise FitError(f"the exact STM is undefined at this iterate ({error}); use backend='dop853'.") from None
         except IntegrationError as error:
-            raise FitError(f"the DOP853 propagation with its STM stopped at this iterate ({error}).") from None
+            raise FitError(f"the {self.backend} propagation with its STM stopped at this iterate ({error}).") from None
         rows, jac = [], []
         attitude_chain = right_jacobian(z[:3])
         for k, obs in enumerate(self.observations):
@@ -240,12 +240,13 @@ def fit_rotation(observations, first_guess, epoch, *, fit_moments=True, sources=
         lengths and μ in the units of the moments' time unit, day), for a torqued fit.
     span : (Time, Time), optional
         The span on which the model holds; observations outside it are refused.
-    backend : {"auto", "exact", "dop853"}
+    backend : {"auto", "exact", "dop853", "taylor"}
         "auto": the exact free-flow STM without sources, DOP853 variational equations with them.
+        "taylor": the Taylor integrator's variational recurrences (with or without sources).
     multi_start : int
         Number of starts over the phase about the angular momentum (module docstring).
     rtol : float
-        DOP853 tolerance of the propagation and its STM.
+        DOP853 (or Taylor) tolerance of the propagation and its STM.
     max_nfev : int
         Cap on least_squares' function evaluations per start.
     correlation_threshold, condition_threshold : float

@@ -2,7 +2,9 @@
 
 ``exact``: the torque-free flow with its exact STM (:func:`spinorbit.core.free_motion.stm.free_flow_stm`);
 ``dop853``: the quaternion integrator with its variational equations
-(:func:`spinorbit.core.integrators.variational.integrate_variational`), with or without torques. Times
+(:func:`spinorbit.core.integrators.variational.integrate_variational`), with or without torques;
+``taylor``: the Taylor integrator with the recurrences of its variational equations
+(:func:`spinorbit.core.integrators.taylor_variational.integrate_taylor_variational`, tol = rtol). Times
 are TDB days since the fit's epoch, on both sides of it (the integrator runs each way from t = 0).
 """
 
@@ -10,9 +12,10 @@ import numpy as np
 
 from spinorbit.core.dynamics.equations import make_model
 from spinorbit.core.free_motion.stm import free_flow_stm
+from spinorbit.core.integrators.taylor_variational import integrate_taylor_variational
 from spinorbit.core.integrators.variational import integrate_variational
 
-BACKENDS = ("exact", "dop853")
+BACKENDS = ("exact", "dop853", "taylor")
 
 
 def propagate_with_stm(backend, q0, omega0, moments, times, sources=(), rtol=1e-11):
@@ -36,7 +39,10 @@ def propagate_with_stm(backend, q0, omega0, moments, times, sources=(), rtol=1e-
             continue
         order = chosen[np.argsort(sign * times[chosen])]
         unique, inverse = np.unique(sign * times[order], return_inverse=True)
-        ys, phis, psis = integrate_variational(y0, 0.0, sign * unique, model, rtol=rtol)
+        if backend == "taylor":
+            ys, phis, psis = integrate_taylor_variational(y0, 0.0, sign * unique, model, tol=rtol)
+        else:
+            ys, phis, psis = integrate_variational(y0, 0.0, sign * unique, model, rtol=rtol)
         q[order], w[order] = ys[inverse, :4], ys[inverse, 4:]
         phi[order], psi[order] = phis[inverse], psis[inverse]
     return q, w, phi, psi

@@ -425,6 +425,19 @@ class AveragedResult:
         self.segments, self.frame, self.steps = segments, frame, steps
 
 
+def checked_max_step(name, t0, t_out, max_step, orbit_averaged, max_steps):
+    """The mean equations' largest step (default: the span, span/64 orbit-averaged), checked, and the run
+    refused before its first step when span / max_step (a lower bound on the steps) exceeds max_steps."""
+    span = abs(t_out[-1] - t0)
+    if max_step is None:
+        max_step = span / 64.0 if orbit_averaged else span
+    if not (math.isfinite(max_step) and max_step > 0.0):
+        raise ValueError(f"max_step: expected a finite step > 0 (time unit of the model), got {max_step!r}.")
+    # a lower bound (the orbital rate only shortens the steps), known before the first step
+    check_step_budget(name, span / max_step, max_steps, "raise max_step or shorten the span")
+    return float(max_step)
+
+
 def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False, quadrature=None,
                        osculating=False, hand_over=True, min_frequency_ratio=MIN_FREQUENCY_RATIO,
                        max_perturbation=MAX_PERTURBATION, min_separatrix_distance=MIN_SEPARATRIX_DISTANCE,
@@ -493,13 +506,7 @@ def propagate_averaged(y0, t0, t_out, model, max_step=None, orbit_averaged=False
         raise ValueError("model: propagate_averaged averages conservative torques only (its mean S and Z are constant); "
                          "sunlight's recoil changes them. Use spinorbit.core.averaging.thermal_mean."
                          "propagate_mean_thermal for the mean YORP evolution, or a full integrator.")
-    span = abs(t_out[-1] - t0)
-    if max_step is None:
-        max_step = span / 64.0 if orbit_averaged else span
-    if not (math.isfinite(max_step) and max_step > 0.0):
-        raise ValueError(f"max_step: expected a finite step > 0 (time unit of the model), got {max_step!r}.")
-    # a lower bound (the orbital rate only shortens the steps), known before the first step
-    check_step_budget("propagate_averaged", span / max_step, max_steps, "raise max_step or shorten the span")
+    max_step = checked_max_step("propagate_averaged", t0, t_out, max_step, orbit_averaged, max_steps)
     moments = moments_of(model)
     ic = inertia_constants(*moments)
     if frame is None:

@@ -377,3 +377,11 @@ def taylor_series(t, y, model, order):
     seed_perturbers(t, model, s, n_pert, np.inf, 1.0, 0.0, np.zeros(max(n_pert, 1), dtype=np.int64), True)
     taylor_coefficients_into(t, model, s, n_pert, order, 0.0, 0.0, np.zeros(max(n_pert, 1), dtype=np.int64))
     return s[:STATE_SIZE].copy()
+
+
+#: Public names of the series array's layout, for modules that read the rows this one fills (the Taylor
+#: variational equations need the body-frame position and |r|⁻⁵ of each perturber).
+SERIES_HEAD_ROWS = _HEAD_ROWS
+PERTURBER_BLOCK_ROWS = _BLOCK_ROWS
+BODY_POSITION_OFFSET = _B
+INVERSE_R5_OFFSET = _S5

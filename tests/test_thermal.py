@@ -203,3 +203,21 @@ def test_bad_thermal_input_is_refused():
     sun = kepler_source(GM_SUN, 1.0, 0.1, 0.0, 0.0, 0.0, 0.0, sign=-1.0)
     with pytest.raises(ValueError, match="no transcription of the thermal"):
         make_rhs(make_model([1.0, 2.0, 3.0], [sun], thermal=block))
+
+
+def test_sensitivities_refuse_a_thermal_model():
+    """The STMs linearise gravity only: with the recoil in the model their Φ and Ψ would miss its part."""
+    from spinorbit.core.averaging.mean_variational import mean_elements_stm
+    from spinorbit.core.integrators.taylor_variational import integrate_taylor_variational
+    from spinorbit.core.integrators.variational import integrate_variational
+
+    normals, areas, centroids = facets_of(ellipsoid_shape([1.0, 0.8, 0.6] * u.km, subdivisions=1))
+    block = pack_thermal(normals, areas, centroids, 4, 1.0, 1.0)
+    sun = kepler_source(GM_SUN, 1.0, 0.1, 0.0, 0.0, 0.0, 0.0, sign=-1.0)
+    model = make_model([0.6, 0.9, 1.0], [sun], thermal=block, thermal_sun=0)
+    y0 = np.array([1.0, 0.0, 0.0, 0.0, 0.5, 0.0, 20.0])
+    for integrate in (integrate_variational, integrate_taylor_variational):
+        with pytest.raises(ValueError, match="thermal"):
+            integrate(y0, 0.0, np.array([1.0]), model)
+    with pytest.raises(ValueError, match="thermal"):
+        mean_elements_stm(np.array([1.0, 0.5, 0.3, 0.0, 0.0, 0.0]), 0.0, np.array([1.0]), model, np.eye(3))

@@ -73,7 +73,7 @@ from spinorbit.core.integrators.elements import (
     ELEMENT_SIZE,
 )
 from spinorbit.core.jit import jit
-from spinorbit.core.model.gravity_field import BODY_NMAX
+from spinorbit.core.model.gravity_field import BODY_NMAX, FIG_THERMAL
 
 #: Relative step of the central differences of the right-hand side in S and Z. Measured in the
 #: Apophis-like test scene: Φ(s, S) changes by 2.5e-8 relative from 1e-4 to 1e-5 and by 2e-10 from 1e-5
@@ -252,6 +252,9 @@ def mean_elements_stm(mean0, t0, t_out, model, frame, orbit_averaged=False, max_
     if frame.shape != (3, 3) or not np.allclose(frame @ frame.T, np.eye(3), atol=1e-12):
         raise ValueError("frame: expected a 3 × 3 rotation matrix (AveragedResult.frame).")
     model = np.ascontiguousarray(model, dtype=float)
+    if model[FIG_THERMAL] > 0.0:  # as in propagate_averaged: the mean equations hold S and Z constant
+        raise ValueError("mean_elements_stm averages conservative torques only; got a model with a thermal (YORP) "
+                         "block. Build the model without thermal=.")
     if model[BODY_NMAX] > 2:
         raise ValueError(f"mean_elements_stm needs the degree-2 closed form; got a figure of degree "
                          f"{int(model[BODY_NMAX])}. Build the model without Stokes coefficients of degree 3–4.")

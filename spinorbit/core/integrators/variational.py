@@ -48,7 +48,7 @@ from spinorbit.core.integrators.quaternion import (
     renormalise_output,
 )
 from spinorbit.core.jit import jit
-from spinorbit.core.model.gravity_field import BODY_A, BODY_B, BODY_C, BODY_NMAX
+from spinorbit.core.model.gravity_field import BODY_A, BODY_B, BODY_C, BODY_NMAX, FIG_THERMAL
 from spinorbit.core.model.lunar_interior import has_interior
 from spinorbit.core.model.perturbers import PERTURBER_ROW, perturber_position_xyz
 
@@ -166,10 +166,13 @@ def variational_atol(y0, rtol):
 
 
 def check_degree_two_rigid_model(model):
-    """Refuse models whose torque the variational equations do not linearise (degree > 2, interior)."""
+    """Refuse models whose torque the variational equations do not linearise (degree > 2, interior, thermal)."""
     if has_interior(model):
         raise ValueError("the variational equations cover rigid bodies only; got a model with a lunar interior "
                          "block. Integrate the Moon with integrate_quaternion and difference it instead.")
+    if model[FIG_THERMAL] > 0.0:  # the recoil's torque is not linearised: its sensitivities would be missing
+        raise ValueError("the variational equations linearise the gravity torque only; got a model with a thermal "
+                         "(YORP) block. Build the model without thermal=, or difference integrate_quaternion instead.")
     if int(model[BODY_NMAX]) != 2 and model[MODEL_PERTURBERS] > 0.0:
         raise ValueError(f"the variational equations linearise the degree-2 torque only; got a figure of degree "
                          f"{int(model[BODY_NMAX])}. Build the model without Stokes coefficients of degree 3–4.")

@@ -70,7 +70,7 @@ BENCHMARKS = (
     Benchmark("before_after.py", quick=("--base", str(ROOT), "--rounds", "1", "--repeat", "1", "--no-write")),
 )
 #: Modules of benchmarks/ that other scripts import and that measure nothing themselves.
-LIBRARY_MODULES = ("_report.py", "peers.py", "scenes.py", "chaotic.py", "run_all.py")
+LIBRARY_MODULES = ("_report.py", "peers.py", "scenes.py", "chaotic.py", "encounter_kepler.py", "run_all.py")
 
 
 def arguments(benchmark: Benchmark, quick: bool, base: str | None, before: str | None):

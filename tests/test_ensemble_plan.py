@@ -14,8 +14,7 @@ from spinorbit import RigidBody, RotationState, Scene
 from spinorbit.coupling.one_way import propagate_one_way
 from spinorbit.ensemble import state_at_phase
 from spinorbit.ensemble.ensemble import clear_process_samplings, run_chunk
-from spinorbit.scene import EphemerisPerturber
-from spinorbit.scene import sampling
+from spinorbit.scene import EphemerisPerturber, sampling
 from spinorbit.scene.routes import attitude_angles
 from spinorbit.scene.tolerances import check_tolerance
 from spinorbit.state_table import quaternion_array
@@ -58,9 +57,9 @@ def test_members_reusing_the_shared_plan_pieces_give_the_bits_of_fresh_per_membe
     real = sampling.grid_of_samples
     monkeypatch.setattr(sampling, "grid_of_samples", lambda *args: grids.append(1) or real(*args))
     clear_process_samplings()
-    rows, failures, tables = run_chunk(member, [(i, dict(phase=p)) for i, p in enumerate(PHASES[:2])], keep_tables=True)
+    rows, failures, tables = run_chunk(member, [(i, {"phase": p}) for i, p in enumerate(PHASES[:2])], keep_tables=True)
     assert len(grids) == 1  # one grid for the chunk's shared sampling, not one per member
-    more, more_failures, more_tables = run_chunk(member, [(i, dict(phase=p)) for i, p in enumerate(PHASES[2:], 2)],
+    more, more_failures, more_tables = run_chunk(member, [(i, {"phase": p}) for i, p in enumerate(PHASES[2:], 2)],
                                                  keep_tables=True)
     assert len(grids) == 1  # the next chunk of this process reuses it with the sampling
     assert not failures and not more_failures

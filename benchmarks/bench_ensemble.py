@@ -319,6 +319,8 @@ def measure_peer(members):
     core_error = _attitude_error(core_states[:, :4] / np.linalg.norm(core_states[:, :4], axis=1)[:, None],
                                  reference[:, :4])
 
+    stages = measure_stages(ek, rows)
+
     # timed, each fresh: spinorbit serial and on a new pool of 2; heyoka threads and processes, 1 and 2
     chunk = Ensemble(ek.kepler_member, parameters).chunk_size
     spin = {}
@@ -347,8 +349,54 @@ def measure_peer(members):
                 spin_error=spin_error, heyoka_error=errors[tol], same=same, per_member=per_member, sent=sent,
                 returned=returned, load=load, heyoka_cpu=mode_cpu[int(compact)].median / members,
                 core_cpu=core_cpu[0].median / members, core_error=core_error, rtol=rtol, batch_cpu=batch_cpu,
-                copy_s=copy_s[0].median,
+                copy_s=copy_s[0].median, stages=stages,
                 batch_error=batch_error, lanes=lanes)
+
+
+def measure_stages(ek, rows, repeats=3):
+    """CPU ms per member of each stage of a chunk of Kepler members, warm, sharing one sampling as a worker does.
+
+    Stages: building the member (``make_scene``: RotationState and Scene), its plan (survey bounds along its
+    free motion, sensitivities, integrator choice), its run (the integration, its check at 10× the tolerance,
+    the result table) and its outcome row; and the a priori grid of the shared sampling, which the plan used
+    to compute per member and now takes once per sampling (``SharedSamples.grid_of``).
+    """
+    from spinorbit.ensemble.ensemble import build_member
+    from spinorbit.ensemble.outcomes import outcome_row
+    from spinorbit.scene.sampling import SharedSamples, grid_of_samples
+    from spinorbit.scene.tolerances import SURVEY_TOLERANCE
+
+    shared = SharedSamples()  # what a worker's chunk holds once the orbit is sampled (and its grid taken)
+    first = build_member(ek.kepler_member, rows[0])
+    with first.sharing_samples(shared):
+        first.run()
+
+    def chunk():
+        spent = dict(build=0.0, plan=0.0, run=0.0, outcome=0.0)
+        for row in rows:
+            clock = time.process_time()
+            scene = build_member(ek.kepler_member, row)
+            spent["build"] += time.process_time() - clock
+            with scene.sharing_samples(shared):
+                clock = time.process_time()
+                plan = scene.plan()
+                spent["plan"] += time.process_time() - clock
+                clock = time.process_time()
+                result = scene.run(plan)
+                spent["run"] += time.process_time() - clock
+            clock = time.process_time()
+            outcome_row(scene, result)
+            spent["outcome"] += time.process_time() - clock
+        return spent
+
+    rounds = [chunk() for _ in range(repeats)]
+    stages = {k: statistics.median(r[k] for r in rounds) / len(rows) for k in rounds[0]}
+    scene = ek.kepler_member(**rows[0])
+    samples = scene.sample_perturbers("user", [p.name for p in scene.moving], SURVEY_TOLERANCE)
+    grid, _ = interleaved_timings([lambda: grid_of_samples(samples, scene.sample_tolerance)], 5,
+                                  clock=time.process_time)
+    stages["grid"] = grid[0].median
+    return stages
 
 
 def _heyoka_batch(ek, earth, sun, tol, compact, states, pars, t0, t_end, reference):
@@ -475,6 +523,21 @@ def _warm_worker(row):
     return ek.kepler_member(**row).run().error_estimate
 
 
+def stages_text(p):
+    """Where a member's CPU goes, stage by stage (:func:`measure_stages`)."""
+    st = p["stages"]
+    total = st["build"] + st["plan"] + st["run"] + st["outcome"]
+    return (f"CPU per member by stage, in a warm chunk of {p['members']} sharing one sampling (median of 3): "
+            f"{total * 1e3:.2f} ms in all; building the member (`make_scene`: its RotationState and Scene) "
+            f"{st['build'] * 1e3:.2f} ms; its plan (the survey's bounds along its own free motion, its "
+            f"sensitivities, the integrator choice) {st['plan'] * 1e3:.2f} ms; its run {st['run'] * 1e3:.2f} ms "
+            f"(the integration and its check at 10× the tolerance, about 2 × {p['core_cpu'] * 1e3:.2f} ms; the rest "
+            f"the result table, its metadata and the error parts); its outcome row {st['outcome'] * 1e3:.2f} ms. "
+            f"The a priori grid of the shared sampling ({st['grid'] * 1e3:.2f} ms, which the plan used to compute "
+            "for every member) is taken once per sampling and kept with it (`SharedSamples.grid_of`), and the check "
+            "run builds no table.")
+
+
 def markdown_peer(p, overhead_pool):
     n = p["members"]
     best_heyoka = max(n / t for t in p["heyoka"].values())
@@ -523,9 +586,8 @@ def markdown_peer(p, overhead_pool):
            f"costs {p['core_cpu'] * 1e3:.2f} ms of CPU alone against heyoka's {p['heyoka_cpu'] * 1e3:.2f} ms; "
            f"a member of the Ensemble costs {p['per_member'] * 1e3:.1f} ms of wall, of which its two integrations "
            f"(the run and its check at 10× the tolerance, about 2 × {p['core_cpu'] * 1e3:.2f} ms) are "
-           f"{100 * 2 * p['core_cpu'] / p['per_member']:.0f}%: the rest is the Scene around them (the RotationState "
-           "and the Scene, the planner's survey, bounds and integrator choice for each member, the astropy result "
-           "tables, the outcome row). heyoka's thread ensemble in turn copies the integrator once per member "
+           f"{100 * 2 * p['core_cpu'] / p['per_member']:.0f}%: the rest is the Scene around them. " + stages_text(p) +
+           " heyoka's thread ensemble in turn copies the integrator once per member "
            f"(`deepcopy`, {p['copy_s'] * 1e3:.2f} ms, median of 20) and runs the member's generator in Python: "
            f"{p['heyoka'][('thread', 1)] / n * 1e3:.2f} ms per member on one worker. A batch route that plans a chunk "
            "once and integrates its members at the core, with no table per member, is what would close the gap "

@@ -28,7 +28,7 @@ from spinorbit.state import MODE_NAMES, QUATERNION_NORM_TOLERANCE, InvalidStateE
 
 __all__ = ["MOTION_COLUMNS", "OMEGA_COLUMNS", "PERIOD_UNIT", "POLE_COLUMNS", "QUATERNION_COLUMNS", "add_obliquity",
            "from_principal", "omega_array", "pole_directions", "quaternion_array", "schema_meta", "table_columns",
-           "as_schema_time", "time_column"]
+           "as_schema_time", "time_column", "unit_quaternions"]
 
 
 def from_principal(body, rows):
@@ -43,7 +43,7 @@ def from_principal(body, rows):
     return attitude_to_quat_many(np.ascontiguousarray(attitudes)), rows[:, 4:] @ p
 
 
-def _unit_quaternions(quaternions):
+def unit_quaternions(quaternions):
     """Each row divided by its norm, refused like RotationState refuses one (not finite, or not unit)."""
     if not np.all(np.isfinite(quaternions)):
         raise InvalidStateError("quaternion components must be finite; the propagated rows contain NaN or inf.")
@@ -144,7 +144,7 @@ def table_columns(body, quaternions, omegas, omega=True, motion=None, orbit_norm
         Column name → ndarray, str array (``mode``) or Quantity (``omega_*`` rad/day, pole and
         obliquity deg, periods h).
     """
-    quaternions = _unit_quaternions(np.atleast_2d(np.asarray(quaternions, dtype=float)))
+    quaternions = unit_quaternions(np.atleast_2d(np.asarray(quaternions, dtype=float)))
     omegas = np.atleast_2d(np.asarray(omegas, dtype=float))
     columns = dict(zip(QUATERNION_COLUMNS, quaternions.T.copy()))
     if omega:

@@ -28,10 +28,11 @@ from spinorbit.core.dynamics.equations import make_model
 from spinorbit.core.integrators.quaternion import integrate_quaternion
 from spinorbit import old_paths
 from spinorbit.state import RotationState
-from spinorbit.state_table import from_principal, schema_meta, table_columns, time_column
+from spinorbit.state_table import from_principal, schema_meta, table_columns, time_column, unit_quaternions
 from spinorbit.time import tdb_days
 
-__all__ = ["DEFAULT_RTOL", "INTEGRATORS", "closest_approaches", "heliocentric_normals", "propagate_one_way"]
+__all__ = ["DEFAULT_RTOL", "INTEGRATORS", "closest_approaches", "heliocentric_normals", "integrate_one_way",
+           "one_way_days", "one_way_quaternions", "one_way_table", "propagate_one_way"]
 
 
 def __getattr__(name):
@@ -134,10 +135,27 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
     """
     if not isinstance(state, RotationState):
         raise TypeError(f"state must be a spinorbit.RotationState, got {type(state).__name__}.")
+    t0, t_out = one_way_days(epoch, times)
+    ys, stats = integrate_one_way(state, t0, t_out, samples, rtol, integrator, extra_sources)
+    return one_way_table(state.body, epoch, t_out, ys, stats, samples, rtol, integrator, periods, orbit_normals)
+
+
+def one_way_days(epoch, times):
+    """(t0, t_out): ``epoch`` and ``times`` as TDB days since J2000, the floats :func:`propagate_one_way` integrates
+    between (a caller that runs several integrations over the same times converts them once)."""
     d0, r0 = tdb_days(epoch)
     t0 = float(d0 + r0)
     days, rem = tdb_days(times)
-    t_out = np.atleast_1d(np.asarray(days, dtype=float) + np.asarray(rem, dtype=float))
+    return t0, np.atleast_1d(np.asarray(days, dtype=float) + np.asarray(rem, dtype=float))
+
+
+def integrate_one_way(state, t0, t_out, samples, rtol=DEFAULT_RTOL, integrator="quaternion", extra_sources=()):
+    """The core rows (N, 7), principal axes, and the integrator's statistics of :func:`propagate_one_way`.
+
+    ``t0``, ``t_out`` as :func:`one_way_days` gives them; the other arguments as :func:`propagate_one_way`'s
+    (the same checks of the span and the integrator). No table is built: a check run that only needs the
+    attitudes takes this, and :func:`one_way_table` turns a run's rows into the schema's table.
+    """
     lo, hi = samples.span
     if min(t0, t_out.min()) < lo or max(t0, t_out.max()) > hi:
         raise ValueError(
@@ -146,8 +164,7 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
         )
     if integrator not in INTEGRATORS:
         raise ValueError(f"integrator: expected one of {INTEGRATORS}, got {integrator!r}.")
-    body = state.body
-    model = make_model(body.principal_moments, [*samples.sources(), *extra_sources])
+    model = make_model(state.body.principal_moments, [*samples.sources(), *extra_sources])
     if integrator == "elements":
         from spinorbit.core.integrators.elements import integrate_elements
 
@@ -161,14 +178,25 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
         stats.update(accepted=stats["steps"], rejected=0)
     else:
         ys, stats = integrate_quaternion(state.core_state(), t0, t_out, model, rtol=rtol, return_stats=True)
+    return ys, stats
+
+
+def one_way_quaternions(body, ys):
+    """The (N, 4) attitudes of core rows ``ys`` as :func:`one_way_table` puts them in its ``q_*`` columns
+    (user body axes, each row divided by its norm; refused when not finite or not unit)."""
+    quaternions, _ = from_principal(body, ys)
+    return unit_quaternions(np.atleast_2d(np.asarray(quaternions, dtype=float)))
+
+
+def one_way_table(body, epoch, t_out, ys, stats, samples, rtol, integrator, periods=True, orbit_normals=None):
+    """:func:`propagate_one_way`'s table of the core rows ``ys`` at ``t_out`` (from :func:`integrate_one_way`)."""
     if orbit_normals is None:
         orbit_normals = heliocentric_normals(samples, t_out)
-    table = QTable()
-    table["time"] = time_column(t_out)
     quaternions, omegas = from_principal(body, ys)  # all rows at once, no RotationState per row
-    for name, column in table_columns(body, quaternions, omegas, motion="rows" if periods else None,
-                                      orbit_normals=orbit_normals).items():
-        table[name] = column
+    columns = {"time": time_column(t_out)}
+    columns.update(table_columns(body, quaternions, omegas, motion="rows" if periods else None,
+                                 orbit_normals=orbit_normals))
+    table = QTable(columns)  # all columns in one go: astropy's per-column insertion costs ~30 µs a column
     table.meta.update(schema_meta(epoch, f"one-way rotation under sampled torques ({integrator})"))
     table.meta.update(stats)
     table.meta["rtol"] = rtol

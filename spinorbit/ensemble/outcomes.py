@@ -71,12 +71,11 @@ def outcome_row(scene, result, at=None):
     timed = at is not None
     start_pole = scene.state.angular_momentum_direction
     row = {}
+    columns = [(name, table[name]) for name in TIMED_COLUMNS[:-1] if name in table.colnames]
     for k, index in enumerate(time_rows(scene, at)):
-        record = table[index]
-        for name in TIMED_COLUMNS[:-1]:
-            if name not in table.colnames:
-                continue
-            value = record[name]
+        # element by element from the columns (an astropy Row per time costs more than the values)
+        for name, column in columns:
+            value = column[index]
             row[_suffix(name, k, timed)] = (str(value) if name == "mode" else
                                             float(u.Quantity(value).to_value(OUTCOME_UNITS[name]))
                                             if name in OUTCOME_UNITS else float(value))

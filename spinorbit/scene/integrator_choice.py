@@ -87,7 +87,6 @@ def taylor_steps(scene, source, kept, skip, tol):
     """
     from spinorbit.core.dynamics.equations import make_model
     from spinorbit.core.integrators.taylor import integrate_taylor
-    from spinorbit.coupling.sampling import a_priori_grid
 
     free = make_model(scene.state.body.principal_moments)  # the figure the one-way run uses
     y0 = scene.state.core_state()
@@ -106,8 +105,7 @@ def taylor_steps(scene, source, kept, skip, tol):
     knots = 0.0
     t0, t1 = scene.epoch_day, scene.output_days[-1]
     for samples, exact in groups:
-        days = samples.days if exact else a_priori_grid(samples.days, samples.states, samples.days[0],
-                                                         samples.days[-1], scene.sample_tolerance)
+        days = samples.days if exact else scene.grid_of(samples, scene.sample_tolerance)  # once per shared sampling
         inside = float(np.count_nonzero((days > t0) & (days < t1)))
         knots += inside if exact else SAMPLE_REFINEMENT * inside
     return steps, knots, probed

@@ -20,7 +20,7 @@ from astropy.table import QTable
 
 from spinorbit.scene.sampling import NoSamples, subset_samples
 from spinorbit.scene.tolerances import MAX_RTOL_RETRIES, refine, sampling_error_bound
-from spinorbit.state_table import OMEGA_COLUMNS, from_principal, quaternion_array, table_columns, time_column
+from spinorbit.state_table import OMEGA_COLUMNS, from_principal, table_columns, time_column
 from spinorbit.time import time_from_tdb_days
 
 __all__ = ["attitude_angles", "result_table", "run_coupled", "run_one_way", "run_torque_free", "scene_orbit_normals"]
@@ -87,7 +87,7 @@ def run_torque_free(scene, plan):
 def run_one_way(scene, plan, report):
     """The one-way integration under the plan's kept perturbers, checked a posteriori; ``report(fraction)``."""
     from spinorbit.core.model.perturbers import fixed_source
-    from spinorbit.coupling.one_way import propagate_one_way
+    from spinorbit.coupling.one_way import integrate_one_way, one_way_days, one_way_quaternions, one_way_table
 
     named = tuple(n for n in plan.kept if n in scene.named)
     fixed = [fixed_source(p.gm_au3_day2, p.position_au) for p in scene.fixed if p.name in plan.kept]
@@ -102,20 +102,23 @@ def run_one_way(scene, plan, report):
         samples = NoSamples(scene.epoch_day, scene.output_days[-1])
     report(0.3)
     epoch = time_from_tdb_days(scene.epoch_day)
-    times = time_from_tdb_days(scene.output_days)
+    t0, t_out = one_way_days(epoch, time_from_tdb_days(scene.output_days))  # propagate_one_way's days, once
+    body = scene.state.body
 
     def run_and_check(rtol, check_rtol):
-        run = propagate_one_way(scene.state, epoch, times, samples, rtol=rtol, periods="periods" in scene.quantities,
-                                integrator=plan.integrator, extra_sources=fixed)
-        check = propagate_one_way(scene.state, epoch, times, samples, rtol=check_rtol, periods=False,
-                                  integrator=plan.integrator, extra_sources=fixed)
-        return run, float(np.max(attitude_angles(quaternion_array(run), quaternion_array(check))))
+        # Both integrations of propagate_one_way, compared on the attitudes its table would hold; only the
+        # accepted run becomes a table (the check needs none).
+        run = integrate_one_way(scene.state, t0, t_out, samples, rtol, plan.integrator, fixed)
+        check, _ = integrate_one_way(scene.state, t0, t_out, samples, check_rtol, plan.integrator, fixed)
+        return run, float(np.max(attitude_angles(one_way_quaternions(body, run[0]), one_way_quaternions(body, check))))
 
     def attempted(attempt):
         report(0.3 + 0.7 * (attempt + 1) / (MAX_RTOL_RETRIES + 1))
 
-    run, integration, rtol = refine(plan.integrator, plan.rtol, max(plan.integration_share_rad, 0.0), run_and_check,
-                                    attempted)
+    (ys, run_stats), integration, rtol = refine(plan.integrator, plan.rtol, max(plan.integration_share_rad, 0.0),
+                                                run_and_check, attempted)
+    run = one_way_table(body, epoch, t_out, ys, run_stats, samples, rtol, plan.integrator,
+                        periods="periods" in scene.quantities)
     kept_bound = sum(plan.estimates[n].worst_or_bound_rad for n in plan.kept)
     sampling = sampling_error_bound(scene.sample_tolerance, kept_bound) if named or moving else 0.0
     if "omega" not in scene.quantities:

@@ -14,7 +14,7 @@ import numpy as np
 
 from spinorbit.time import time_from_tdb_days
 
-__all__ = ["NoSamples", "SharedSamples", "body_orbit", "sample_perturbers", "subset_samples"]
+__all__ = ["NoSamples", "SharedSamples", "body_orbit", "grid_of_samples", "sample_perturbers", "subset_samples"]
 
 
 def sample_perturbers(orbit, moving, epoch_day, end_day, source, names, tolerance):
@@ -76,6 +76,14 @@ def body_orbit(orbit):
     return orbit.function
 
 
+def grid_of_samples(samples, tolerance):
+    """:func:`spinorbit.coupling.sampling.a_priori_grid` of ``samples`` over their own span at ``tolerance``: the
+    grid a sampling of their orbits at that tolerance starts from (the planner counts its knots)."""
+    from spinorbit.coupling.sampling import a_priori_grid
+
+    return a_priori_grid(samples.days, samples.states, samples.days[0], samples.days[-1], tolerance)
+
+
 def subset_samples(samples, names):
     """The columns of ``names`` of a SampledPerturbers (same grid, same error estimates per perturber)."""
     from spinorbit.coupling.sampling import SampledPerturbers
@@ -100,6 +108,25 @@ class SharedSamples:
     def __init__(self, memo=None):
         self._taken = []
         self._memo = memo
+        self._grids = {}
+
+    def grid_of(self, samples, tolerance):
+        """:func:`grid_of_samples` of ``samples``, computed once per samples object and tolerance.
+
+        The grid is a pure function of the samples' arrays and the tolerance, so a kept one is the bits
+        a fresh one gives. It is keyed by the samples *object* (held with the grid, so its id is not
+        reused while the entry lives) and kept here, and in the memo when the samples are the memo's
+        own (then later chunks of this process reuse it too).
+        """
+        key = ("a priori grid", id(samples), tolerance)
+        in_memo = self._memo is not None and any(kept is samples for kept in self._memo.values())
+        store = self._memo if in_memo else self._grids
+        hit = store.get(key)
+        if hit is not None and hit[0] is samples:
+            return hit[1]
+        grid = grid_of_samples(samples, tolerance)
+        store[key] = (samples, grid)
+        return grid
 
     def find(self, source, names, tolerance):
         """The samples of ``names`` from ``source`` at ``tolerance`` if taken already (their columns), else None."""

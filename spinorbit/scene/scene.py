@@ -53,7 +53,7 @@ from spinorbit.scene.inputs import QUANTITIES, SceneError
 from spinorbit.scene.plan import Plan
 from spinorbit.scene.planning import plan_scene
 from spinorbit.scene.routes import run_coupled, run_one_way, run_torque_free, scene_orbit_normals
-from spinorbit.scene.sampling import SharedSamples, sample_perturbers
+from spinorbit.scene.sampling import SharedSamples, grid_of_samples, sample_perturbers
 
 __all__ = ["Scene", "SceneResult"]
 
@@ -244,6 +244,13 @@ class Scene:
         if self._report_planning is not None:  # the survey's sampling is most of a plan's time
             self._report_planning(0.8)
         return samples
+
+    def grid_of(self, samples, tolerance):
+        """The a priori grid (:func:`~spinorbit.scene.sampling.grid_of_samples`) of ``samples`` at ``tolerance``;
+        within :meth:`sharing_samples`, computed once per samples object for every scene sharing them."""
+        if self._cache is not None:
+            return self._cache.grid_of(samples, tolerance)
+        return grid_of_samples(samples, tolerance)
 
     def _sample(self, source, names, tolerance):
         return sample_perturbers(self.orbit, self.moving, self.epoch_day, self.output_days[-1], source, names,

@@ -94,7 +94,7 @@ from spinorbit.core.free_motion.flow_constants import (
     FL_RATE_LO,
     FLOW_SIZE,
     flow_constants,
-    kappa_pn,
+    flow_kappa_pn,
 )
 from spinorbit.core.free_motion.regular_precession import (
     NO_SYMMETRY_AXIS,
@@ -179,7 +179,7 @@ def evaluate_flow(t, flow, mo, mk, pk, q_out, m_out):
     if flow[FL_PERIODIC] > 0.0:
         j, rh, rl = dd_remainder_dd(ah, al, flow[FL_PERIOD_HI], flow[FL_PERIOD_LO])
         s, c, d = sncndn_reduced(rh, mk[MK_M], mk[MK_MC], mk[MK_SQRT_MUC], mk[MK_K_HI], mk[MK_K_LO])
-        ph, pl = kappa_pn(flow[FL_KAPPA_HI], flow[FL_KAPPA_LO], rh, rl, s, c, d, pk)
+        ph, pl = flow_kappa_pn(flow, rh, rl, s, c, d, pk)
         gh, gl = dd_add(gh, gl, ph, pl)
         if j != 0.0:
             wh, wl = dd_scale(flow[FL_G_ADVANCE_HI], flow[FL_G_ADVANCE_LO], j)

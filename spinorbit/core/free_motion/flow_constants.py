@@ -42,9 +42,9 @@ from spinorbit.core.math.elliptic_integrals import (
     METHOD_LARGE_NEGATIVE,
     NK_METHOD,
     NK_N,
+    characteristic_constants_with_complete,
     ellipf_k,
     pi_principal,
-    pn_constants,
     pn_k,
 )
 from spinorbit.core.math.elliptic_periods import (
@@ -55,7 +55,7 @@ from spinorbit.core.math.elliptic_periods import (
     MK_SQRT_MUC,
     PI_HI,
     PI_LO,
-    parameter_constants,
+    parameter_constants_with_k,
 )
 from spinorbit.core.math.jacobi import sncndn_reduced
 from spinorbit.core.math.pn_fourier import FOURIER_MAX_TERMS, pn_fourier_coefficients, sine_series
@@ -198,14 +198,14 @@ def phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c):
 
     Returns
     -------
-    tuple of 14 floats
-        (ν_hi, ν_lo, P_hi, P_lo, cG_hi, cG_lo, W_hi, W_lo, κ_hi, κ_lo, p, p_c, n, ok): the argument
+    tuple of 15 floats
+        (ν_hi, ν_lo, P_hi, P_lo, cG_hi, cG_lo, W_hi, W_lo, κ_hi, κ_lo, p, p_c, n, ok, Π): the argument
         rate ν (argument per time unit), the half period P = 2K(p) of the argument, the secular rate
         c G of g (rad per time unit), the advance W = 2 κ Π(n|p) of g per half period (rad), the pn
         coefficient κ (rad), and the parameter, complementary parameter and characteristic rounded
         once from their double-double values (for the double kernels: near the separatrix p_c from
         doubles would lose ε/p_c); ok = 0 when the double-double p_c is not positive (the
-        separatrix), 1 otherwise.
+        separatrix), 1 otherwise; Π(n|p) rounded once (NaN at the separatrix).
 
     Notes
     -----
@@ -248,10 +248,10 @@ def phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c):
     kah, kal = dd_mul(ach, acl, gh, gl)
     kah, kal = dd_div(kah, kal, nuh, nul)
     if not pch > 0.0:
-        return nuh, nul, math.inf, 0.0, cgh, cgl, 0.0, 0.0, kah, kal, param, pch, -fh, 0.0
+        return nuh, nul, math.inf, 0.0, cgh, cgl, 0.0, 0.0, kah, kal, param, pch, -fh, 0.0, math.nan
     kh, kl, pih, pil = complete_k_pi_dd(fh, fl, pch, pcl)
     wh, wl = dd_mul(kah, kal, 2.0 * pih, 2.0 * pil)
-    return nuh, nul, 2.0 * kh, 2.0 * kl, cgh, cgl, wh, wl, kah, kal, param, pch, -fh, 1.0
+    return nuh, nul, 2.0 * kh, 2.0 * kl, cgh, cgl, wh, wl, kah, kal, param, pch, -fh, 1.0, pih + pil
 
 
 @jit
@@ -305,14 +305,15 @@ def flow_constants(quaternion, momentum, big_a, big_b, big_c):
         mk, pk = elliptic_constants(mo)  # unused by a uniform rotation; returned for one signature
         return flow, mo, mk, pk
     mx, my, mz = fx * m0x, fy * m0y, fz * m0z
-    (nuh, nul, perh, perl, cgh, cgl, wh, wl, kah, kal, param, param_c, char_n, ok) = (
+    (nuh, nul, perh, perl, cgh, cgl, wh, wl, kah, kal, param, param_c, char_n, ok, complete_pi) = (
         phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c)
     )
     if ok > 0.0 and mo[MO_PARAM_C] > 0.0:
         # kernel constants from the once-rounded double-double p, p_c, n (not from ratios of rounded
-        # differences: near the separatrix those lose ε/p_c in p_c)
-        mk = parameter_constants(param, param_c)
-        pk = pn_constants(char_n, param, param_c)
+        # differences: near the separatrix those lose ε/p_c in p_c), with K and Π from the
+        # double-double AGM above instead of a second AGM and a Carlson R_J per state
+        mk = parameter_constants_with_k(param, param_c, 0.5 * perh, 0.5 * perl)
+        pk = characteristic_constants_with_complete(char_n, param, complete_pi)
         periodic = True
     else:  # the separatrix: the kernels' closed forms, from the motion constants
         mk, pk = elliptic_constants(mo)

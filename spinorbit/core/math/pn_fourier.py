@@ -25,15 +25,18 @@ keeps the Carlson path. Checked against mpmath on both sides of the rule in
 
 import math
 
+import numpy as np
+
 from spinorbit.core.jit import jit
 from spinorbit.core.math.carlson import rf
 
-# Tail of the series: stop at the first N with ρ^{N+1} below this fraction of ρ (c_1 ∝ ρ): the
-# omitted terms are then below ε/20 of the leading one.
+# Tail of the series: N terms with ρ^N below this (the first omitted term over the first kept is
+# ρ^N): the omitted terms are below ε/20 of the leading one.
 FOURIER_TAIL = 1e-17
 # At most this many terms; with the tail above this allows ρ up to FOURIER_RHO_MAX.
 FOURIER_MAX_TERMS = 24
 FOURIER_RHO_MAX = FOURIER_TAIL ** (1.0 / FOURIER_MAX_TERMS)  # ≈ 0.196
+_RECIPROCALS = np.array([1.0 / k for k in range(1, FOURIER_MAX_TERMS + 1)])  # 1/k, no division per set-up
 
 
 @jit
@@ -83,25 +86,25 @@ def pn_fourier_coefficients(f, m, k_quarter, one_minus_ratio, scale, out):
     if not (f > 0.0) or not (0.0 <= m < 1.0):
         return 0
     rho = pn_fourier_ratio(f, m, k_quarter)
-    if rho > FOURIER_RHO_MAX:
+    if not (0.0 < rho <= FOURIER_RHO_MAX):  # ρ underflows only for m < 1e-200 (K'/K > 237); NaN too
         return 0
     q = 0.0
     if m > 0.0:
         q = math.exp(-math.pi * rf(0.0, m, 1.0) / k_quarter)  # K' = K(1 − m) = R_F(0, m, 1)
     sigma = q * q / rho
-    terms = 1
-    rho_k = rho
-    while terms < FOURIER_MAX_TERMS and rho_k * rho > FOURIER_TAIL * rho:
-        rho_k *= rho
-        terms += 1
+    q2 = q * q
+    # N from ρ^N ≤ FOURIER_TAIL (ρ ≤ FOURIER_RHO_MAX keeps N ≤ FOURIER_MAX_TERMS)
+    terms = min(FOURIER_MAX_TERMS, max(1, math.ceil(math.log(FOURIER_TAIL) / math.log(rho))))
     rho_k, sigma_k, q2_k = 1.0, 1.0, 1.0
     slope = 0.0  # Σ k c_k / C
     for k in range(terms):
         rho_k *= rho
         sigma_k *= sigma
-        q2_k *= q * q
-        b = (rho_k - sigma_k) / (1.0 - q2_k)
-        out[k] = b / (k + 1.0)
+        b = rho_k - sigma_k
+        if q2_k > FOURIER_TAIL:  # 1/(1 − q^{2k}) is 1 to the last bit once q^{2k} < ε/10
+            q2_k *= q2
+            b /= 1.0 - q2_k
+        out[k] = b * _RECIPROCALS[k]
         slope += b
     norm = scale * one_minus_ratio * k_quarter / (math.pi * slope)
     for k in range(terms):

@@ -114,14 +114,25 @@ def pn_fourier_coefficients(f, m, k_quarter, one_minus_ratio, scale, out):
 
 @jit
 def sine_series(theta, coefficients, offset, terms):
-    """Σ_{k=1}^{terms} a_k sin(kθ), a_k = coefficients[offset + k − 1] (Clenshaw, DLMF 3.11.15 form).
+    """Σ_{k=1}^{terms} a_k sin(kθ), a_k = coefficients[offset + k − 1], by Clenshaw's recurrence.
 
-    b_k = a_k + 2 cos θ b_{k+1} − b_{k+2}, sum = b_1 sin θ: relative accuracy near θ = 0 and π too,
-    since the sum is sin θ times a polynomial in cos θ.
+    The odd and the even terms are summed as two independent recurrences in steps of 2θ
+    (φ_{j+1} = 2 cos 2θ φ_j − φ_{j−1}), so the two dependent chains run side by side, each written
+    as (a − b_{j+2}) + α b_{j+1} to keep one product and one sum on its critical path:
+    odd part = (b_0 + b_1) sin θ (sin 3θ − α sin θ = sin θ), even part = b_0 sin 2θ. Both are sin θ times a polynomial in
+    cos θ, so the sum keeps its relative accuracy near θ = 0 and θ = π.
     """
-    x2 = 2.0 * math.cos(theta)
-    b1 = 0.0
-    b2 = 0.0
-    for k in range(terms - 1, -1, -1):
-        b1, b2 = coefficients[offset + k] + x2 * b1 - b2, b1
-    return b1 * math.sin(theta)
+    s = math.sin(theta)
+    c = math.cos(theta)
+    alpha = 2.0 * ((c - s) * (c + s))  # 2 cos 2θ without the cancellation of 1 − 2 sin²θ
+    odd1, odd2, even1, even2 = 0.0, 0.0, 0.0, 0.0
+    top = terms - 1  # index of the last term (k = terms)
+    if top % 2 == 1:  # the last term is even (k = terms even): start the even chain with it
+        even1 = coefficients[offset + top]
+        top -= 1
+    # now coefficients[offset + top] is odd (k = top + 1 odd); pair (odd k, even k − 1)
+    for index in range(top, 0, -2):
+        odd1, odd2 = (coefficients[offset + index] - odd2) + alpha * odd1, odd1
+        even1, even2 = (coefficients[offset + index - 1] - even2) + alpha * even1, even1
+    odd1, odd2 = (coefficients[offset] - odd2) + alpha * odd1, odd1
+    return (odd1 + odd2) * s + even1 * (2.0 * s * c)

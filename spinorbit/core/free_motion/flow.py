@@ -34,8 +34,9 @@ double inputs (A, B, C, M):
   nearly symmetric bodies κ is huge), and the sum is reduced modulo 4π (half angles feed the
   quaternion).
 
-The reduced r then goes to the double kernels (one sn/cn/dn, one Π of the principal range: the
-pn of r), whose errors are bounded and do not grow. Measured errors are in ``docs/torque_free.md``.
+The reduced r then goes to the double kernels (one sn/cn/dn, and the pn of r: its nome sine series
+of :mod:`spinorbit.core.math.pn_fourier` where that converges fast, else one Π of the principal
+range), whose errors are bounded and do not grow. Measured errors are in ``docs/torque_free.md``.
 
 Bodies with two exactly equal moments (and spheres) do not come here: the loops below send them to
 the regular precession in closed form (:mod:`.regular_precession`, trig only, the same double-double
@@ -158,8 +159,8 @@ def evaluate_flow(t, flow, mo, mk, pk, q_out, m_out):
     """Attitude quaternion and body momentum at time t of the motion described by flow constants.
 
     Writes q_out[0:4] (scalar first, body → inertial) and m_out[0:3] (body momentum). Per call: one
-    sn/cn/dn and one principal-range Π (the pn of the reduced argument), one sin/cos, a few square
-    roots; no allocation.
+    sn/cn/dn and the pn of the reduced argument (a sine series or one principal-range Π, as the
+    set-up chose), one sin/cos, a few square roots; no allocation.
     """
     mode = flow[FL_MODE]
     if mode == MODE_UNIFORM:

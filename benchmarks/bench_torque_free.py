@@ -48,6 +48,10 @@ GOAL_ONE_TIME_STATES_PER_SECOND = 2.0e6  # issue 18: one time per state
 MOMENTS = (2.0 / 3.0, 1.0, 2.0)
 MOMENTUM = np.array([math.sin(1.1), 0.0, math.cos(1.1)])
 IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
+# A body whose pn takes Carlson's form, not the nome series (f = −n ≈ 17, ρ ≈ 0.66 > FOURIER_RHO_MAX):
+# the Apophis-like moments and momentum of tests/test_torque_free.py.
+CARLSON_MOMENTS = (0.61, 0.965, 1.0)
+CARLSON_MOMENTUM = np.array([0.15, 0.25, 0.95])
 SPAN_PERIODS = 100.0
 N_TIMES = 1000  # output times per state
 N_STATES = 2000  # states in the many-states run of the exact solution
@@ -56,7 +60,7 @@ HEYOKA_TOLERANCE = 2.0**-52  # heyoka's default (machine epsilon): the tightest 
 SCIPY_TOLERANCE = 2.3e-14  # DOP853 refuses rtol < 100 ε (it raises it with a warning)
 
 
-EXACT_REPEATS = 9  # interleaved rounds of the three exact-solution workloads
+EXACT_REPEATS = 9  # interleaved rounds of the four exact-solution workloads
 
 
 def timed(function, repeats=5):
@@ -151,7 +155,7 @@ def main():
 
     # exact solution: one state → many times, many states → many times (small random rotations of
     # the HLW state), many states at one time each (setup-dominated: the double-double AGM per
-    # state); the three timed in turn, EXACT_REPEATS rounds, so the machine's load moves all alike
+    # state); the four timed in turn, EXACT_REPEATS rounds, so the machine's load moves all alike
     q, m = torque_free_states(IDENTITY, MOMENTUM, *MOMENTS, times)
     error = rotation_angle(q_ref, q).max()
     rng = np.random.default_rng(1)
@@ -162,14 +166,18 @@ def main():
     many = 50 * N_STATES
     quaternions_many = np.repeat(quaternions, 50, axis=0)
     momenta_many = np.repeat(momenta, 50, axis=0)
-    (one_state, many_states, one_time_each), _ = interleaved_timings(
+    momenta_carlson = CARLSON_MOMENTUM + 1e-3 * rng.normal(size=(N_STATES, 3))
+    (one_state, many_states, one_time_each, carlson_states), _ = interleaved_timings(
         [lambda: torque_free_states(IDENTITY, MOMENTUM, *MOMENTS, times),
          lambda: torque_free_states_many(quaternions, momenta, MOMENTS, times),
-         lambda: torque_free_states_many(quaternions_many, momenta_many, MOMENTS, one_time)],
+         lambda: torque_free_states_many(quaternions_many, momenta_many, MOMENTS, one_time),
+         lambda: torque_free_states_many(quaternions, momenta_carlson, CARLSON_MOMENTS, times)],
         EXACT_REPEATS, clock=time.process_time, warm_up=True)
     rows.append((f"spinorbit exact, 1 state × {N_TIMES} times", N_TIMES, one_state, error))
     rows.append((f"spinorbit exact, {N_STATES} states × {N_TIMES} times", N_STATES * N_TIMES, many_states, error))
     rows.append((f"spinorbit exact, {many} states × 1 time", many, one_time_each, math.nan))
+    rows.append((f"spinorbit exact, Apophis-like body (pn in Carlson's form), {N_STATES} states × {N_TIMES} times",
+                 N_STATES * N_TIMES, carlson_states, math.nan))
 
     # heyoka, double precision, Taylor, the package's equations in peers' formulation, its faster mode;
     # compiled once, reused for every state
@@ -213,8 +221,11 @@ def main():
         "",
         f"Hairer–Lubich–Wanner body, {N_TIMES} output times over {SPAN_PERIODS:.0f} polhode periods "
         f"({span:.0f} time units) per state; a *state* is one attitude quaternion + body momentum at "
-        "one time. Error: largest attitude error on the grid against heyoka long double (tol 1e-19). "
-        f"Rates: CPU (`time.process_time`), median of the repeats, their min–max range beside it; the three "
+        "one time. The Apophis-like row (moments (0.61, 0.965, 1), f = −n ≈ 17, same grid) is a body "
+        "whose pn keeps Carlson's form: the nome series of `spinorbit.core.math.pn_fourier` is taken "
+        "only where its ratio ρ ≤ 0.196 (HLW: ρ ≈ 0.09, 16 terms). "
+        "Error: largest attitude error on the grid against heyoka long double (tol 1e-19). "
+        f"Rates: CPU (`time.process_time`), median of the repeats, their min–max range beside it; the four "
         f"exact-solution rows are timed in turn ({EXACT_REPEATS} rounds), so the machine's load moves them alike.",
         "",
         "| method | states/s (range) | vs exact (many states) | max attitude error (rad) |",
@@ -230,7 +241,8 @@ def main():
         "",
         f"Goal: ≥ {GOAL_STATES_PER_SECOND:.0e} states/s on one core for the exact solution (many times "
         f"per state): **{verdict}** ({exact_rate:.3g} states/s). With one time per state the per-state "
-        f"setup dominates (double-double AGM for K and Π, forward map to the elements, node frame; "
+        f"setup dominates (one double-double AGM for K and Π, forward map to the elements, node frame, "
+        f"coefficients of pn's nome series; "
         f"≈ {1e6 / one_time_rate:.1f} µs per state; goal ≥ {GOAL_ONE_TIME_STATES_PER_SECOND:.0e}): "
         f"**{one_time_verdict}** for that workload ({one_time_rate:.3g} states/s). The integrators cannot reach the exact "
         "solution's error in double precision at any tolerance they accept; they are shown at their "

@@ -16,7 +16,17 @@ from _heyoka_reference import propagate, rotation_angle
 from _mp_reference import exact_states
 from spinorbit.core.elements.canonical import MODE_LAM, MODE_SAM, MODE_UNIFORM
 from spinorbit.core.free_motion.flow import torque_free_attitudes, torque_free_states, torque_free_states_many
-from spinorbit.core.free_motion.flow_constants import FL_MODE, FL_PERIOD_HI, FL_RATE_HI, complete_k_pi_dd, flow_constants
+from spinorbit.core.free_motion.flow_constants import (
+    FL_FOURIER_TERMS,
+    FL_MODE,
+    FL_PERIOD_HI,
+    FL_RATE_HI,
+    complete_k_pi_dd,
+    flow_constants,
+)
+from spinorbit.core.math.elliptic_integrals import NK_N
+from spinorbit.core.math.elliptic_periods import MK_K_HI, MK_M
+from spinorbit.core.math.pn_fourier import FOURIER_MAX_TERMS, FOURIER_RHO_MAX, FOURIER_TAIL, pn_fourier_ratio
 from spinorbit.core.math.rotations import quat_to_attitude
 
 # Goal of the long-span work: attitude error after 1e4 rotation periods (rad). Measured against
@@ -314,3 +324,52 @@ def test_random_states_do_not_drift_against_mpmath():
         assert rotation_angle(q_ref, q).max() < RANDOM_MP_TOLERANCE, (moments, momentum)
         assert np.abs(m - m_ref).max() < RANDOM_MP_TOLERANCE * np.linalg.norm(momentum)
 
+
+
+# --------------------------------------------------------------------------------------------------
+# The nome series of pn (spinorbit.core.math.pn_fourier) and the rule that chooses it
+# --------------------------------------------------------------------------------------------------
+
+
+def _series_ratio(momentum, moments):
+    """(ρ of the nome series, number of terms the set-up chose) for a state."""
+    flow, _, mk, pk = flow_constants(IDENTITY, np.asarray(momentum, float), *moments)
+    rho = pn_fourier_ratio(-pk[NK_N], mk[MK_M], mk[MK_K_HI])
+    return rho, int(flow[FL_FOURIER_TERMS])
+
+
+def _momentum_at_ratio(moments, target, sign):
+    """A body momentum whose ρ is ``target`` (bisection in m_c: ρ grows as m_c → 0, K → ∞)."""
+    low, high = 0.0, 0.999  # m_c (m_c = 1 is the spin about the axis, no SAM/LAM state)
+    for _ in range(60):
+        mid = 0.5 * (low + high)
+        rho, _ = _series_ratio(near_separatrix_momentum(moments, sign * mid), moments)
+        low, high = (mid, high) if rho > target else (low, mid)
+    return near_separatrix_momentum(moments, sign * high)
+
+
+@pytest.mark.validation
+@pytest.mark.parametrize("sign", [1.0, -1.0], ids=["sam", "lam"])
+@pytest.mark.parametrize("side", [0.98, 1.02], ids=["series", "carlson"])
+def test_pn_series_rule_both_sides_against_mpmath(sign, side):
+    """States just inside and just outside ρ ≤ FOURIER_RHO_MAX: both paths at the ε level to 1e6 periods."""
+    momentum = _momentum_at_ratio(HLW_MOMENTS, side * FOURIER_RHO_MAX, sign)
+    rho, terms = _series_ratio(momentum, HLW_MOMENTS)
+    assert (terms > 0) == (side < 1.0), (rho, terms)
+    if side < 1.0:
+        assert rho**terms <= FOURIER_TAIL < rho ** (terms - 1)  # the fewest terms that reach the tail
+    period = rotation_period(TILTED, momentum, HLW_MOMENTS)
+    times = period * np.array([0.11, 0.37, 0.5, 0.83, 1e2 + 0.3, 1e6 + 0.1])
+    q, m = torque_free_states(TILTED, momentum, *HLW_MOMENTS, times)
+    q_ref, m_ref = exact_states(TILTED, momentum, HLW_MOMENTS, times)
+    assert rotation_angle(q_ref, q).max() < MP_TOLERANCE
+    assert np.abs(m - m_ref).max() < MP_TOLERANCE * np.linalg.norm(momentum)
+
+
+def test_typical_and_nearly_symmetric_states_take_the_series():
+    """The HLW body (ρ ≈ 0.09) and a nearly symmetric one (f ≈ 1e-9) use the series; f ≈ 1e9 and
+    the Apophis-like body (f ≈ 17, ρ ≈ 0.66) do not."""
+    assert _series_ratio(HLW_MOMENTUM, HLW_MOMENTS)[1] > 0
+    assert _series_ratio([0.3, 0.4, 0.8], SYMMETRIC_PROLATE)[1] > 0
+    assert _series_ratio([0.3, 0.4, 0.8], SYMMETRIC_OBLATE)[1] == 0
+    assert _series_ratio(APOPHIS_MOMENTUM, APOPHIS_MOMENTS)[1] == 0

@@ -34,8 +34,9 @@ double inputs (A, B, C, M):
   nearly symmetric bodies κ is huge), and the sum is reduced modulo 4π (half angles feed the
   quaternion).
 
-The reduced r then goes to the double kernels (one sn/cn/dn, one Π of the principal range: the
-pn of r), whose errors are bounded and do not grow. Measured errors are in ``docs/torque_free.md``.
+The reduced r then goes to the double kernels (one sn/cn/dn, and the pn of r: its nome sine series
+of :mod:`spinorbit.core.math.pn_fourier` where that converges fast, else one Π of the principal
+range), whose errors are bounded and do not grow. Measured errors are in ``docs/torque_free.md``.
 
 Bodies with two exactly equal moments (and spheres) do not come here: the loops below send them to
 the regular precession in closed form (:mod:`.regular_precession`, trig only, the same double-double
@@ -94,7 +95,7 @@ from spinorbit.core.free_motion.flow_constants import (
     FL_RATE_LO,
     FLOW_SIZE,
     flow_constants,
-    kappa_pn,
+    flow_kappa_pn,
 )
 from spinorbit.core.free_motion.regular_precession import (
     NO_SYMMETRY_AXIS,
@@ -158,8 +159,8 @@ def evaluate_flow(t, flow, mo, mk, pk, q_out, m_out):
     """Attitude quaternion and body momentum at time t of the motion described by flow constants.
 
     Writes q_out[0:4] (scalar first, body → inertial) and m_out[0:3] (body momentum). Per call: one
-    sn/cn/dn and one principal-range Π (the pn of the reduced argument), one sin/cos, a few square
-    roots; no allocation.
+    sn/cn/dn and the pn of the reduced argument (a sine series or one principal-range Π, as the
+    set-up chose), one sin/cos, a few square roots; no allocation.
     """
     mode = flow[FL_MODE]
     if mode == MODE_UNIFORM:
@@ -179,7 +180,7 @@ def evaluate_flow(t, flow, mo, mk, pk, q_out, m_out):
     if flow[FL_PERIODIC] > 0.0:
         j, rh, rl = dd_remainder_dd(ah, al, flow[FL_PERIOD_HI], flow[FL_PERIOD_LO])
         s, c, d = sncndn_reduced(rh, mk[MK_M], mk[MK_MC], mk[MK_SQRT_MUC], mk[MK_K_HI], mk[MK_K_LO])
-        ph, pl = kappa_pn(flow[FL_KAPPA_HI], flow[FL_KAPPA_LO], rh, rl, s, c, d, pk)
+        ph, pl = flow_kappa_pn(flow, rh, rl, s, c, d, pk)
         gh, gl = dd_add(gh, gl, ph, pl)
         if j != 0.0:
             wh, wl = dd_scale(flow[FL_G_ADVANCE_HI], flow[FL_G_ADVANCE_LO], j)

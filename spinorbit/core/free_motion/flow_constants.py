@@ -41,9 +41,10 @@ from spinorbit.core.math.ddouble import (
 from spinorbit.core.math.elliptic_integrals import (
     METHOD_LARGE_NEGATIVE,
     NK_METHOD,
+    NK_N,
+    characteristic_constants_with_complete,
     ellipf_k,
     pi_principal,
-    pn_constants,
     pn_k,
 )
 from spinorbit.core.math.elliptic_periods import (
@@ -54,9 +55,10 @@ from spinorbit.core.math.elliptic_periods import (
     MK_SQRT_MUC,
     PI_HI,
     PI_LO,
-    parameter_constants,
+    parameter_constants_with_k,
 )
 from spinorbit.core.math.jacobi import sncndn_reduced
+from spinorbit.core.math.pn_fourier import FOURIER_MAX_TERMS, pn_fourier_coefficients, sine_series
 from spinorbit.core.math.rotations import matrix_to_quat, quat_to_attitude
 
 # The double-double AGM for K and Π stops when both the AGM gap and the last term of the Π series
@@ -97,8 +99,13 @@ AGM_MAX_STEPS = 200
     FL_M0_Z,
     FL_KAPPA_HI,  # κ = (a−c) G / ν, the coefficient of pn in g (rad per unit of pn)
     FL_KAPPA_LO,
-) = range(29)
-FLOW_SIZE = 29
+    FL_FOURIER_TERMS,  # N > 0: κ pn(r) from the nome series of .pn_fourier; 0: the Carlson form
+    FL_FOURIER_SCALE,  # π / K: θ = π r / K
+    FL_LINEAR_HI,  # κ Π / K = W / (2K): the secular slope of κ pn(r) in r
+    FL_LINEAR_LO,
+    FL_FOURIER_0,  # κ c_1 … κ c_N (FOURIER_MAX_TERMS slots)
+) = range(34)
+FLOW_SIZE = FL_FOURIER_0 + FOURIER_MAX_TERMS
 
 
 # --------------------------------------------------------------------------------------------------
@@ -191,14 +198,14 @@ def phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c):
 
     Returns
     -------
-    tuple of 14 floats
-        (ν_hi, ν_lo, P_hi, P_lo, cG_hi, cG_lo, W_hi, W_lo, κ_hi, κ_lo, p, p_c, n, ok): the argument
+    tuple of 15 floats
+        (ν_hi, ν_lo, P_hi, P_lo, cG_hi, cG_lo, W_hi, W_lo, κ_hi, κ_lo, p, p_c, n, ok, Π): the argument
         rate ν (argument per time unit), the half period P = 2K(p) of the argument, the secular rate
         c G of g (rad per time unit), the advance W = 2 κ Π(n|p) of g per half period (rad), the pn
         coefficient κ (rad), and the parameter, complementary parameter and characteristic rounded
         once from their double-double values (for the double kernels: near the separatrix p_c from
         doubles would lose ε/p_c); ok = 0 when the double-double p_c is not positive (the
-        separatrix), 1 otherwise.
+        separatrix), 1 otherwise; Π(n|p) rounded once (NaN at the separatrix).
 
     Notes
     -----
@@ -241,10 +248,10 @@ def phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c):
     kah, kal = dd_mul(ach, acl, gh, gl)
     kah, kal = dd_div(kah, kal, nuh, nul)
     if not pch > 0.0:
-        return nuh, nul, math.inf, 0.0, cgh, cgl, 0.0, 0.0, kah, kal, param, pch, -fh, 0.0
+        return nuh, nul, math.inf, 0.0, cgh, cgl, 0.0, 0.0, kah, kal, param, pch, -fh, 0.0, math.nan
     kh, kl, pih, pil = complete_k_pi_dd(fh, fl, pch, pcl)
     wh, wl = dd_mul(kah, kal, 2.0 * pih, 2.0 * pil)
-    return nuh, nul, 2.0 * kh, 2.0 * kl, cgh, cgl, wh, wl, kah, kal, param, pch, -fh, 1.0
+    return nuh, nul, 2.0 * kh, 2.0 * kl, cgh, cgl, wh, wl, kah, kal, param, pch, -fh, 1.0, pih + pil
 
 
 @jit
@@ -298,14 +305,15 @@ def flow_constants(quaternion, momentum, big_a, big_b, big_c):
         mk, pk = elliptic_constants(mo)  # unused by a uniform rotation; returned for one signature
         return flow, mo, mk, pk
     mx, my, mz = fx * m0x, fy * m0y, fz * m0z
-    (nuh, nul, perh, perl, cgh, cgl, wh, wl, kah, kal, param, param_c, char_n, ok) = (
+    (nuh, nul, perh, perl, cgh, cgl, wh, wl, kah, kal, param, param_c, char_n, ok, complete_pi) = (
         phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c)
     )
     if ok > 0.0 and mo[MO_PARAM_C] > 0.0:
         # kernel constants from the once-rounded double-double p, p_c, n (not from ratios of rounded
-        # differences: near the separatrix those lose ε/p_c in p_c)
-        mk = parameter_constants(param, param_c)
-        pk = pn_constants(char_n, param, param_c)
+        # differences: near the separatrix those lose ε/p_c in p_c), with K and Π from the
+        # double-double AGM above instead of a second AGM and a Carlson R_J per state
+        mk = parameter_constants_with_k(param, param_c, 0.5 * perh, 0.5 * perl)
+        pk = characteristic_constants_with_complete(char_n, param, complete_pi)
         periodic = True
     else:  # the separatrix: the kernels' closed forms, from the motion constants
         mk, pk = elliptic_constants(mo)
@@ -323,12 +331,14 @@ def flow_constants(quaternion, momentum, big_a, big_b, big_c):
     flow[FL_G_RATE_HI], flow[FL_G_RATE_LO] = cgh, cgl
     flow[FL_G_ADVANCE_HI], flow[FL_G_ADVANCE_LO] = wh, wl
     flow[FL_KAPPA_HI], flow[FL_KAPPA_LO] = kah, kal
+    if periodic:
+        _fourier_constants(flow, mk, pk)
     # g0 − κ pn(arg0), with pn(arg0) = 2Π j0 + pn(r0) split as at every later time, so that the
     # large parts cancel exactly at t = 0 (κ pn is huge for nearly symmetric bodies)
     if periodic:
         j0, r0h, r0l = dd_remainder_dd(arg0, 0.0, perh, perl)
         s, c, d = sncndn_reduced(r0h, mk[MK_M], mk[MK_MC], mk[MK_SQRT_MUC], mk[MK_K_HI], mk[MK_K_LO])
-        ph, pl = kappa_pn(kah, kal, r0h, r0l, s, c, d, pk)
+        ph, pl = flow_kappa_pn(flow, r0h, r0l, s, c, d, pk)
         jwh, jwl = dd_scale(wh, wl, j0)
         ph, pl = dd_add(ph, pl, jwh, jwl)
     else:
@@ -368,3 +378,39 @@ def kappa_pn(kah, kal, rh, rl, s, c, d, pk):
         return dd_mul(kah, kal, pi_principal(s, c * c, d * d, rh, pk), 0.0)
     xh, xl = dd_add(rh, rl, pi_principal(s, c * c, d * d, 0.0, pk), 0.0)
     return dd_mul(kah, kal, xh, xl)
+
+
+@jit
+def _fourier_constants(flow, mk, pk):
+    """Fill the FL_FOURIER_* / FL_LINEAR_* slots when the nome series of pn converges fast enough.
+
+    The slope κΠ/K = W/(2K) and 1 − Π/K = 1 − (κΠ/K)/κ are formed in double-double from the
+    double-double W, 2K and κ, so neither the secular slope nor the normalisation of the series
+    (:func:`.pn_fourier.pn_fourier_coefficients`) loses digits when Π ≈ K (n → 0).
+    """
+    lh, ll = dd_div(flow[FL_G_ADVANCE_HI], flow[FL_G_ADVANCE_LO], flow[FL_PERIOD_HI], flow[FL_PERIOD_LO])
+    rh, rl = dd_div(lh, ll, flow[FL_KAPPA_HI], flow[FL_KAPPA_LO])
+    one_minus_ratio = dd_add(1.0, 0.0, -rh, -rl)[0]
+    k_quarter = mk[MK_K_HI]
+    terms = pn_fourier_coefficients(
+        -pk[NK_N], mk[MK_M], k_quarter, one_minus_ratio, flow[FL_KAPPA_HI], flow[FL_FOURIER_0:]
+    )
+    flow[FL_FOURIER_TERMS] = terms
+    flow[FL_FOURIER_SCALE] = math.pi / k_quarter
+    flow[FL_LINEAR_HI], flow[FL_LINEAR_LO] = lh, ll
+
+
+@jit
+def flow_kappa_pn(flow, rh, rl, s, c, d, pk):
+    """κ · pn(r) for |r| ≤ K as a double-double, by whichever form the set-up chose.
+
+    FL_FOURIER_TERMS > 0: (κΠ/K) · r in double-double plus κ Σ c_k sin(kπr/K) (:mod:`.pn_fourier`);
+    otherwise the Carlson form :func:`kappa_pn`. The set-up forms g0 − κ pn(arg0) with this same
+    function, so the two agree exactly at t = 0.
+    """
+    terms = int(flow[FL_FOURIER_TERMS])
+    if terms > 0:
+        xh, xl = dd_mul(flow[FL_LINEAR_HI], flow[FL_LINEAR_LO], rh, rl)
+        periodic = sine_series(flow[FL_FOURIER_SCALE] * rh, flow, FL_FOURIER_0, terms)
+        return dd_add(xh, xl, periodic, 0.0)
+    return kappa_pn(flow[FL_KAPPA_HI], flow[FL_KAPPA_LO], rh, rl, s, c, d, pk)

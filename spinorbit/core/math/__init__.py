@@ -6,6 +6,7 @@
   K(m), and the reduction of arguments by the periods;
 - :mod:`.jacobi` — the Jacobian elliptic functions sn, cn, dn and the amplitude am, every m ≥ 0;
 - :mod:`.elliptic_integrals` — F(φ|m), Π(φ, n|m) and Fukushima's pn(u, n|m), every m ≥ 0;
+- :mod:`.pn_fourier` — the periodic part of pn(u, n ≤ 0 | m < 1) as a sine series in the nome;
 - :mod:`.elliptic` — the elliptic layer's one import point: the public names of the four above;
 - :mod:`.rotations` — quaternions (scalar first), rotation matrices and the 3-1-3 Euler sequence.
 

@@ -55,15 +55,7 @@ def characteristic_constants(n, m, mc):
     complete integral for 0 ≤ m < 1 (used for the reduction φ = jπ + r), NaN for m ≥ 1 where no
     reduction happens (F, Π are only real on |φ| ≤ π/2 there).
     """
-    f = -n
-    g = 0.0
-    if n == m:
-        method = METHOD_EQUAL_TO_M
-    elif f >= 1.0:
-        method = METHOD_LARGE_NEGATIVE
-        g = m / f
-    else:
-        method = METHOD_GENERAL
+    method, f, g = _characteristic_method(n, m)
     complete = math.nan
     if mc > 0.0:
         k = rf(0.0, mc, 1.0)
@@ -77,6 +69,33 @@ def characteristic_constants(n, m, mc):
             complete = k
         else:
             complete = k + (n / 3.0) * rj(0.0, mc, 1.0, 1.0 - n)
+    return (float(method), n, f, g, complete)
+
+
+@jit
+def _characteristic_method(n, m):
+    """(METHOD_*, f = −n, g) for the characteristic n (see characteristic_constants)."""
+    f = -n
+    g = 0.0
+    if n == m:
+        method = METHOD_EQUAL_TO_M
+    elif f >= 1.0:
+        method = METHOD_LARGE_NEGATIVE
+        g = m / f
+    else:
+        method = METHOD_GENERAL
+    return method, f, g
+
+
+@jit
+def characteristic_constants_with_complete(n, m, complete):
+    """:func:`characteristic_constants` for 0 ≤ m < 1 with Π(n|m) already known.
+
+    For callers that hold Π from their own double-double AGM (the flow set-up,
+    :func:`spinorbit.core.free_motion.flow_constants.complete_k_pi_dd`), so the complete integral is
+    not formed a second time in Carlson's form.
+    """
+    method, f, g = _characteristic_method(n, m)
     return (float(method), n, f, g, complete)
 
 

@@ -101,6 +101,23 @@ def parameter_constants(m, mc):
         inf = math.inf
         return (m, mc, m, mc, 0.0, 1.0, inf, 0.0, inf, 0.0)
     k_hi, k_lo = quarter_period_dd(muc_hi, muc_lo)
+    return _constants_with_quarter_period(m, mc, mu, muc_hi, sqrt_m, k_hi, k_lo)
+
+
+@jit
+def parameter_constants_with_k(m, mc, k_hi, k_lo):
+    """:func:`parameter_constants` for 0 ≤ m < 1 with K(m) already known as a double-double.
+
+    For callers that hold K from their own double-double AGM (the flow set-up forms K from the
+    exact inputs, :func:`spinorbit.core.free_motion.flow_constants.complete_k_pi_dd`), so the AGM
+    is not run twice per state.
+    """
+    return _constants_with_quarter_period(m, mc, m, mc, 1.0, k_hi, k_lo)
+
+
+@jit
+def _constants_with_quarter_period(m, mc, mu, muc_hi, sqrt_m, k_hi, k_lo):
+    """The MK_* tuple from the reduced parameter and K(μ) (the common tail of the two above)."""
     # half period in u: 2K(μ)/√m, in double-double (√m exact to a double-double too)
     if mc < 0.0:
         sm_hi, sm_lo = dd_sqrt(m, 0.0)

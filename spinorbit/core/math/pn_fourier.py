@@ -1,0 +1,138 @@
+"""The periodic part of pn(u, n | m) for n ≤ 0, 0 ≤ m < 1 as a sine series in the nome.
+
+For n = −f < 0 the integrand 1/(1 + f sn²u) is even with period 2K, so on the principal range
+
+    pn(u) = (Π(n|m)/K) u + Σ_{k≥1} c_k sin(k θ),   θ = π u / K,
+
+and Jacobi's form of Π (Π(u, a) = u Z(a) + ½ ln[Θ(u − a)/Θ(u + a)], n = m sn²a, DLMF 22.16.31 with
+the product of Θ, DLMF 20.5.4 taken logarithmically) gives c_k ∝ q^k sinh(kπγ/K)/(k(1 − q^{2k})),
+where q = e^{−πK'/K} is the nome and a = iγ. Written with β = K' − γ (the distance of the nearest
+pole of the integrand, sn²(iβ) = −1/f, from the real axis, sc(β | 1 − m) = 1/√f):
+
+    c_k = C (ρ^k − σ^k) / (k (1 − q^{2k})),   ρ = e^{−πβ/K},  σ = q²/ρ ≤ ρ,
+
+and the constant C follows from pn'(0) = 1: (π/K) Σ k c_k = 1 − Π/K. β comes without a
+trigonometric call: β = F(φ | 1 − m) with sin²φ = 1/(1 + f), i.e. s R_F(c², Δ², 1) with
+c² = f/(1 + f), Δ² = (f + m)/(1 + f).
+
+Why: per evaluation this is one sin/cos and a Clenshaw sum of a few terms instead of Carlson's R_J
+(five duplication steps, each with an R_C). The series converges like ρ^k; it is used only where
+ρ ≤ ``FOURIER_RHO_MAX`` (at most ``FOURIER_MAX_TERMS`` terms, tail below 1e-17 of the first term).
+Near the separatrix (m → 1: K → ∞, ρ → 1) and for a strongly negative n (f ≫ 1: β → 0) the caller
+keeps the Carlson path. Checked against mpmath on both sides of the rule in
+``tests/test_torque_free.py``.
+"""
+
+import math
+
+import numpy as np
+
+from spinorbit.core.jit import jit
+from spinorbit.core.math.carlson import rf
+
+# Tail of the series: N terms with ρ^N below this (the first omitted term over the first kept is
+# ρ^N): the omitted terms are below ε/20 of the leading one.
+FOURIER_TAIL = 1e-17
+# At most this many terms; with the tail above this allows ρ up to FOURIER_RHO_MAX.
+FOURIER_MAX_TERMS = 24
+FOURIER_RHO_MAX = FOURIER_TAIL ** (1.0 / FOURIER_MAX_TERMS)  # ≈ 0.196
+_RECIPROCALS = np.array([1.0 / k for k in range(1, FOURIER_MAX_TERMS + 1)])  # 1/k, no division per set-up
+
+
+@jit
+def pn_fourier_ratio(f, m, k_quarter):
+    """ρ = e^{−πβ/K}, the convergence ratio of the series (see the module docstring).
+
+    Parameters
+    ----------
+    f : float
+        −n > 0 (dimensionless).
+    m : float
+        Parameter, 0 ≤ m < 1.
+    k_quarter : float
+        K(m), the quarter period.
+    """
+    s2 = 1.0 / (1.0 + f)
+    c2 = f * s2
+    delta2 = (f + m) * s2
+    beta = math.sqrt(s2) * rf(c2, delta2, 1.0)
+    return math.exp(-math.pi * beta / k_quarter)
+
+
+@jit
+def pn_fourier_coefficients(f, m, k_quarter, one_minus_ratio, scale, out):
+    """Write scale · c_k, k = 1..N, into out[0:N] and return N (0 if the series is not used).
+
+    Parameters
+    ----------
+    f : float
+        −n > 0 (dimensionless).
+    m : float
+        Parameter, 0 ≤ m < 1.
+    k_quarter : float
+        K(m).
+    one_minus_ratio : float
+        1 − Π(n|m)/K(m), formed by the caller without cancellation (it fixes C through pn'(0) = 1).
+    scale : float
+        Factor applied to every coefficient (κ of the flow, rad per unit of pn).
+    out : ndarray
+        At least FOURIER_MAX_TERMS slots.
+
+    Returns
+    -------
+    int
+        N, the number of terms written; 0 when ρ > FOURIER_RHO_MAX (use the Carlson form).
+    """
+    if not (f > 0.0) or not (0.0 <= m < 1.0):
+        return 0
+    rho = pn_fourier_ratio(f, m, k_quarter)
+    if not (0.0 < rho <= FOURIER_RHO_MAX):  # ρ underflows only for m < 1e-200 (K'/K > 237); NaN too
+        return 0
+    q = 0.0
+    if m > 0.0:
+        q = math.exp(-math.pi * rf(0.0, m, 1.0) / k_quarter)  # K' = K(1 − m) = R_F(0, m, 1)
+    sigma = q * q / rho
+    q2 = q * q
+    # N from ρ^N ≤ FOURIER_TAIL (ρ ≤ FOURIER_RHO_MAX keeps N ≤ FOURIER_MAX_TERMS)
+    terms = min(FOURIER_MAX_TERMS, max(1, math.ceil(math.log(FOURIER_TAIL) / math.log(rho))))
+    rho_k, sigma_k, q2_k = 1.0, 1.0, 1.0
+    slope = 0.0  # Σ k c_k / C
+    for k in range(terms):
+        rho_k *= rho
+        sigma_k *= sigma
+        b = rho_k - sigma_k
+        if q2_k > FOURIER_TAIL:  # 1/(1 − q^{2k}) is 1 to the last bit once q^{2k} < ε/10
+            q2_k *= q2
+            b /= 1.0 - q2_k
+        out[k] = b * _RECIPROCALS[k]
+        slope += b
+    norm = scale * one_minus_ratio * k_quarter / (math.pi * slope)
+    for k in range(terms):
+        out[k] *= norm
+    return terms
+
+
+@jit
+def sine_series(theta, coefficients, offset, terms):
+    """Σ_{k=1}^{terms} a_k sin(kθ), a_k = coefficients[offset + k − 1], by Clenshaw's recurrence.
+
+    The odd and the even terms are summed as two independent recurrences in steps of 2θ
+    (φ_{j+1} = 2 cos 2θ φ_j − φ_{j−1}), so the two dependent chains run side by side, each written
+    as (a − b_{j+2}) + α b_{j+1} to keep one product and one sum on its critical path:
+    odd part = (b_0 + b_1) sin θ (sin 3θ − α sin θ = sin θ), even part = b_0 sin 2θ. Both are sin θ times a polynomial in
+    cos θ, so the sum keeps its relative accuracy near θ = 0 and θ = π.
+    """
+    s = math.sin(theta)
+    c = math.cos(theta)
+    alpha = 2.0 * ((c - s) * (c + s))  # 2 cos 2θ without the cancellation of 1 − 2 sin²θ
+    odd1, odd2, even1, even2 = 0.0, 0.0, 0.0, 0.0
+    top = terms - 1  # index of the last term (k = terms)
+    if top % 2 == 1:  # the last term is even (k = terms even): start the even chain with it
+        even1 = coefficients[offset + top]
+        top -= 1
+    # now coefficients[offset + top] is odd (k = top + 1 odd); pair (odd k, even k − 1)
+    for index in range(top, 0, -2):
+        odd1, odd2 = (coefficients[offset + index] - odd2) + alpha * odd1, odd1
+        even1, even2 = (coefficients[offset + index - 1] - even2) + alpha * even1, even1
+    odd1, odd2 = (coefficients[offset] - odd2) + alpha * odd1, odd1
+    return (odd1 + odd2) * s + even1 * (2.0 * s * c)

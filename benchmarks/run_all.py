@@ -64,6 +64,8 @@ BENCHMARKS = (
     Benchmark("didymos_report.py", quick=("--no-write",)),
     Benchmark("bench_binary.py", quick=("--repeat", "1", "--no-write")),
     Benchmark("bench_averaged.py"),
+    Benchmark("thermal_validation.py", quick=("--no-write",)),
+    Benchmark("yarkovsky_validation.py", quick=("--quick", "--no-write")),
     Benchmark("stability.py"),
     Benchmark("work_precision.py", full=("--averaged",)),
     Benchmark("bench_startup.py", quick=("--repeat", "1", "--cold-repeat", "0", "--no-write")),

@@ -205,3 +205,10 @@ def test_kernel_refuses_what_has_no_meaning():
         kernel.thermal_response(1.0, -1.0)
     with pytest.raises(ValueError, match="theta"):
         diurnal_recoil_fd(math.nan)
+
+
+def test_orbit_averages_refuse_an_unbound_orbit():
+    with pytest.raises(ValueError, match="eccentricity: expected 0 ≤ e < 1"):
+        kernel.orbit_mean_drift(AU, 1.0, 0.1, 0.0, **MATERIAL)
+    with pytest.raises(ValueError, match="eccentricity: expected 0 ≤ e < 1"):
+        kernel.zero_conductivity_drift(np.eye(3), np.ones(3), 1.0, 1.0, AU, -0.1, 0.1, 0.0)

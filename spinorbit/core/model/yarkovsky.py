@@ -30,6 +30,7 @@ equation, and where the linear theory stops holding, is in docs/thermal.md.
 """
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -204,6 +205,11 @@ def yarkovsky_acceleration(position, velocity, spin_axis, radius, density, condu
     return diurnal, seasonal
 
 
+def _check_eccentricity(eccentricity):
+    if not 0.0 <= eccentricity < 1.0:
+        raise ValueError(f"eccentricity: expected 0 ≤ e < 1 (a bound orbit); got {eccentricity!r}.")
+
+
 def orbit_mean_drift(semi_major_axis, eccentricity, obliquity, spin_longitude, radius, density, conductivity,
                      heat_capacity, absorptivity, emissivity, spin_rate, samples=256):
     """(⟨da/dt⟩ diurnal, seasonal) in m/s over one Kepler orbit, from :func:`yarkovsky_acceleration`.
@@ -214,40 +220,50 @@ def orbit_mean_drift(semi_major_axis, eccentricity, obliquity, spin_longitude, r
     the spin axis is at ``obliquity`` from the orbit normal, its projection ``spin_longitude`` (rad)
     from the perihelion. For e = 0 the result is :func:`circular_drift` (a test checks it).
     """
-    if not 0.0 <= eccentricity < 1.0:
-        raise ValueError(f"eccentricity: expected 0 ≤ e < 1 (a bound orbit); got {eccentricity!r}.")
+    _check_eccentricity(eccentricity)
     mean_motion = math.sqrt(GM_SUN / semi_major_axis**3)
     axis = np.array([math.sin(obliquity) * math.cos(spin_longitude), math.sin(obliquity) * math.sin(spin_longitude),
                      math.cos(obliquity)])
-    root = math.sqrt(1.0 - eccentricity**2)
-    semi_latus = semi_major_axis * (1.0 - eccentricity**2)
     totals = np.zeros(2)
     for anomaly in 2.0 * math.pi * np.arange(samples) / samples:
-        cos_e, sin_e = math.cos(anomaly), math.sin(anomaly)
-        distance = semi_major_axis * (1.0 - eccentricity * cos_e)
-        position = semi_major_axis * np.array([cos_e - eccentricity, root * sin_e, 0.0])
-        velocity = semi_major_axis**2 * mean_motion / distance * np.array([-sin_e, root * cos_e, 0.0])
-        radial = position / distance
-        along = np.array([-radial[1], radial[0], 0.0])  # in the plane, 90° ahead of r̂ (prograde)
-        sin_true = root * sin_e * semi_major_axis / distance
-        parts = yarkovsky_acceleration(position, velocity, axis, radius, density, conductivity, heat_capacity,
+        point = _orbit_point(semi_major_axis, eccentricity, anomaly, mean_motion)
+        parts = yarkovsky_acceleration(point.position, point.velocity, axis, radius, density, conductivity, heat_capacity,
                                        absorptivity, emissivity, spin_rate, mean_motion)
         for index, acceleration in enumerate(parts):
-            rate = 2.0 / (mean_motion * root) * (eccentricity * sin_true * (acceleration @ radial)
-                                                 + semi_latus / distance * (acceleration @ along))
-            totals[index] += rate * (1.0 - eccentricity * cos_e)
+            totals[index] += _weighted_rate(acceleration, point, semi_major_axis, eccentricity, anomaly, mean_motion)
     diurnal, seasonal = totals / samples
     return float(diurnal), float(seasonal)
 
 
+class _OrbitPoint(NamedTuple):
+    position: np.ndarray
+    velocity: np.ndarray
+    distance: float
+    radial: np.ndarray
+    along: np.ndarray  # in the plane, 90° ahead of r̂ (prograde)
+    sin_true: float
+
+
 def _orbit_point(semi_major_axis, eccentricity, eccentric_anomaly, mean_motion):
-    """Position, unit radial and along-track (prograde, 90° ahead of r̂) vectors and sin f at eccentric anomaly E."""
+    """Position, velocity, distance, unit radial and along-track vectors, sin f at eccentric anomaly E."""
     root = math.sqrt(1.0 - eccentricity**2)
     cos_e, sin_e = math.cos(eccentric_anomaly), math.sin(eccentric_anomaly)
     distance = semi_major_axis * (1.0 - eccentricity * cos_e)
     position = semi_major_axis * np.array([cos_e - eccentricity, root * sin_e, 0.0])
+    velocity = semi_major_axis**2 * mean_motion / distance * np.array([-sin_e, root * cos_e, 0.0])
     radial = position / distance
-    return position, distance, radial, np.array([-radial[1], radial[0], 0.0]), root * sin_e * semi_major_axis / distance
+    along = np.array([-radial[1], radial[0], 0.0])
+    return _OrbitPoint(position=position, velocity=velocity, distance=distance, radial=radial, along=along,
+                       sin_true=root * sin_e * semi_major_axis / distance)
+
+
+def _weighted_rate(acceleration, point, semi_major_axis, eccentricity, eccentric_anomaly, mean_motion):
+    """Gauss's da/dt = 2/(n√(1 − e²)) [e sin f a_R + (p/r) a_T] times dM/dE = 1 − e cos E."""
+    semi_latus = semi_major_axis * (1.0 - eccentricity**2)
+    rate = 2.0 / (mean_motion * math.sqrt(1.0 - eccentricity**2)) * (
+        eccentricity * point.sin_true * (acceleration @ point.radial)
+        + semi_latus / point.distance * (acceleration @ point.along))
+    return rate * (1.0 - eccentricity * math.cos(eccentric_anomaly))
 
 
 def zero_conductivity_drift(normals, areas, mass, pressure, semi_major_axis, eccentricity, obliquity, spin_longitude,
@@ -262,27 +278,25 @@ def zero_conductivity_drift(normals, areas, mass, pressure, semi_major_axis, ecc
     obliquity 0 it has no along-track part, and on a sphere it is radial and ∝ 1/r², a conservative
     force, so ⟨da/dt⟩ = 0 on any orbit. The diurnal drift needs conduction (the linear theory above).
     """
+    _check_eccentricity(eccentricity)
     mean_motion = math.sqrt(GM_SUN / semi_major_axis**3)
     sin_o, cos_o = math.sin(obliquity), math.cos(obliquity)
     sin_l, cos_l = math.sin(spin_longitude), math.cos(spin_longitude)
-    # Body → orbit frame: tilt the spin axis by the obliquity towards the spin longitude.
+    # Spin-axis frame → orbit frame: tilt the axis by the obliquity towards the spin longitude.
     tilt = np.array([[cos_o, 0.0, sin_o], [0.0, 1.0, 0.0], [-sin_o, 0.0, cos_o]])
     turn = np.array([[cos_l, -sin_l, 0.0], [sin_l, cos_l, 0.0], [0.0, 0.0, 1.0]])
     to_orbit = turn @ tilt
     centroids = np.zeros_like(normals)  # the torque is not needed
-    root = math.sqrt(1.0 - eccentricity**2)
     total = 0.0
     for anomaly in 2.0 * math.pi * np.arange(samples) / samples:
-        position, distance, radial, along, sin_true = _orbit_point(semi_major_axis, eccentricity, anomaly, mean_motion)
-        sun_body = to_orbit.T @ (-radial)
+        point = _orbit_point(semi_major_axis, eccentricity, anomaly, mean_motion)
+        sun_spin_frame = to_orbit.T @ (-point.radial)
         mean_force = np.zeros(3)
         for phase in 2.0 * math.pi * np.arange(spin_phases) / spin_phases:
             spin = np.array([[math.cos(phase), -math.sin(phase), 0.0], [math.sin(phase), math.cos(phase), 0.0],
                              [0.0, 0.0, 1.0]])  # body → spin-axis frame at this phase
-            force_over_pressure, _ = facet_force_torque(normals, areas, centroids, spin.T @ sun_body)
+            force_over_pressure, _ = facet_force_torque(normals, areas, centroids, spin.T @ sun_spin_frame)
             mean_force += to_orbit @ (spin @ force_over_pressure)
-        acceleration = -pressure * (ASTRONOMICAL_UNIT / distance) ** 2 * mean_force / (spin_phases * mass)
-        rate = 2.0 / (mean_motion * root) * (eccentricity * sin_true * (acceleration @ radial)
-                                             + semi_major_axis * (1.0 - eccentricity**2) / distance * (acceleration @ along))
-        total += rate * (1.0 - eccentricity * math.cos(anomaly))
+        acceleration = -pressure * (ASTRONOMICAL_UNIT / point.distance) ** 2 * mean_force / (spin_phases * mass)
+        total += _weighted_rate(acceleration, point, semi_major_axis, eccentricity, anomaly, mean_motion)
     return total / samples

@@ -21,8 +21,9 @@ W = −(3/2π) ∫∫ u⁴ sin h cos²φ dφ dh over the last period.
 Scheme: uniform cells in depth, Crank–Nicolson in time, the emission linearised about the previous
 step (the surface row is the only one that changes, so the matrix is a fixed inverse plus a rank-one
 Sherman–Morrison update per step); Gauss–Legendre in latitude. The error is second order in the
-cell size (measured in docs/thermal.md), and the start (each latitude at its radiative-equilibrium
-mean temperature) settles within a few periods.
+cell size (measured in docs/thermal.md). From the start (each latitude at its radiative-equilibrium
+mean temperature) the run settles in a few rotations at Θ ≲ 3 and in about Θ rotations above, where
+the column's mean temperature relaxes slowly; the returned change over the last rotation shows it.
 """
 
 import math

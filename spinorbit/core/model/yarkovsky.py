@@ -181,7 +181,7 @@ def yarkovsky_acceleration(position, velocity, spin_axis, radius, density, condu
                            absorptivity, emissivity, spin_rate, mean_motion):
     """The linear theory's recoil acceleration (m/s², split (diurnal, seasonal)) at one heliocentric position.
 
-    Vokrouhlický et al. (2017), AJ 153, 270, as written in Fenucci et al.'s code: with n̂ = r/|r|,
+    Vokrouhlický et al. (2017), AJ 153, 270, as written in Fenucci et al.'s code: with n̂ the unit vector from the Sun,
     ŝ the spin axis, e₂ = n̂ × ŝ, e₃ = ŝ × e₂ and N̂ the orbit normal,
     a = (4/9)αΦ(r) [γ₁ e₂ + γ₂ e₃  (diurnal)  +  (γ̄₂ n̂·ŝ + γ̄₁ (N̂ × n̂)·ŝ) ŝ  (seasonal)],
     (γ₁, γ₂) the response at the spin rate and (γ̄₁, γ̄₂) at the mean motion, both with T*(r) at the

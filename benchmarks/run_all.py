@@ -56,6 +56,7 @@ BENCHMARKS = (
     Benchmark("moon_validation.py"),
     Benchmark("bench_coupled_outputs.py"),
     Benchmark("cli_examples.py"),
+    Benchmark("yarkovsky_validation.py", quick=("--quick", "--no-write")),
     Benchmark("bad_input.py", quick=("--no-write",)),
     Benchmark("bench_ensemble.py", quick=("--members", "4", "--no-write")),
     Benchmark("stm_accuracy.py", quick=("--no-write",)),

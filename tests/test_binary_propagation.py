@@ -19,7 +19,9 @@ from spinorbit.data import didymos
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "didymos_gubas_case.json"
+#: A copy of ../shared/data/didymos_gubas_case.json (the project's reference data, outside the checkout),
+#: so a clean clone tests the numbers against the file they came from.
+DATA = Path(__file__).resolve().parent / "data" / "didymos_gubas_case.json"
 G = 6.6743e-11
 
 

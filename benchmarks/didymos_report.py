@@ -27,7 +27,7 @@ from spinorbit.binary.run import strongest_line  # noqa: E402
 from spinorbit.binary.system import G_SI  # noqa: E402
 from spinorbit.data import didymos  # noqa: E402
 
-DATA = ROOT.parent / "shared" / "data" / "didymos_gubas_case.json"
+DATA = ROOT / "tests" / "data" / "didymos_gubas_case.json"  # the copy of ../shared/data/didymos_gubas_case.json
 ORBITS = 100
 
 

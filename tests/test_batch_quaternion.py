@@ -94,6 +94,7 @@ def test_a_failing_member_is_reported_and_leaves_the_others_alone():
     (dict(t_end=0.0), "t_end: expected an end time other than t0 for every member; member 0"),
     (dict(t0=np.nan), "t0/t_end: expected finite times"),
     (dict(rtol=1e-17), "rtol: expected rtol ≥ 1e-15"),
+    (dict(rtol=[1e-9, 0.0, 1e-9]), "rtol: expected a relative tolerance > 0, got 0.0 for member 1"),
     (dict(atol=np.ones((2, 7))), r"atol: expected a scalar, 7 values or an \(N, 7\) array with N = 3"),
     (dict(atol=-1.0), "atol: expected absolute tolerances ≥ 0"),
 ])
@@ -109,9 +110,15 @@ def test_bad_states_and_models_are_refused():
     y0s, models, _ = _members(3)
     bad = y0s.copy()
     bad[2, 5] = np.inf
-    with pytest.raises(ValueError, match="y0: expected 7 finite numbers"):
+    with pytest.raises(ValueError, match=r"y0s: expected finite states \(q, ω\)"):
         integrate_quaternion_batch(bad, 0.0, 2.0, models)
     with pytest.raises(ValueError, match=r"models: expected one model per member \(3\) or one for all, got 2"):
         integrate_quaternion_batch(y0s, 0.0, 2.0, models[:2])
+    bad = y0s.copy()
+    bad[1, :4] = 0.0
+    with pytest.raises(ValueError, match="y0s: expected a non-zero quaternion .* member 1"):
+        integrate_quaternion_batch(bad, 0.0, 2.0, models)
+    with pytest.raises(ValueError, match="max_steps = 10; raise max_steps"):
+        integrate_quaternion_batch(y0s, 0.0, 200.0, models, max_steps=10)
     with pytest.raises(ValueError, match="models: expected model arrays of one length"):
         integrate_quaternion_batch(y0s, 0.0, 2.0, [models[0], models[1], make_model((0.5, 0.8, 1.0))])

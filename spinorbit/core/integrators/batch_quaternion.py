@@ -28,7 +28,8 @@ import math
 import numpy as np
 
 from spinorbit.core.dynamics.equations import STATE_SIZE, rhs_into
-from spinorbit.core.dynamics.validation import check_step_budget, validate_sampled_span, validate_state
+from spinorbit.core.dynamics.validation import check_step_budget, validate_sampled_span
+from spinorbit.core.errors import require_finite
 from spinorbit.core.integrators.dop853 import (
     C,
     DEFAULT_MAX_STEPS,
@@ -53,7 +54,7 @@ from spinorbit.core.integrators.dop853 import (
     initial_step,
     rejected_step_factor,
 )
-from spinorbit.core.integrators.quaternion import QUATERNION_SIZE, default_atol, minimum_steps, validate_tolerances
+from spinorbit.core.integrators.quaternion import QUATERNION_SIZE, STEPS_PER_TURN_COEFFICIENT
 from spinorbit.core.jit import jit
 from spinorbit.core.model.lunar_interior import has_interior
 
@@ -366,7 +367,7 @@ def integrate_quaternion_batch(y0s, t0, t_end, models, rtol=1e-10, atol=None, ma
         raise ValueError(f"y0s: expected an (N, {STATE_SIZE}) array of states (q, ω), one row per member, "
                          f"got shape {y0s.shape}.")
     n = y0s.shape[0]
-    y0s = np.array([validate_state(row) for row in y0s])
+    y0s = _validated_states(y0s)
     if isinstance(lanes, bool) or not isinstance(lanes, (int, np.integer)) or not 1 <= lanes <= MAX_LANES:
         raise ValueError(f"lanes: expected a whole number of lanes from 1 to {MAX_LANES}, got {lanes!r}.")
     t0s = _per_member("t0", t0, n, "start time")
@@ -376,24 +377,64 @@ def integrate_quaternion_batch(y0s, t0, t_end, models, rtol=1e-10, atol=None, ma
     if np.any(t_ends == t0s):
         bad = int(np.flatnonzero(t_ends == t0s)[0])
         raise ValueError(f"t_end: expected an end time other than t0 for every member; member {bad} has "
-                         f"t0 = t_end = {t0s[bad]!r}.")
+                         f"t0 = t_end = {float(t0s[bad])!r}.")
     models = _stack_models(models, n)
-    rtols = _per_member("rtol", rtol, n, "relative tolerance")
-    atols = np.empty((n, STATE_SIZE))
-    atol_rows = None if atol is None else np.asarray(atol, dtype=float)
-    if atol_rows is not None and atol_rows.ndim == 2 and atol_rows.shape != (n, STATE_SIZE):
-        raise ValueError(f"atol: expected a scalar, {STATE_SIZE} values or an (N, {STATE_SIZE}) array with "
-                         f"N = {n}, got shape {atol_rows.shape}.")
+    rtols = _validated_rtols(_per_member("rtol", rtol, n, "relative tolerance"))
+    spin = np.array([float(np.linalg.norm(row[4:])) for row in y0s])  # default_atol's and rotation_turns' |ω|
+    atols = _validated_atols(atol, rtols, spin)
     for m in range(n):
-        given = default_atol(y0s[m], rtols[m]) if atol_rows is None else (
-            atol_rows[m] if atol_rows.ndim == 2 else atol_rows)
-        rtols[m], atols[m] = validate_tolerances(rtols[m], given)
         validate_sampled_span(models[m], t0s[m], t_ends[m:m + 1])
-        check_step_budget("integrate_quaternion_batch", minimum_steps(y0s[m], t0s[m], t_ends[m], rtols[m]),
-                          max_steps, "shorten the span or loosen rtol")
+    # minimum_steps of every member at once; the worst one against the budget
+    estimates = spin * np.abs(t_ends - t0s) / (2.0 * math.pi) * STEPS_PER_TURN_COEFFICIENT * rtols ** (-1.0 / 8.0)
+    check_step_budget("integrate_quaternion_batch", float(estimates.max()), max_steps,
+                      "shorten the span or loosen rtol")
     ys, stats = batch_dop853_kernel(y0s, t0s, t_ends, models, rtols, atols, int(max_steps), int(lanes))
     return ys, {"accepted": stats[:, STAT_ACCEPTED].copy(), "rejected": stats[:, STAT_REJECTED].copy(),
                 "rhs_calls": stats[:, STAT_RHS_CALLS].copy(), "status": stats[:, STAT_STATUS].copy()}
+
+
+def _validated_states(y0s):
+    """The states with q normalised exactly as :func:`validate_state` does it, checked all at once."""
+    require_finite("y0s", y0s, "finite states (q, ω)")
+    norms = np.array([math.sqrt(float(np.dot(q, q))) for q in y0s[:, :QUATERNION_SIZE]])  # validate_state's sum
+    if np.any(norms < 1e-150):
+        bad = int(np.flatnonzero(norms < 1e-150)[0])
+        raise ValueError(f"y0s: expected a non-zero quaternion in every row's first 4 numbers; member {bad} has "
+                         f"{y0s[bad, :QUATERNION_SIZE].tolist()}; use (1, 0, 0, 0) for the identity attitude.")
+    y0s = y0s.copy()
+    y0s[:, :QUATERNION_SIZE] /= norms[:, None]
+    return y0s
+
+
+def _validated_rtols(rtols):
+    """validate_tolerances' checks of rtol, for every member, naming the first bad one."""
+    bad = ~(np.isfinite(rtols) & (rtols > 0))
+    if np.any(bad):
+        m = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"rtol: expected a relative tolerance > 0, got {float(rtols[m])!r} for member {m}; try 1e-10.")
+    if np.any(rtols < 1e-15):
+        m = int(np.flatnonzero(rtols < 1e-15)[0])
+        raise ValueError(f"rtol: expected rtol ≥ 1e-15 (double precision cannot do better), got {float(rtols[m])!r} "
+                         f"for member {m}.")
+    return rtols
+
+
+def _validated_atols(atol, rtols, spin):
+    """(N, 7) absolute tolerances: each member's default_atol (its bits), or the given ones checked."""
+    n = rtols.shape[0]
+    if atol is None:
+        scale = np.ones((n, STATE_SIZE))
+        scale[:, QUATERNION_SIZE:] = np.maximum(spin, 1e-300)[:, None]
+        return rtols[:, None] * scale
+    atol = np.asarray(atol, dtype=float)
+    if atol.shape not in ((), (1,), (STATE_SIZE,), (n, STATE_SIZE)):
+        raise ValueError(f"atol: expected a scalar, {STATE_SIZE} values or an (N, {STATE_SIZE}) array with "
+                         f"N = {n}, got shape {atol.shape}.")
+    atols = np.broadcast_to(atol, (n, STATE_SIZE)).copy()
+    if not np.all(np.isfinite(atols)) or np.any(atols < 0):
+        raise ValueError(f"atol: expected absolute tolerances ≥ 0 (scalar, {STATE_SIZE} values or one row per "
+                         f"member), got {atol.tolist()}.")
+    return atols
 
 
 def _stack_models(models, n):

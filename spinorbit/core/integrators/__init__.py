@@ -4,6 +4,8 @@
 - :mod:`.dop853` — the one DOP853 engine (stages, error norm, dense output, step-size control, the
   adaptive and fixed-step loops) that every DOP853 propagator uses with its own right-hand side;
 - :mod:`.quaternion` — adaptive DOP853 in (q, ω), with dense output and landing on output times;
+- :mod:`.batch_quaternion` — the same DOP853 on many members in SIMD-friendly lanes (end states only,
+  each member the scalar integrator's bits);
 - :mod:`.elements` — DOP853 in Fukushima's canonical elements (free motion exact, torque as the rate);
 - :mod:`.taylor_recurrences`, :mod:`.taylor` — adaptive Taylor series (Jorba–Zou recurrences) in (q, ω);
 - :mod:`.splitting` — symplectic splittings: exact free flow + torque kicks;

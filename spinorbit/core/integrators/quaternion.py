@@ -175,6 +175,9 @@ def _validate_tolerances(rtol, atol, size=STATE_SIZE):
         raise ValueError(f"atol: expected absolute tolerances ≥ 0 (scalar or {size} values), got {atol.tolist()}.")
     return float(rtol), atol
 
+#: The tolerance check under its public name, for the batch integrator (:mod:`.batch_quaternion`).
+validate_tolerances = _validate_tolerances
+
 
 #: Fewest DOP853 steps per rotation at rtol, as c · rtol^(−1/8): measured 0.46 · rtol^(−1/8) or more on
 #: free rotations of four bodies, three spins, rtol 1e-3 … 1e-14 (1.1 steps per turn at 1e-3, 26 at

@@ -578,8 +578,9 @@ def markdown_peer(p, overhead_pool):
         "", f"The serial and pooled tables are {'the same bits' if p['same'] else 'NOT the same bits'}. "
         f"The 1-minute load average was {p['load'][0]:.2f} before and {p['load'][1]:.2f} after.", "",
         f"The core integrator alone is as accurate (worst {p['core_error'].max():.2e} rad), and so is heyoka's "
-        f"batch mode at the same tolerance (worst {p['batch_error'].max():.2e} rad). spinorbit has no batch mode "
-        "yet (issue 18), so the batch row has no spinorbit peer. "
+        f"batch mode at the same tolerance (worst {p['batch_error'].max():.2e} rad). spinorbit's batch DOP853 "
+        "(`integrate_quaternion_batch`) is measured against it on the same members in the 'batch' section below "
+        "(`benchmarks/bench_batch.py`); the Ensemble does not use it yet. "
         f"The goal (≥ 1.5× heyoka's ensemble throughput at equal accuracy) is "
         + (f"met on one core ({n / p['spin'][1] / best_heyoka:.2f}×)." if n / p['spin'][1] >= 1.5 * best_heyoka else
            f"missed by a factor {1.5 * best_heyoka / (n / p['spin'][1]):.1f} on one core. A member's integration "

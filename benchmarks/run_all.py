@@ -66,7 +66,6 @@ BENCHMARKS = (
     Benchmark("fit_toutatis.py", quick=("--no-write",)),
     Benchmark("didymos_report.py", quick=("--no-write",)),
     Benchmark("bench_binary.py", quick=("--repeat", "1", "--no-write")),
-    Benchmark("thermal_validation.py", quick=("--no-write",)),
     Benchmark("bench_averaged.py"),
     Benchmark("stability.py"),
     Benchmark("work_precision.py", full=("--averaged",)),

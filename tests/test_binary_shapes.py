@@ -9,7 +9,10 @@ import pytest
 from spinorbit.binary import BinaryState, BinarySystem, Figure, propagate
 from spinorbit.core.binary import equations as eq
 from spinorbit.core.binary.errors import UnsupportedOrderError
-from spinorbit.core.binary.inertia_integrals import ellipsoid_integrals, polyhedron_integrals
+from spinorbit.core.binary.inertia_integrals import (
+    ellipsoid_integrals,
+    polyhedron_integrals,
+)
 from spinorbit.core.binary.monomials import DEGREE_START, EXPONENTS, MAX_ORDER
 from spinorbit.core.math.rotations import matrix_to_quat
 from spinorbit.core.model.polyhedron import monomial_moments

@@ -112,7 +112,7 @@ def with_sun(model, sun):
     return out
 
 
-@jit(inline="always")
+@jit  # not inlined: a call only when the Sun is on keeps the isolated pair's RHS as compact as before
 def solar_terms_into(t, y, model):
     """The Sun's tidal acceleration of R (inertial) and its torques on A and B (each on its own axes).
 
@@ -243,6 +243,15 @@ def euler_rate_into(y, w_offset, model, inertia_offset, nx, ny, nz, out):
     out[w_offset + 2] = model[v + 6] * bx + model[v + 7] * by + model[v + 8] * bz
 
 
+@jit(inline="always")
+def add_inverse_inertia_into(out, w_offset, model, inverse_offset, nx, ny, nz):
+    """out[w_offset:w_offset + 3] += I⁻¹ N (I⁻¹ row-major at inverse_offset)."""
+    v = inverse_offset
+    out[w_offset] += model[v] * nx + model[v + 1] * ny + model[v + 2] * nz
+    out[w_offset + 1] += model[v + 3] * nx + model[v + 4] * ny + model[v + 5] * nz
+    out[w_offset + 2] += model[v + 6] * nx + model[v + 7] * ny + model[v + 8] * nz
+
+
 @jit
 def binary_rhs_into(t, y, params, out):
     """dy/dt of the full two-body problem into out; returns |R| − contact distance (< 0: in contact).
@@ -252,17 +261,24 @@ def binary_rhs_into(t, y, params, out):
     """
     model, scratch = params
     _, gx, gy, gz, nax, nay, naz, nbx, nby, nbz = field_into(y, model, scratch)
-    tx, ty, tz, sax, say, saz, sbx, sby, sbz = solar_terms_into(t, y, model)
     inverse_reduced_mass = 1.0 / model[M_MASS_A] + 1.0 / model[M_MASS_B]
     for i in range(3):
         out[POSITION + i] = y[VELOCITY + i]
-    out[VELOCITY] = inverse_reduced_mass * gx + tx
-    out[VELOCITY + 1] = inverse_reduced_mass * gy + ty
-    out[VELOCITY + 2] = inverse_reduced_mass * gz + tz
+    out[VELOCITY] = inverse_reduced_mass * gx
+    out[VELOCITY + 1] = inverse_reduced_mass * gy
+    out[VELOCITY + 2] = inverse_reduced_mass * gz
     quaternion_rate_into(y, QUAT_A, OMEGA_A, out)
     quaternion_rate_into(y, QUAT_B, OMEGA_B, out)
-    euler_rate_into(y, OMEGA_A, model, M_INERTIA_A, nax + sax, nay + say, naz + saz, out)
-    euler_rate_into(y, OMEGA_B, model, M_INERTIA_B, nbx + sbx, nby + sby, nbz + sbz, out)
+    euler_rate_into(y, OMEGA_A, model, M_INERTIA_A, nax, nay, naz, out)
+    euler_rate_into(y, OMEGA_B, model, M_INERTIA_B, nbx, nby, nbz, out)
+    if model[M_SUN] != 0.0:
+        # ω̇ is linear in the torque: the Sun's part is I⁻¹ N_sun added on (the isolated pair pays one test).
+        tx, ty, tz, sax, say, saz, sbx, sby, sbz = solar_terms_into(t, y, model)
+        out[VELOCITY] += tx
+        out[VELOCITY + 1] += ty
+        out[VELOCITY + 2] += tz
+        add_inverse_inertia_into(out, OMEGA_A, model, M_INVERSE_A, sax, say, saz)
+        add_inverse_inertia_into(out, OMEGA_B, model, M_INVERSE_B, sbx, sby, sbz)
     distance = math.sqrt(y[POSITION] ** 2 + y[POSITION + 1] ** 2 + y[POSITION + 2] ** 2)
     return distance - model[M_CONTACT]
 

@@ -23,7 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 from astropy import units as u
 
-from spinorbit.binary.system import BinaryState
+from spinorbit.binary.sun import HeliocentricOrbit
+from spinorbit.binary.system import G_SI, BinaryState
 from spinorbit.core.binary import equations as core
 from spinorbit.core.binary.libration import (
     COL_ENERGY_RATIO,
@@ -59,10 +60,19 @@ class BinaryRun:
     times: u.Quantity
     states: np.ndarray
     stats: dict
+    sun: object = None
 
     @property
     def model(self):
-        return self.initial.system.model()
+        """The core's model array of the pair (with the Sun's block on when the run had one)."""
+        model = self.initial.system.model()
+        return model if self.sun is None else core.with_sun(model, self.sun)
+
+    def tide_power(self):
+        """dE/dt at each output time (W): the Sun's tide working on the orbit and both spins (0 without the Sun)."""
+        model = self.model
+        t = self.times.to_value(u.s)
+        return np.array([core.tide_power(ti, y, model) for ti, y in zip(t, self.states)]) * u.W
 
     def energy(self):
         """Total energy at each output time (J)."""
@@ -174,7 +184,7 @@ def _fit_lines(t, x, frequencies):
     return amplitudes, float(np.sqrt(np.mean(residual ** 2)))
 
 
-def propagate(state, times, rtol=1e-12, max_steps=100_000_000):
+def propagate(state, times, rtol=1e-12, max_steps=100_000_000, sun=None):
     """Propagate a :class:`~spinorbit.binary.system.BinaryState` to ``times`` after it (Quantity, time).
 
     Parameters
@@ -185,6 +195,10 @@ def propagate(state, times, rtol=1e-12, max_steps=100_000_000):
     rtol : float
         DOP853's relative tolerance (1e-15 … 1); 1e-12 keeps E and H to ~1e-13 over 10⁴ orbits
         (docs/binary.md).
+    sun : HeliocentricOrbit, optional
+        The barycentre's heliocentric orbit: adds the Sun's degree-2 tide on the orbit and its
+        gravity-gradient torque on both bodies (:mod:`spinorbit.binary.sun`). Energy and angular
+        momentum are then no longer conserved (:meth:`BinaryRun.tide_power` is the energy's rate).
 
     Raises
     ------
@@ -194,8 +208,15 @@ def propagate(state, times, rtol=1e-12, max_steps=100_000_000):
     t = np.atleast_1d(value_in("times", times, u.s, "np.linspace(0, 10, 1001) * u.day"))
     y0 = state.core_state()
     model = state.system.model()
+    source = None
+    if sun is not None:
+        if not isinstance(sun, HeliocentricOrbit):
+            raise TypeError(f"sun: expected a spinorbit.binary.HeliocentricOrbit (the barycentre's heliocentric "
+                            f"elements) or None, got {type(sun).__name__}.")
+        source = sun.source(model[core.M_MASS_A] + model[core.M_MASS_B], G_SI)
     first = 1 if t[0] == 0.0 else 0
-    ys, stats = propagate_binary(y0, 0.0, t[first:], model, rtol=rtol, max_steps=max_steps, return_stats=True)
+    ys, stats = propagate_binary(y0, 0.0, t[first:], model, rtol=rtol, max_steps=max_steps, return_stats=True,
+                                 sun=source)
     if first:
         ys = np.vstack([y0[None, :], ys])
-    return BinaryRun(state, t * u.s, ys, stats)
+    return BinaryRun(state, t * u.s, ys, stats, source)

@@ -15,7 +15,14 @@ from astropy import constants
 from astropy import units as u
 
 from spinorbit.core.binary import equations as core
-from spinorbit.core.binary.inertia_integrals import ellipsoid_integrals, inertia_tensor
+from spinorbit.core.binary.errors import UnsupportedOrderError
+from spinorbit.core.binary.inertia_integrals import (
+    INTEGRALS_SIZE,
+    ellipsoid_integrals,
+    inertia_tensor,
+    polyhedron_integrals,
+)
+from spinorbit.core.binary.monomials import DEGREE_START, EXPONENTS, MAX_ORDER
 from spinorbit.core.binary.propagate import check_order, check_separation
 from spinorbit.core.math.rotations import quat_to_matrix
 from spinorbit.quantities import value_in
@@ -26,15 +33,21 @@ G_SI = constants.G.si.value
 
 @dataclass(frozen=True)
 class Figure:
-    """A homogeneous rigid body: its inertia integrals on its own axes (SI) and circumscribing radius.
+    """A rigid body: its inertia integrals on its own axes (SI), circumscribing radius and supported order.
 
-    Build it with :meth:`ellipsoid` or :meth:`sphere`.
+    Build it with :meth:`ellipsoid`, :meth:`sphere`, :meth:`from_shape` (a constant-density polyhedron)
+    or :meth:`from_inertia` (mass and inertia tensor only). ``supported_order`` is the highest expansion
+    order its integrals are known to: MAX_ORDER for ellipsoids, spheres and polyhedra (exact), 2 for a
+    body known by its inertia tensor alone. ``semi_axes_m`` is set for ellipsoids only;
+    ``to_principal`` (polyhedra) turns the shape's axes onto the figure's body axes.
     """
 
     name: str
     integrals: np.ndarray
     circumscribing_radius_m: float
-    semi_axes_m: tuple
+    semi_axes_m: tuple | None
+    supported_order: int = MAX_ORDER
+    to_principal: np.ndarray | None = None
 
     @classmethod
     def ellipsoid(cls, name, semi_axes, density):
@@ -65,6 +78,72 @@ class Figure:
         r = value_in("radius", radius, u.m, "390 * u.m", shape=())
         return cls.ellipsoid(name, [r, r, r] * u.m, density)
 
+    @classmethod
+    def from_shape(cls, name, shape, density=None, mass=None):
+        """A constant-density polyhedron (a :class:`spinorbit.shape.Shape`) on its principal axes.
+
+        The figure's body axes are the shape's principal axes about its centre of mass, A ≤ B ≤ C on
+        x, y, z (``to_principal`` takes the shape's axes there: x_body = to_principal @ (x_shape − centre));
+        its integrals to order 4 are exact to rounding (:func:`~spinorbit.core.binary.inertia_integrals.
+        polyhedron_integrals`), its circumscribing radius the farthest vertex from the centre of mass.
+
+        Parameters
+        ----------
+        shape : spinorbit.shape.Shape
+        density : Quantity, mass density, optional
+        mass : Quantity, mass, optional
+            Exactly one of density and mass.
+        """
+        if (density is None) == (mass is None):
+            raise ValueError(f"{name}: give exactly one of density (such as 2200 * u.kg / u.m**3) or mass (such as "
+                             f"4.3e9 * u.kg); got density={density!r}, mass={mass!r}.")
+        vertices_m = shape.vertices.to_value(u.m)
+        unit_integrals, _, rotation, principal_vertices = polyhedron_integrals(vertices_m, shape.faces, 1.0)
+        if density is not None:
+            rho = value_in("density", density, u.kg / u.m ** 3, "2200 * u.kg / u.m**3", shape=())
+        else:
+            rho = value_in("mass", mass, u.kg, "4.3e9 * u.kg", shape=()) / unit_integrals[0]
+        if not rho > 0:
+            raise ValueError(f"{name}: expected a positive density or mass, got a density of {rho!r} kg/m³.")
+        radius = float(np.linalg.norm(principal_vertices, axis=1).max())
+        return cls(name, rho * unit_integrals, radius, None, MAX_ORDER, rotation)
+
+    @classmethod
+    def from_inertia(cls, name, mass, inertia, circumscribing_radius):
+        """A body known by its mass and inertia tensor only: its figure supports expansion order 2.
+
+        The second moments are T₂ = ½ tr(I) E − I; the degree-3 and 4 integrals are unknown, so a system
+        of a higher order refuses it (:class:`~spinorbit.core.binary.errors.UnsupportedOrderError`).
+
+        Parameters
+        ----------
+        mass : Quantity, mass
+        inertia : Quantity (3, 3) or (3,), kg m²
+            Inertia tensor about the centre of mass on the body axes (or its diagonal, principal moments).
+        circumscribing_radius : Quantity, length
+            Radius of a sphere about the centre of mass that contains the body (for the contact distance).
+        """
+        m = value_in("mass", mass, u.kg, "4.3e9 * u.kg", shape=())
+        tensor = np.asarray(value_in("inertia", inertia, u.kg * u.m ** 2, "[2.1e12, 3.2e12, 3.9e12] * u.kg * u.m**2"))
+        tensor = np.diag(tensor) if tensor.shape == (3,) else tensor
+        radius = value_in("circumscribing_radius", circumscribing_radius, u.m, "103 * u.m", shape=())
+        if tensor.shape != (3, 3) or not np.allclose(tensor, tensor.T, rtol=1e-12, atol=0.0):
+            raise ValueError(f"{name}: expected a symmetric (3, 3) inertia tensor or 3 principal moments, got "
+                             f"{tensor.tolist()} kg m².")
+        moments = np.linalg.eigvalsh(tensor)
+        if not m > 0 or not radius > 0 or not moments[0] > 0 or moments[0] + moments[1] < moments[2] * (1 - 1e-12):
+            raise ValueError(f"{name}: expected a positive mass and radius and a physical inertia tensor (positive "
+                             f"principal moments obeying A + B ≥ C), got mass {m} kg, radius {radius} m, principal "
+                             f"moments {moments.tolist()} kg m².")
+        second = 0.5 * np.trace(tensor) * np.eye(3) - tensor
+        integrals = np.zeros(INTEGRALS_SIZE)
+        integrals[0] = m
+        for index in range(DEGREE_START[2], DEGREE_START[3]):
+            # T^α for |α| = 2 is the second moment ∫ x_i x_j dm of the two axes the multi-index names.
+            first, second_axis = np.repeat(np.arange(3), EXPONENTS[index])
+            integrals[index] = second[first, second_axis]
+        return cls(name, integrals, float(radius), None, 2, None)
+
     @property
     def mass(self):
         """Mass (kg)."""
@@ -86,6 +165,13 @@ class BinarySystem:
 
     def __post_init__(self):
         check_order(self.order)
+        for role, figure in (("primary", self.primary), ("secondary", self.secondary)):
+            if self.order > figure.supported_order:
+                raise UnsupportedOrderError(
+                    f"order {self.order}: the {role} {figure.name!r} has inertia integrals to order "
+                    f"{figure.supported_order} only (a body known by its inertia tensor has no degree-3 or 4 "
+                    f"integrals); use order ≤ {figure.supported_order}, or build it from its shape "
+                    "(Figure.from_shape, Figure.ellipsoid).")
 
     @property
     def contact_distance(self):

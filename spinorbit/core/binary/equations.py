@@ -20,7 +20,9 @@ with N_A, N_B the torques of :func:`.mutual_potential.torque_from_weights` (N_B 
 inertia tensors may be full (any body whose integrals are given on axes that are not principal).
 
 The model is one flat float64 array (:func:`make_binary_model`): G, the order, both masses, the
-contact distance, both inertia tensors and their inverses, and both tables of inertia integrals.
+contact distance, both inertia tensors and their inverses, both tables of inertia integrals, and the
+Sun's block (off by default; :func:`with_sun` switches it on): with it, R̈ gains the solar tide and
+each Euler equation the Sun's gravity-gradient torque (:mod:`.solar_tide`, degree 2).
 """
 
 import math
@@ -30,7 +32,9 @@ import numpy as np
 from spinorbit.core.binary.inertia_integrals import INTEGRALS_SIZE, inertia_tensor, rotate_integrals_into
 from spinorbit.core.binary.monomials import N_MONOMIALS
 from spinorbit.core.binary.mutual_potential import mutual_field, torque_from_weights
+from spinorbit.core.binary.solar_tide import gravity_gradient_torque_xyz, sun_position_xyz, tidal_acceleration_xyz
 from spinorbit.core.jit import jit
+from spinorbit.core.model.perturbers import KIND_KEPLER, PARAM_SIZE
 
 # State layout.
 POSITION, VELOCITY, QUAT_A, OMEGA_A, QUAT_B, OMEGA_B = 0, 3, 6, 10, 13, 17
@@ -44,7 +48,11 @@ M_INERTIA_B = M_INVERSE_A + 9
 M_INVERSE_B = M_INERTIA_B + 9
 M_INTEGRALS_A = M_INVERSE_B + 9
 M_INTEGRALS_B = M_INTEGRALS_A + INTEGRALS_SIZE
-BINARY_MODEL_SIZE = M_INTEGRALS_B + INTEGRALS_SIZE
+# The Sun's block: [switch (1 on, 0 off), μ = G M_sun, Kepler parameter row of perturbers.py].
+M_SUN = M_INTEGRALS_B + INTEGRALS_SIZE
+M_SUN_MU = M_SUN + 1
+M_SUN_ORBIT = M_SUN + 2
+BINARY_MODEL_SIZE = M_SUN_ORBIT + PARAM_SIZE
 
 
 def make_binary_model(g, integrals_a, integrals_b, order, contact_distance):
@@ -75,6 +83,54 @@ def make_binary_model(g, integrals_a, integrals_b, order, contact_distance):
     model[M_INTEGRALS_A:M_INTEGRALS_A + INTEGRALS_SIZE] = integrals_a
     model[M_INTEGRALS_B:M_INTEGRALS_B + INTEGRALS_SIZE] = integrals_b
     return model
+
+
+def with_sun(model, sun):
+    """A copy of the model with the Sun's tide on, the barycentre on the orbit of ``sun``.
+
+    Parameters
+    ----------
+    model : ndarray
+        :func:`make_binary_model`.
+    sun : perturber source
+        :func:`spinorbit.core.model.perturbers.kepler_source` of the Sun relative to the barycentre, in
+        the units of the model (μ = G M_sun; epoch in the run's time): from the barycentre's
+        heliocentric elements with ``sign=-1``.
+
+    Raises
+    ------
+    ValueError
+        ``sun`` is not a Keplerian source (sampled or fixed ones are not carried by the binary's model).
+    """
+    if getattr(sun, "kind", None) != KIND_KEPLER:
+        raise ValueError(f"sun: expected a Keplerian source from perturbers.kepler_source (the barycentre's "
+                         f"heliocentric orbit, sign=-1), got {sun!r}.")
+    out = np.array(model, dtype=float)
+    out[M_SUN] = 1.0
+    out[M_SUN_MU] = sun.mu
+    out[M_SUN_ORBIT:M_SUN_ORBIT + PARAM_SIZE] = sun.params
+    return out
+
+
+@jit  # not inlined: a call only when the Sun is on keeps the isolated pair's RHS as compact as before
+def solar_terms_into(t, y, model):
+    """The Sun's tidal acceleration of R (inertial) and its torques on A and B (each on its own axes).
+
+    Returns 9 floats (ax, ay, az, N_Ax, N_Ay, N_Az, N_Bx, N_By, N_Bz), all zero when the Sun is off.
+    """
+    if model[M_SUN] == 0.0:
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    mu = model[M_SUN_MU]
+    sx, sy, sz = sun_position_xyz(t, model, M_SUN_ORBIT)
+    rx, ry, rz = y[POSITION], y[POSITION + 1], y[POSITION + 2]
+    ax, ay, az = tidal_acceleration_xyz(mu, sx, sy, sz, rx, ry, rz)
+    share_a = model[M_MASS_A] / (model[M_MASS_A] + model[M_MASS_B])  # r_B = share_a R, r_A = (share_a − 1) R
+    share_b = share_a - 1.0
+    nax, nay, naz = gravity_gradient_torque_xyz(mu, sx - share_b * rx, sy - share_b * ry, sz - share_b * rz,
+                                                unit_quaternion_matrix_parts(y, QUAT_A), model, M_INERTIA_A)
+    nbx, nby, nbz = gravity_gradient_torque_xyz(mu, sx - share_a * rx, sy - share_a * ry, sz - share_a * rz,
+                                                unit_quaternion_matrix_parts(y, QUAT_B), model, M_INERTIA_B)
+    return ax, ay, az, nax, nay, naz, nbx, nby, nbz
 
 
 # Scratch of one field evaluation (one float64 array, allocated once per run: the RHS allocates nothing).
@@ -187,6 +243,15 @@ def euler_rate_into(y, w_offset, model, inertia_offset, nx, ny, nz, out):
     out[w_offset + 2] = model[v + 6] * bx + model[v + 7] * by + model[v + 8] * bz
 
 
+@jit(inline="always")
+def add_inverse_inertia_into(out, w_offset, model, inverse_offset, nx, ny, nz):
+    """out[w_offset:w_offset + 3] += I⁻¹ N (I⁻¹ row-major at inverse_offset)."""
+    v = inverse_offset
+    out[w_offset] += model[v] * nx + model[v + 1] * ny + model[v + 2] * nz
+    out[w_offset + 1] += model[v + 3] * nx + model[v + 4] * ny + model[v + 5] * nz
+    out[w_offset + 2] += model[v + 6] * nx + model[v + 7] * ny + model[v + 8] * nz
+
+
 @jit
 def binary_rhs_into(t, y, params, out):
     """dy/dt of the full two-body problem into out; returns |R| − contact distance (< 0: in contact).
@@ -206,6 +271,14 @@ def binary_rhs_into(t, y, params, out):
     quaternion_rate_into(y, QUAT_B, OMEGA_B, out)
     euler_rate_into(y, OMEGA_A, model, M_INERTIA_A, nax, nay, naz, out)
     euler_rate_into(y, OMEGA_B, model, M_INERTIA_B, nbx, nby, nbz, out)
+    if model[M_SUN] != 0.0:
+        # ω̇ is linear in the torque: the Sun's part is I⁻¹ N_sun added on (the isolated pair pays one test).
+        tx, ty, tz, sax, say, saz, sbx, sby, sbz = solar_terms_into(t, y, model)
+        out[VELOCITY] += tx
+        out[VELOCITY + 1] += ty
+        out[VELOCITY + 2] += tz
+        add_inverse_inertia_into(out, OMEGA_A, model, M_INVERSE_A, sax, say, saz)
+        add_inverse_inertia_into(out, OMEGA_B, model, M_INVERSE_B, sbx, sby, sbz)
     distance = math.sqrt(y[POSITION] ** 2 + y[POSITION + 1] ** 2 + y[POSITION + 2] ** 2)
     return distance - model[M_CONTACT]
 
@@ -242,3 +315,22 @@ def binary_angular_momentum(y, model):
         out += unit_quaternion_matrix(y, q_offset) @ (inertia @ y[w_offset:w_offset + 3])
     return out
 
+
+
+@jit
+def solar_terms(t, y, model):
+    """(tidal acceleration (3,) inertial, N_A (3,) on A's axes, N_B (3,) on B's axes) of the Sun at t, as arrays."""
+    ax, ay, az, nax, nay, naz, nbx, nby, nbz = solar_terms_into(t, y, model)
+    return np.array([ax, ay, az]), np.array([nax, nay, naz]), np.array([nbx, nby, nbz])
+
+
+@jit
+def tide_power(t, y, model):
+    """dE/dt of :func:`binary_energy` under the Sun: ν Ṙ·a + ω_A·N_A + ω_B·N_B (the mutual terms cancel)."""
+    acceleration, torque_a, torque_b = solar_terms(t, y, model)
+    reduced_mass = 1.0 / (1.0 / model[M_MASS_A] + 1.0 / model[M_MASS_B])
+    power = 0.0
+    for i in range(3):
+        power += (reduced_mass * y[VELOCITY + i] * acceleration[i] + y[OMEGA_A + i] * torque_a[i]
+                  + y[OMEGA_B + i] * torque_b[i])
+    return power

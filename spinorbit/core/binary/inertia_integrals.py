@@ -14,12 +14,17 @@ Homogeneous triaxial ellipsoid, semi-axes a, b, c (closed form): the odd integra
 ∫₀¹ r^{2n} r² dr / ∫₀¹ r² dr = 3/(2n + 3) gives the ball; (−1)!! = 1). It gives T^{200} = m a²/5,
 T^{400} = 3 m a⁴/35, T^{220} = m a² b²/35. A homogeneous sphere is the case a = b = c; its mutual
 potential is exactly that of a point mass because every derivative tensor of 1/R is traceless.
+
+Homogeneous polyhedron (:func:`polyhedron_integrals`): ρ ∫ x^α dV over its tetrahedra by the
+Grundmann–Möller rule of :func:`spinorbit.core.model.polyhedron.monomial_moments`, exact to rounding,
+about the centre of mass on the principal axes (A ≤ B ≤ C on x, y, z); degree 3 no longer vanishes.
 """
 
 import numpy as np
 
 from spinorbit.core.binary.monomials import DEGREE_START, EXPONENTS, MAX_ORDER, UP, index_of, monomials_to_degree
 from spinorbit.core.jit import jit
+from spinorbit.core.model.polyhedron import mass_properties, monomial_moments, principal_frame
 
 #: Length of a body's integral table: every monomial up to the highest supported order.
 INTEGRALS_SIZE = monomials_to_degree(MAX_ORDER)
@@ -65,6 +70,39 @@ def ellipsoid_integrals(mass, semi_axes):
 def sphere_integrals(mass, radius):
     """Inertia integrals of a homogeneous sphere (an ellipsoid with a = b = c = radius)."""
     return ellipsoid_integrals(mass, (radius, radius, radius))
+
+
+def polyhedron_integrals(vertices, faces, density):
+    """Inertia integrals of a constant-density closed polyhedron on its principal axes about its centre of mass.
+
+    Parameters
+    ----------
+    vertices : ndarray (n, 3)
+        Vertex positions on any axes about any origin (length unit, e.g. m), of a mesh checked by
+        :func:`spinorbit.core.model.polyhedron.check_closed_mesh`.
+    faces : ndarray (m, 3) int
+        Outward-oriented triangles.
+    density : float
+        Mass per unit volume (mass/length³).
+
+    Returns
+    -------
+    integrals : ndarray (INTEGRALS_SIZE,)
+        T^α = ρ ∫ x^α dV, indexed as :data:`spinorbit.core.binary.monomials.EXPONENTS` (degree 1 is zero
+        to rounding and set to 0: the origin is the centre of mass).
+    center_of_mass : ndarray (3,)
+        On the input axes.
+    to_principal : ndarray (3, 3)
+        Proper rotation with x_principal = to_principal @ (x − center_of_mass).
+    principal_vertices : ndarray (n, 3)
+        The vertices on the principal axes about the centre of mass.
+    """
+    _, center, inertia = mass_properties(vertices, faces)
+    _, rotation = principal_frame(inertia)
+    principal_vertices = (vertices - center) @ rotation.T
+    integrals = density * monomial_moments(principal_vertices, faces, EXPONENTS[:INTEGRALS_SIZE])
+    integrals[DEGREE_START[1]:DEGREE_START[2]] = 0.0
+    return integrals, center, rotation, principal_vertices
 
 
 def point_mass_integrals(mass):

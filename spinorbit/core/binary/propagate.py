@@ -34,6 +34,7 @@ from spinorbit.core.binary.equations import (
     SCRATCH_SIZE,
     VELOCITY,
     binary_rhs_into,
+    with_sun,
 )
 from spinorbit.core.binary.errors import ContactError, UnsupportedOrderError
 from spinorbit.core.binary.monomials import MAX_ORDER
@@ -172,7 +173,8 @@ def minimum_steps(y0, t0, t_end, rtol):
     return turns * STEPS_PER_TURN_COEFFICIENT * rtol ** (-1.0 / 8.0)
 
 
-def propagate_binary(y0, t0, t_out, model, rtol=1e-12, atol=None, max_steps=DEFAULT_MAX_STEPS, return_stats=False):
+def propagate_binary(y0, t0, t_out, model, rtol=1e-12, atol=None, max_steps=DEFAULT_MAX_STEPS, return_stats=False,
+                     sun=None):
     """Integrate the full two-body problem with adaptive DOP853, output at ``t_out``.
 
     Parameters
@@ -194,6 +196,11 @@ def propagate_binary(y0, t0, t_out, model, rtol=1e-12, atol=None, max_steps=DEFA
         Cap on the steps (refused before the run when the lower bound :func:`minimum_steps` exceeds it).
     return_stats : bool
         Also return a dict of step counts.
+    sun : perturber source, optional
+        The Sun relative to the barycentre on a Keplerian orbit (:func:`spinorbit.core.model.perturbers.
+        kepler_source`, ``sign=-1`` with the barycentre's heliocentric elements; epoch in the run's time):
+        adds the solar tide and both gravity-gradient torques (:func:`.equations.with_sun`). None: the
+        isolated pair (or the model's own Sun block, if it has one switched on).
 
     Returns
     -------
@@ -209,7 +216,7 @@ def propagate_binary(y0, t0, t_out, model, rtol=1e-12, atol=None, max_steps=DEFA
     IntegrationError
         The engine stopped early (step cap, step underflow, non-finite state).
     """
-    model = np.ascontiguousarray(model, dtype=float)
+    model = np.ascontiguousarray(model if sun is None else with_sun(model, sun), dtype=float)
     check_order(int(model[M_ORDER]))
     y0 = validate_binary_state(y0, model)
     t0 = float(t0)

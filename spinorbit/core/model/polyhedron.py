@@ -17,7 +17,9 @@ volumes of the parts outside the body cancel, whatever the origin. With D = a ·
 The degree 2–4 Stokes coefficients integrate the regular solid harmonics rⁿ P_nm(sin φ) e^{imλ}
 (degree-n polynomials) over the same tetrahedra with the Grundmann–Möller rule of degree 5
 (Grundmann & Möller 1978, SIAM J. Numer. Anal. 15, 282), which is exact for polynomials of degree ≤ 5:
-the coefficients are exact to rounding, not approximations of the polyhedron.
+the coefficients are exact to rounding, not approximations of the polyhedron. The moments of any
+monomials, ∫ x^α dV (:func:`monomial_moments`, the inertia integrals of the binary), use the same
+rule at the lowest odd degree ≥ max |α|.
 """
 
 import math
@@ -29,7 +31,7 @@ from spinorbit.core.errors import SpinorbitError, require_finite
 
 __all__ = [
     "InvalidMeshError", "check_closed_mesh", "face_geometry", "mass_properties", "principal_frame",
-    "regular_solid_harmonics", "stokes_coefficients", "simplex_rule",
+    "regular_solid_harmonics", "stokes_coefficients", "simplex_rule", "tetrahedron_nodes", "monomial_moments",
 ]
 
 #: A face whose area is below this fraction of the mesh's squared size is degenerate: its normal is
@@ -282,11 +284,7 @@ def stokes_coefficients(vertices, faces, reference_radius, degree_max=4):
     if not 0 <= degree_max <= RULE_DEGREE:
         raise ValueError(f"degree_max: expected 0..{RULE_DEGREE} (the exact tetrahedron rule's degree); got "
                          f"{degree_max!r}.")
-    nodes, weights = simplex_rule()
-    a, b, c = (vertices[faces[:, k]] for k in range(3))
-    det = np.einsum("ij,ij->i", a, np.cross(b, c))
-    # Node k of face f at Σ_j u_kj v_j (the tetrahedron (0, a, b, c)); volume element |det| du.
-    points = (nodes[:, 0, None, None] * a + nodes[:, 1, None, None] * b + nodes[:, 2, None, None] * c)
+    points, weights, det = tetrahedron_nodes(vertices, faces)
     real, imag = regular_solid_harmonics(points, degree_max)
     integral_real = np.einsum("nmkf,k,f->nm", real, weights, det)
     integral_imag = np.einsum("nmkf,k,f->nm", imag, weights, det)
@@ -299,3 +297,63 @@ def stokes_coefficients(vertices, faces, reference_radius, degree_max=4):
             c_out[n, m] = factor * integral_real[n, m]
             s_out[n, m] = factor * integral_imag[n, m]
     return c_out, s_out
+
+
+def tetrahedron_nodes(vertices, faces, degree=RULE_DEGREE):
+    """Nodes, weights and signed volume factors of the rule of ``degree`` over the tetrahedra (0, a, b, c).
+
+    ∫_V f dV = Σ_{k,f} weights[k] · det[f] · f(points[k, f]) exactly for polynomials f of degree ≤ ``degree``
+    (the signed volumes of the parts outside the body cancel for a closed surface).
+
+    Returns
+    -------
+    points : ndarray (k, m, 3)
+        Node k of face f at Σ_j u_kj v_j, (a, b, c) = the face's vertices (length).
+    weights : ndarray (k,)
+        The rule's weights on the unit tetrahedron (sum 1/6).
+    det : ndarray (m,)
+        a · (b × c), the Jacobian of each tetrahedron (length³; negative where it lies outside).
+    """
+    nodes, weights = simplex_rule(degree)
+    a, b, c = (vertices[faces[:, k]] for k in range(3))
+    det = np.einsum("ij,ij->i", a, np.cross(b, c))
+    points = (nodes[:, 0, None, None] * a + nodes[:, 1, None, None] * b + nodes[:, 2, None, None] * c)
+    return points, weights, det
+
+
+def monomial_moments(vertices, faces, exponents):
+    """∫ x^α dV over a closed polyhedron for each row α of ``exponents``, exactly (to rounding).
+
+    The tetrahedron rule's degree is the lowest odd one ≥ max |α| (Grundmann–Möller rules have odd
+    degree), so every monomial is integrated exactly.
+
+    Parameters
+    ----------
+    vertices : ndarray (n, 3)
+        length, about the origin the moments are taken about and on the axes they are taken on.
+    faces : ndarray (m, 3) int
+    exponents : array_like of int, shape (p, 3)
+        (α_x, α_y, α_z) of each monomial, all ≥ 0.
+
+    Returns
+    -------
+    ndarray (p,)
+        ∫ x^α_x y^α_y z^α_z dV (length^(3 + |α|)).
+    """
+    exponents = np.asarray(exponents)
+    if exponents.ndim != 2 or exponents.shape[1] != 3 or not np.issubdtype(exponents.dtype, np.integer) \
+            or np.any(exponents < 0):
+        raise ValueError(f"exponents: expected a (p, 3) array of non-negative integers (α_x, α_y, α_z); got shape "
+                         f"{exponents.shape} and dtype {exponents.dtype}.")
+    highest = int(exponents.sum(axis=1).max()) if exponents.shape[0] else 0
+    degree = max(1, highest + (1 - highest % 2))
+    points, weights, det = tetrahedron_nodes(vertices, faces, degree)
+    weighted = weights[:, None] * det[None, :]
+    powers = [np.ones(points.shape[:2] + (3,))]
+    for _ in range(highest):
+        powers.append(powers[-1] * points)
+    out = np.empty(exponents.shape[0])
+    for row, (ax, ay, az) in enumerate(exponents):
+        values = powers[ax][..., 0] * powers[ay][..., 1] * powers[az][..., 2]
+        out[row] = float(np.sum(weighted * values))
+    return out

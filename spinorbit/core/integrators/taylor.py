@@ -110,6 +110,43 @@ def convergence_radius(n_prev, n_last, order):
 
 
 @jit
+def step_factor_of(order, order_factor, tol):
+    """The safety factor on the convergence radius: heyoka's (order_factor = 1), or tol^(1/p) for raised orders."""
+    if order_factor == 1.0:
+        return math.exp(-2.0) * math.exp(-0.7 / (order - 1))
+    return tol ** (1.0 / order) * math.exp(-0.7 / (order - 1))
+
+
+@jit
+def first_step_bound(y):
+    """The step the first one may grow from: 1/(e² |ω|), a fraction of a rotation."""
+    w_norm = math.sqrt(y[4] * y[4] + y[5] * y[5] + y[6] * y[6])
+    return 1.0 / (math.e * math.e * max(w_norm, 1e-300))
+
+
+@jit
+def next_step(t, rho, step_factor, h_cap, direction, t_stop):
+    """(t_new, h, status) of the step from t with convergence radius rho, capped at h_cap and at t_stop.
+
+    status is STATUS_SUCCESS, or STATUS_NOT_FINITE (no finite radius) or STATUS_STEP_TOO_SMALL (a step
+    of at most 10 ulp of t), in which case no step is taken.
+    """
+    h_abs = min(rho * step_factor, h_cap)
+    if not math.isfinite(h_abs) or h_abs <= 0.0:
+        if math.isinf(rho) and math.isfinite(h_cap):
+            h_abs = h_cap  # exactly polynomial solution (e.g. at rest)
+        else:
+            return t, 0.0, STATUS_NOT_FINITE
+    t_new = t + direction * h_abs
+    if direction * (t_new - t_stop) > 0.0:
+        t_new = t_stop
+    h = t_new - t
+    if not (abs(h) > 10.0 * abs(np.nextafter(t, t + direction) - t)):
+        return t, h, STATUS_STEP_TOO_SMALL
+    return t_new, h, STATUS_SUCCESS
+
+
+@jit
 def integrate_taylor_kernel(y0, t0, t_out, model, tol, order_factor, max_steps):
     """Adaptive Taylor integration from (t0, y0) with output at the monotone times ``t_out``.
 
@@ -131,15 +168,10 @@ def integrate_taylor_kernel(y0, t0, t_out, model, tol, order_factor, max_steps):
     normalize_quaternion_part(y)
     t_end = t_out[n_out - 1]
     direction = 1.0 if t_end >= t0 else -1.0
-    # heyoka's safety factor on ρ (order_factor = 1), or the tolerance itself for raised orders.
-    if order_factor == 1.0:
-        step_factor = math.exp(-2.0) * math.exp(-0.7 / (order - 1))
-    else:
-        step_factor = tol ** (1.0 / order) * math.exp(-0.7 / (order - 1))
+    step_factor = step_factor_of(order, order_factor, tol)
     orbit_orders = np.zeros(max(n_pert, 1), dtype=np.int64)
     orbit_tol = ORBIT_TOLERANCE_FRACTION * tol
-    w_norm = math.sqrt(y[4] * y[4] + y[5] * y[5] + y[6] * y[6])
-    h_prev = 1.0 / (math.e * math.e * max(w_norm, 1e-300))
+    h_prev = first_step_bound(y)
     h_last = 0.0
     t = t0
     i_out = 0
@@ -164,19 +196,9 @@ def integrate_taylor_kernel(y0, t0, t_out, model, tol, order_factor, max_steps):
         rho = convergence_radius(n_prev, n_last, order)
         if n_pert > 0:
             rho = min(rho, orbit_radius(s, n_pert, orbit_orders, order))
-        h_abs = min(rho * step_factor, h_cap)
-        if not math.isfinite(h_abs) or h_abs <= 0.0:
-            if math.isinf(rho) and math.isfinite(h_cap):
-                h_abs = h_cap  # exactly polynomial solution (e.g. at rest)
-            else:
-                stats[STAT_STATUS] = STATUS_NOT_FINITE
-                return ys, stats
-        t_new = t + direction * h_abs
-        if direction * (t_new - t_stop) > 0.0:
-            t_new = t_stop
-        h = t_new - t
-        if not (abs(h) > 10.0 * abs(np.nextafter(t, t + direction) - t)):
-            stats[STAT_STATUS] = STATUS_STEP_TOO_SMALL
+        t_new, h, status = next_step(t, rho, step_factor, h_cap, direction, t_stop)
+        if status != STATUS_SUCCESS:
+            stats[STAT_STATUS] = status
             return ys, stats
         steps += 1
         stats[STAT_STEPS] += 1

@@ -47,7 +47,6 @@ from spinorbit.core.integrators.dop853 import (
     STATUS_MAX_STEPS,
     STATUS_MESSAGES,
     STATUS_NOT_FINITE,
-    STATUS_STEP_TOO_SMALL,
     STATUS_SUCCESS,
     IntegrationError,
 )
@@ -60,6 +59,9 @@ from spinorbit.core.integrators.taylor import (
     STAT_STEPS,
     STEP_GROWTH,
     TAYLOR_STEPS_PER_TURN,
+    first_step_bound,
+    next_step,
+    step_factor_of,
     taylor_order,
 )
 from spinorbit.core.integrators.taylor_recurrences import (
@@ -226,11 +228,10 @@ def integrate_taylor_variational_kernel(y0, t0, t_out, model, tol, max_steps):
         var[V_PHI + i * LOCAL_SIZE + i] = 1.0
     t_end = t_out[n_out - 1]
     direction = 1.0 if t_end >= t0 else -1.0
-    step_factor = math.exp(-2.0) * math.exp(-0.7 / (order - 1))  # the Taylor integrator's, order_factor 1
+    step_factor = step_factor_of(order, 1.0, tol)
     orbit_orders = np.zeros(max(n_pert, 1), dtype=np.int64)
     orbit_tol = ORBIT_TOLERANCE_FRACTION * tol
-    w_norm = math.sqrt(y[4] * y[4] + y[5] * y[5] + y[6] * y[6])
-    h_prev = 1.0 / (math.e * math.e * max(w_norm, 1e-300))
+    h_prev = first_step_bound(y)
     h_last = 0.0
     t = t0
     i_out = 0
@@ -264,19 +265,9 @@ def integrate_taylor_variational_kernel(y0, t0, t_out, model, tol, max_steps):
                 rho = min(rho, n_var ** (-1.0 / k))
         if n_pert > 0:
             rho = min(rho, orbit_radius(s, n_pert, orbit_orders, order))
-        h_abs = min(rho * step_factor, h_cap)
-        if not math.isfinite(h_abs) or h_abs <= 0.0:
-            if math.isinf(rho) and math.isfinite(h_cap):
-                h_abs = h_cap  # exactly polynomial solution (e.g. at rest)
-            else:
-                stats[STAT_STATUS] = STATUS_NOT_FINITE
-                return ys, vs, stats
-        t_new = t + direction * h_abs
-        if direction * (t_new - t_stop) > 0.0:
-            t_new = t_stop
-        h = t_new - t
-        if not (abs(h) > 10.0 * abs(np.nextafter(t, t + direction) - t)):
-            stats[STAT_STATUS] = STATUS_STEP_TOO_SMALL
+        t_new, h, status = next_step(t, rho, step_factor, h_cap, direction, t_stop)
+        if status != STATUS_SUCCESS:
+            stats[STAT_STATUS] = status
             return ys, vs, stats
         steps += 1
         stats[STAT_STEPS] += 1

@@ -19,25 +19,17 @@ from spinorbit.core.binary.inertia_integrals import (
 from spinorbit.core.binary.monomials import EXPONENTS, MAX_ORDER
 from spinorbit.core.binary.propagate import check_order, propagate_binary
 from spinorbit.core.errors import SpinorbitError
-from spinorbit.core.math.rotations import matrix_to_quat, quat_to_matrix
+from spinorbit.core.math.rotations import matrix_to_quat
 from spinorbit.core.model.gravity_field import figure_force_function_and_gradient, figure_torque, make_body
 
 sys.path.insert(0, str(Path(__file__).parent))
 import _binary_reference as reference  # noqa: E402
+from _binary_differences import differenced_field, rotation  # noqa: E402
 
 AXES_A = (1.2, 1.0, 0.8)
 AXES_B = (0.5, 0.4, 0.3)
 MASS_A, MASS_B = 2.0, 0.3
 CONTACT = max(AXES_A) + max(AXES_B)
-
-
-def rotation(vector):
-    """Rodrigues: the matrix of the rotation by |vector| about vector."""
-    vector = np.asarray(vector, dtype=float)
-    angle = np.linalg.norm(vector)
-    k = vector / angle
-    cross = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + np.sin(angle) * cross + (1 - np.cos(angle)) * cross @ cross
 
 
 def state(separation, attitude_a=np.eye(3), attitude_b=np.eye(3)):
@@ -133,11 +125,6 @@ def test_two_spheres_are_two_point_masses_at_every_order(order):
 
 # --- derivatives of the one potential ----------------------------------------------------------------
 
-def five_point_derivative(f, h):
-    """(−f(2h) + 8 f(h) − 8 f(−h) + f(−2h)) / 12h: truncation h⁴ f⁽⁵⁾/30."""
-    return (-f(2 * h) + 8 * f(h) - 8 * f(-h) + f(-2 * h)) / (12 * h)
-
-
 @pytest.mark.parametrize("order", [2, 3, 4])
 def test_force_and_both_torques_are_derivatives_of_the_potential(order):
     # Five-point differences of U with h = 1e-3 (lengths and radians of order 1): truncation ~ h⁴ U⁽⁵⁾ ≈
@@ -146,27 +133,7 @@ def test_force_and_both_torques_are_derivatives_of_the_potential(order):
     model = ellipsoids(order)
     y = state(SEPARATION, M_A, M_B)
     _, grad, torque_a, torque_b, _ = eq.mutual_state(y, model)
-    h = 1e-3
-
-    def potential_moved(k):
-        def f(x):
-            moved = y.copy()
-            moved[eq.POSITION + k] += x
-            return eq.mutual_state(moved, model)[0]
-        return f
-
-    def potential_turned(offset, attitude, k):
-        def f(x):
-            angle = np.zeros(3)
-            angle[k] = x
-            turned = y.copy()
-            turned[offset:offset + 4] = matrix_to_quat(rotation(angle) @ attitude)
-            return eq.mutual_state(turned, model)[0]
-        return f
-
-    fd_grad = np.array([five_point_derivative(potential_moved(k), h) for k in range(3)])
-    fd_a = np.array([five_point_derivative(potential_turned(eq.QUAT_A, M_A, k), h) for k in range(3)])
-    fd_b = np.array([five_point_derivative(potential_turned(eq.QUAT_B, M_B, k), h) for k in range(3)])
+    fd_grad, fd_a, fd_b = differenced_field(y, model, M_A, M_B, h=1e-3)
     assert np.allclose(grad, fd_grad, rtol=0, atol=1e-8 * np.abs(grad).max())
     # The finite differences rotate about inertial axes; the torques are on each body's axes.
     assert np.allclose(M_A @ torque_a, fd_a, rtol=0, atol=1e-8 * np.abs(fd_a).max())

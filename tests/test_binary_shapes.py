@@ -6,6 +6,8 @@ import astropy.units as u
 import numpy as np
 import pytest
 
+from _binary_differences import differenced_field, rotation
+
 from spinorbit.binary import BinaryState, BinarySystem, Figure, propagate
 from spinorbit.core.binary import equations as eq
 from spinorbit.core.binary.errors import UnsupportedOrderError
@@ -20,15 +22,6 @@ from spinorbit.shape import box_shape, ellipsoid_shape, gaussian_random_sphere
 
 AXES = (3.0, 2.0, 1.0)
 SIZE = int(DEGREE_START[MAX_ORDER + 1])
-
-
-def rotation(vector):
-    """Rodrigues: the matrix of the rotation by |vector| about vector."""
-    vector = np.asarray(vector, dtype=float)
-    angle = np.linalg.norm(vector)
-    k = vector / angle
-    cross = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + np.sin(angle) * cross + (1 - np.cos(angle)) * cross @ cross
 
 
 def test_ellipsoid_mesh_integrals_converge_to_the_closed_form_at_the_mesh_s_rate():
@@ -111,11 +104,6 @@ def test_odd_integrals_of_an_irregular_shape_match_the_divergence_theorem():
     assert np.abs(tetrahedra[third]).max() > 1e-3 * tetrahedra[0]  # the shape really is lopsided
 
 
-def five_point_derivative(f, h):
-    """(−f(2h) + 8 f(h) − 8 f(−h) + f(−2h)) / 12h: truncation h⁴ f⁽⁵⁾/30."""
-    return (-f(2 * h) + 8 * f(h) - 8 * f(-h) + f(-2 * h)) / (12 * h)
-
-
 @pytest.mark.parametrize("order", [3, 4])
 def test_lopsided_polyhedra_give_a_force_and_torques_that_are_derivatives_of_the_potential(order):
     # Ellipsoids have no odd integrals; two irregular shapes exercise the degree-3 terms of the expansion.
@@ -134,26 +122,7 @@ def test_lopsided_polyhedra_give_a_force_and_torques_that_are_derivatives_of_the
     y[eq.QUAT_B:eq.QUAT_B + 4] = matrix_to_quat(attitude_b)
     _, grad, torque_a, torque_b, _ = eq.mutual_state(y, model)
 
-    def moved(k):
-        def f(x):
-            z = y.copy()
-            z[eq.POSITION + k] += x
-            return eq.mutual_state(z, model)[0]
-        return f
-
-    def turned(offset, attitude, k):
-        def f(x):
-            angle = np.zeros(3)
-            angle[k] = x
-            z = y.copy()
-            z[offset:offset + 4] = matrix_to_quat(rotation(angle) @ attitude)
-            return eq.mutual_state(z, model)[0]
-        return f
-
-    h = 1e-3
-    fd_grad = np.array([five_point_derivative(moved(k), h) for k in range(3)])
-    fd_a = np.array([five_point_derivative(turned(eq.QUAT_A, attitude_a, k), h) for k in range(3)])
-    fd_b = np.array([five_point_derivative(turned(eq.QUAT_B, attitude_b, k), h) for k in range(3)])
+    fd_grad, fd_a, fd_b = differenced_field(y, model, attitude_a, attitude_b, h=1e-3)
     assert np.allclose(grad, fd_grad, rtol=0, atol=1e-8 * np.abs(grad).max())
     assert np.allclose(attitude_a @ torque_a, fd_a, rtol=0, atol=1e-8 * np.abs(fd_a).max())
     assert np.allclose(attitude_b @ torque_b, fd_b, rtol=0, atol=1e-8 * np.abs(fd_b).max())

@@ -6,6 +6,8 @@ import astropy.units as u
 import numpy as np
 import pytest
 
+from _binary_differences import rotation
+
 from spinorbit.binary import HeliocentricOrbit, propagate
 from spinorbit.core.binary import equations as eq
 from spinorbit.core.binary.inertia_integrals import ellipsoid_integrals
@@ -21,14 +23,6 @@ AXES_A, AXES_B = (1.2, 1.0, 0.8), (0.5, 0.4, 0.3)
 MASS_A, MASS_B = 2.0, 0.3
 MU_SUN = 5.0e4
 SUN_ELEMENTS = dict(a=200.0, e=0.3, inc=0.4, node=1.1, argp=-0.6, mean_anomaly=2.0)
-
-
-def rotation(vector):
-    vector = np.asarray(vector, dtype=float)
-    angle = np.linalg.norm(vector)
-    k = vector / angle
-    cross = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + np.sin(angle) * cross + (1 - np.cos(angle)) * cross @ cross
 
 
 def pair_with_sun(separation=(3.1, 1.2, -0.7)):

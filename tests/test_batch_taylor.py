@@ -8,23 +8,14 @@ tolerance is needed, and any change of the arithmetic or of the step sequence wo
 
 import numpy as np
 import pytest
+from _batch_members import SOURCES, members
 
 from spinorbit.core import integrate_taylor, integrate_taylor_batch, make_model
 from spinorbit.core.dynamics.equations import MODEL_PERTURBERS
 from spinorbit.core.errors import NonFiniteError, WorkLimitError
 from spinorbit.core.integrators.batch_quaternion import raise_for_batch_status
 from spinorbit.core.integrators.dop853 import STATUS_MAX_STEPS, STATUS_NOT_FINITE, STATUS_SUCCESS, IntegrationError
-from spinorbit.core.model.perturbers import kepler_source, sampled_source
-
-#: Two point masses on an ellipse and a hyperbola (a close passage), in units where the spin is O(1).
-SOURCES = (kepler_source(1e-2, 2.0, 0.3, 0.2, 0.1, 0.4, 0.0), kepler_source(3e-3, -1.5, 1.4, 0.5, 0.3, 0.2, -1.0))
-
-
-def _members(n, seed=1, sources=SOURCES):
-    rng = np.random.default_rng(seed)
-    models = [make_model((0.5 + 0.1 * rng.random(), 0.8 + 0.1 * rng.random(), 1.0), sources) for _ in range(n)]
-    y0s = np.hstack([rng.normal(size=(n, 4)), 3.0 * rng.normal(size=(n, 3))])
-    return y0s, models, rng
+from spinorbit.core.model.perturbers import sampled_source
 
 
 def _scalar(y0, t0, t_end, model, tol):
@@ -35,7 +26,7 @@ def _scalar(y0, t0, t_end, model, tol):
 @pytest.mark.parametrize("lanes", [1, 3, 4])
 def test_each_member_is_the_scalar_integrators_bits(lanes):
     """Own moments, states, spans (forward and backward), start times and tolerances (so orders) per member."""
-    y0s, models, rng = _members(7)
+    y0s, models, rng = members(7)
     t0s = rng.uniform(-1.0, 1.0, 7)
     t_ends = t0s + rng.choice([-1.0, 1.0], 7) * rng.uniform(2.0, 6.0, 7)
     tols = 10.0 ** -rng.uniform(6.0, 13.0, 7)
@@ -52,7 +43,7 @@ def test_each_member_is_the_scalar_integrators_bits(lanes):
 
 
 def test_a_members_result_does_not_depend_on_its_lane_mates():
-    y0s, models, _ = _members(6, seed=3)
+    y0s, models, _ = members(6, seed=3)
     ys, _ = integrate_taylor_batch(y0s, 0.0, 4.0, models, 1e-10, lanes=4)
     order = [5, 2, 0, 4, 1, 3]
     shuffled, _ = integrate_taylor_batch(y0s[order], 0.0, 4.0, [models[i] for i in order], 1e-10, lanes=2)
@@ -62,7 +53,7 @@ def test_a_members_result_does_not_depend_on_its_lane_mates():
 def test_finished_lanes_are_masked_and_refilled():
     """Spans from 0.5 to 8 in 3 lanes: short members finish while long ones still step, their lanes take the
     next members, and a lane left idle at the end of the queue changes no other member's bits."""
-    y0s, models, _ = _members(8, seed=5)
+    y0s, models, _ = members(8, seed=5)
     t_ends = np.array([0.5, 8.0, 1.0, 6.0, 0.7, 3.0, 8.0, 0.5])
     ys, stats = integrate_taylor_batch(y0s, 0.0, t_ends, models, 1e-9, lanes=3)
     assert stats["steps"].max() > 5 * stats["steps"].min()
@@ -78,7 +69,7 @@ def test_sampled_and_fixed_perturbers_and_one_model_for_all():
     positions = np.column_stack([3.0 * np.cos(0.3 * times), 3.0 * np.sin(0.3 * times), 0.2 + 0.0 * times])
     velocities = np.column_stack([-0.9 * np.sin(0.3 * times), 0.9 * np.cos(0.3 * times), 0.0 * times])
     model = make_model((0.6, 0.85, 1.0), [sampled_source(2e-2, times, positions, velocities)])
-    y0s, _, _ = _members(3, seed=6)
+    y0s, _, _ = members(3, seed=6)
     ys, stats = integrate_taylor_batch(y0s, 0.0, 4.0, model, 1e-10, lanes=2)
     for m in range(3):
         end, scalar_stats = _scalar(y0s[m], 0.0, 4.0, model, 1e-10)
@@ -88,7 +79,7 @@ def test_sampled_and_fixed_perturbers_and_one_model_for_all():
 def test_a_failing_member_is_reported_and_leaves_the_others_alone():
     """A NaN perturber mass makes one member's torque NaN: it stops NOT_FINITE with a NaN row, its lane is
     refilled, and every other member keeps the scalar integrator's bits; a step cap stops another one."""
-    y0s, models, _ = _members(5, seed=2)
+    y0s, models, _ = members(5, seed=2)
     broken = models[1].copy()
     broken[MODEL_PERTURBERS + 1 + 1] = np.nan  # the first perturber's mu (its row's second entry)
     models[1] = broken
@@ -120,7 +111,7 @@ def test_a_failing_member_is_reported_and_leaves_the_others_alone():
     (dict(t_end=200.0, max_steps=10), WorkLimitError, "max_steps = 10; raise max_steps"),
 ])
 def test_bad_input_is_refused_with_a_specific_message(kwargs, error, match):
-    y0s, models, _ = _members(3)
+    y0s, models, _ = members(3)
     arguments = dict(y0s=y0s, t0=0.0, t_end=2.0, models=models, tol=1e-10)
     arguments.update(kwargs)
     with pytest.raises(error, match=match):
@@ -128,7 +119,7 @@ def test_bad_input_is_refused_with_a_specific_message(kwargs, error, match):
 
 
 def test_bad_states_and_models_are_refused():
-    y0s, models, _ = _members(3)
+    y0s, models, _ = members(3)
     bad = y0s.copy()
     bad[2, 5] = np.inf
     with pytest.raises(NonFiniteError, match=r"y0s: expected finite states \(q, ω\)"):

@@ -34,13 +34,7 @@ import numpy as np
 
 from spinorbit.core.dynamics.equations import MODEL_PERTURBERS, STATE_SIZE
 from spinorbit.core.dynamics.validation import check_step_budget, validate_sampled_span
-from spinorbit.core.integrators.batch_quaternion import (
-    DEFAULT_LANES,
-    MAX_LANES,
-    _per_member,
-    _stack_models,
-    _validated_states,
-)
+from spinorbit.core.integrators.batch_quaternion import DEFAULT_LANES, MAX_LANES, per_member, validated_members
 from spinorbit.core.integrators.dop853 import (
     DEFAULT_MAX_STEPS,
     STATUS_MAX_STEPS,
@@ -58,15 +52,14 @@ from spinorbit.core.integrators.taylor import (
     STAT_STEPS,
     STEP_GROWTH,
     TAYLOR_STEPS_PER_TURN,
-    _fallback_reason,
-    _needs_fallback,
-    _validate_order_factor,
-    _validate_tolerance,
     convergence_radius,
+    fallback_reason,
     first_step_bound,
     next_step,
     step_factor_of,
     taylor_order,
+    validate_order_factor,
+    validate_tolerance,
 )
 from spinorbit.core.integrators.taylor_recurrences import (
     horner,
@@ -77,6 +70,8 @@ from spinorbit.core.integrators.taylor_recurrences import (
     taylor_coefficients_into,
 )
 from spinorbit.core.jit import jit
+from spinorbit.core.model.gravity_field import BODY_NMAX, FIG_THERMAL
+from spinorbit.core.model.perturbers import sampled_span
 
 __all__ = ["DEFAULT_LANES", "MAX_LANES", "batch_taylor_kernel", "integrate_taylor_batch"]
 
@@ -285,43 +280,39 @@ def integrate_taylor_batch(y0s, t0, t_end, models, tol=1e-10, order_factor=DEFAU
         before any integration; :class:`~spinorbit.core.errors.WorkLimitError` for a run whose step
         estimate exceeds ``max_steps``.
     """
-    y0s = np.asarray(y0s, dtype=float)
-    if y0s.ndim != 2 or y0s.shape[1] != STATE_SIZE or y0s.shape[0] == 0:
-        raise ValueError(f"y0s: expected an (N, {STATE_SIZE}) array of states (q, ω), one row per member, "
-                         f"got shape {y0s.shape}.")
+    y0s, t0s, t_ends, models = validated_members(y0s, t0, t_end, models, lanes)
     n = y0s.shape[0]
-    y0s = _validated_states(y0s)
-    if isinstance(lanes, bool) or not isinstance(lanes, (int, np.integer)) or not 1 <= lanes <= MAX_LANES:
-        raise ValueError(f"lanes: expected a whole number of lanes from 1 to {MAX_LANES}, got {lanes!r}.")
-    t0s = _per_member("t0", t0, n, "start time")
-    t_ends = _per_member("t_end", t_end, n, "end time")
-    if not (np.all(np.isfinite(t0s)) and np.all(np.isfinite(t_ends))):
-        raise ValueError("t0/t_end: expected finite times, got NaN or inf.")
-    if np.any(t_ends == t0s):
-        bad = int(np.flatnonzero(t_ends == t0s)[0])
-        raise ValueError(f"t_end: expected an end time other than t0 for every member; member {bad} has "
-                         f"t0 = t_end = {float(t0s[bad])!r}.")
-    models = _stack_models(models, n)
-    for m in range(n):
-        if _needs_fallback(models[m]):
-            raise ValueError(f"models: member {m} has {_fallback_reason(models[m])}, for which there is no Taylor "
-                             "recurrence; integrate these members with integrate_quaternion_batch.")
-    tols = _per_member("tol", tol, n, "tolerance")
-    for m in range(n):
+    fallback = (models[:, BODY_NMAX] > 2) | (models[:, FIG_THERMAL] > 0.0)  # _needs_fallback of every member
+    if np.any(fallback):
+        m = int(np.flatnonzero(fallback)[0])
+        raise ValueError(f"models: member {m} has {fallback_reason(models[m])}, for which there is no Taylor "
+                         "recurrence; integrate these members with integrate_quaternion_batch.")
+    tols = per_member("tol", tol, n, "tolerance")
+    unique_tols, first = np.unique(tols, return_index=True)
+    for m in np.sort(first):  # integrate_taylor's check of each distinct tol, in member order
         try:
-            tols[m] = _validate_tolerance(float(tols[m]))
+            validate_tolerance(float(tols[m]))
         except ValueError as error:
-            raise ValueError(f"{error} (member {m})") from None
-    order_factor = _validate_order_factor(order_factor)
-    for m in range(n):
-        validate_sampled_span(models[m], t0s[m], t_ends[m:m + 1])
+            raise ValueError(f"{error} (member {int(m)})") from None
+    order_factor = validate_order_factor(order_factor)
+    _validate_sampled_spans(models, t0s, t_ends)
     turns = np.linalg.norm(y0s[:, 4:], axis=1) * np.abs(t_ends - t0s) / (2.0 * math.pi)  # rotation_turns of each
     check_step_budget("integrate_taylor_batch", float(turns.max()) * TAYLOR_STEPS_PER_TURN, max_steps,
                       "shorten the span")
     ys, stats = batch_taylor_kernel(y0s, t0s, t_ends, models, tols, order_factor, int(max_steps), int(lanes))
     steps = stats[:, STAT_STEPS].copy()
+    orders = dict((value, taylor_order(float(value), order_factor)) for value in unique_tols)
     return ys, {"steps": steps, "accepted": steps.copy(), "rejected": np.zeros(n, dtype=np.int64),
-                "order": np.array([taylor_order(float(x), order_factor) for x in tols], dtype=np.int64),
+                "order": np.array([orders[value] for value in tols.tolist()], dtype=np.int64),
                 "mean_orbit_order": stats[:, STAT_ORBIT_ORDER_SUM] / np.maximum(steps, 1),
                 "status": stats[:, STAT_STATUS].copy()}
 
+
+def _validate_sampled_spans(models, t0s, t_ends):
+    """validate_sampled_span of every member, the perturbers' span computed once for the members that share
+    the first member's perturber block (the common case: one sampling, each member its own moments)."""
+    shared = np.all(models[:, MODEL_PERTURBERS:] == models[0, MODEL_PERTURBERS:], axis=1)
+    lo, hi = sampled_span(models[0], MODEL_PERTURBERS)
+    outside = shared & ((np.minimum(t0s, t_ends) < lo) | (np.maximum(t0s, t_ends) > hi))
+    for m in np.flatnonzero(outside | ~shared):
+        validate_sampled_span(models[m], t0s[m], t_ends[m:m + 1])  # raises with the member's own span

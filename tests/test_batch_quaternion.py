@@ -8,10 +8,9 @@ lane-mates; no tolerance is needed, and any reordering of the arithmetic would f
 
 import numpy as np
 import pytest
-from _batch_members import SOURCES, members
+from _batch_members import break_mass, members, spans
 
 from spinorbit.core import integrate_quaternion, make_model
-from spinorbit.core.dynamics.equations import MODEL_PERTURBERS
 from spinorbit.core.integrators.batch_quaternion import integrate_quaternion_batch, raise_for_batch_status
 from spinorbit.core.integrators.dop853 import STATUS_NOT_FINITE, STATUS_SUCCESS, IntegrationError
 
@@ -25,8 +24,7 @@ def _scalar(y0, t0, t_end, model, rtol):
 def test_each_member_is_the_scalar_integrators_bits(lanes):
     """Own moments, spans (forward and backward), start times and rtols per member."""
     y0s, models, rng = members(7)
-    t0s = rng.uniform(-1.0, 1.0, 7)
-    t_ends = t0s + rng.choice([-1.0, 1.0], 7) * rng.uniform(2.0, 6.0, 7)
+    t0s, t_ends = spans(rng, 7)
     rtols = 10.0 ** -rng.uniform(6.0, 12.0, 7)
     ys, stats = integrate_quaternion_batch(y0s, t0s, t_ends, models, rtols, lanes=lanes)
     for m in range(7):
@@ -58,9 +56,7 @@ def test_a_failing_member_is_reported_and_leaves_the_others_alone():
     """A NaN in one member's perturber mass makes its torque NaN: the member stops NOT_FINITE, its row
     is NaN, its lane is refilled, and every other member keeps the scalar integrator's bits."""
     y0s, models, _ = members(5, seed=2)
-    broken = models[1].copy()
-    broken[MODEL_PERTURBERS + 1 + 1] = np.nan  # the first perturber's mu (its row's second entry)
-    models[1] = broken
+    broken = break_mass(models, 1)
     with pytest.raises(IntegrationError, match="NaN/inf"):  # the scalar integrator stops on it too
         integrate_quaternion(y0s[1], 0.0, [3.0], broken, rtol=1e-10)
     ys, stats = integrate_quaternion_batch(y0s, 0.0, 3.0, models, 1e-10, lanes=2)

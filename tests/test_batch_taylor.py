@@ -8,10 +8,9 @@ tolerance is needed, and any change of the arithmetic or of the step sequence wo
 
 import numpy as np
 import pytest
-from _batch_members import SOURCES, members
+from _batch_members import SOURCES, break_mass, members, spans
 
 from spinorbit.core import integrate_taylor, integrate_taylor_batch, make_model
-from spinorbit.core.dynamics.equations import MODEL_PERTURBERS
 from spinorbit.core.errors import NonFiniteError, WorkLimitError
 from spinorbit.core.integrators.batch_quaternion import raise_for_batch_status
 from spinorbit.core.integrators.dop853 import STATUS_MAX_STEPS, STATUS_NOT_FINITE, STATUS_SUCCESS, IntegrationError
@@ -27,8 +26,7 @@ def _scalar(y0, t0, t_end, model, tol):
 def test_each_member_is_the_scalar_integrators_bits(lanes):
     """Own moments, states, spans (forward and backward), start times and tolerances (so orders) per member."""
     y0s, models, rng = members(7)
-    t0s = rng.uniform(-1.0, 1.0, 7)
-    t_ends = t0s + rng.choice([-1.0, 1.0], 7) * rng.uniform(2.0, 6.0, 7)
+    t0s, t_ends = spans(rng, 7)
     tols = 10.0 ** -rng.uniform(6.0, 13.0, 7)
     ys, stats = integrate_taylor_batch(y0s, t0s, t_ends, models, tols, lanes=lanes)
     assert len(set(stats["order"].tolist())) > 2  # lanes of different orders side by side
@@ -80,9 +78,7 @@ def test_a_failing_member_is_reported_and_leaves_the_others_alone():
     """A NaN perturber mass makes one member's torque NaN: it stops NOT_FINITE with a NaN row, its lane is
     refilled, and every other member keeps the scalar integrator's bits; a step cap stops another one."""
     y0s, models, _ = members(5, seed=2)
-    broken = models[1].copy()
-    broken[MODEL_PERTURBERS + 1 + 1] = np.nan  # the first perturber's mu (its row's second entry)
-    models[1] = broken
+    broken = break_mass(models, 1)
     with pytest.raises(IntegrationError, match="NaN/inf"):  # the scalar integrator stops on it too
         integrate_taylor(y0s[1], 0.0, [3.0], broken, tol=1e-10)
     ys, stats = integrate_taylor_batch(y0s, 0.0, 3.0, models, 1e-10, lanes=2)

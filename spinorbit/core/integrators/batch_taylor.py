@@ -82,20 +82,13 @@ def batch_taylor_kernel(y0s, t0s, t_ends, models, tols, order_factor, max_steps,
 
     Parameters
     ----------
-    y0s : ndarray (N, 7)
-        Initial states (q normalised by the caller, as :func:`validate_state` does).
-    t0s, t_ends : ndarray (N,)
-        Start and end times (t_end ≠ t0; either direction).
-    models : ndarray (N, M)
-        Each member's model array, one row each (Taylor recurrences only: degree ≤ 2, no thermal block).
+    y0s, t0s, t_ends, models, max_steps, lanes
+        As :func:`~spinorbit.core.integrators.batch_quaternion.batch_dop853_kernel`'s (models: Taylor
+        recurrences only, degree ≤ 2, no thermal block).
     tols : ndarray (N,)
         Local error tolerances (each member's order is :func:`taylor_order` of its own tol).
     order_factor : float
         Multiplies heyoka's order, in [1, 2].
-    max_steps : int
-        Cap on each member's steps.
-    lanes : int
-        Members advanced together.
 
     Returns
     -------
@@ -243,22 +236,19 @@ def integrate_taylor_batch(y0s, t0, t_end, models, tol=1e-10, order_factor=DEFAU
 
     Parameters
     ----------
-    y0s : array_like (N, 7)
-        Initial states (q, ω) (q normalised here), body angular velocity in rad per time unit.
-    t0, t_end : float or array_like (N,)
-        Start and end times (time unit of the models), one for all or one per member; t_end ≠ t0.
-    models : array_like (N, M) or a sequence of N model arrays of equal length
-        Each member's model (:func:`~spinorbit.core.dynamics.equations.make_model`), or one model
-        (1-d) for all. Rigid bodies with degree-2 figures only: the Taylor recurrences have no
-        degree-3/4 or thermal terms (use ``integrate_quaternion_batch`` for those).
+    y0s, t0, t_end
+        As :func:`~spinorbit.core.integrators.batch_quaternion.integrate_quaternion_batch`'s: states (N, 7)
+        (q, ω in rad per time unit), start and end times (one for all or one per member, t_end ≠ t0).
+    models : array_like (N, M), a sequence of N equal-length model arrays, or one model (1-d) for all
+        Rigid bodies with degree-2 figures only: the Taylor recurrences have no degree-3/4 or thermal
+        terms (use ``integrate_quaternion_batch`` for those).
     tol : float or array_like (N,)
         Local error tolerance per member, 1e-16 ≤ tol (as ``integrate_taylor``'s).
     order_factor : float
         Multiplies heyoka's order ⌈−ln(tol)/2 + 1⌉, in [1, 2].
-    max_steps : int
-        Cap on each member's steps (refused before the run if a member's lower bound exceeds it).
-    lanes : int
-        Members advanced together, 1 … 64.
+    max_steps, lanes : int
+        Cap on each member's steps (refused before the run if a member's lower bound exceeds it), and
+        the members advanced together, 1 … 64.
 
     Returns
     -------

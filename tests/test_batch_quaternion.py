@@ -8,22 +8,11 @@ lane-mates; no tolerance is needed, and any reordering of the arithmetic would f
 
 import numpy as np
 import pytest
+from _batch_members import break_mass, members, spans
 
 from spinorbit.core import integrate_quaternion, make_model
-from spinorbit.core.dynamics.equations import MODEL_PERTURBERS
 from spinorbit.core.integrators.batch_quaternion import integrate_quaternion_batch, raise_for_batch_status
 from spinorbit.core.integrators.dop853 import STATUS_NOT_FINITE, STATUS_SUCCESS, IntegrationError
-from spinorbit.core.model.perturbers import kepler_source
-
-#: Two point masses on an ellipse and a hyperbola (a close passage), in units where the spin is O(1).
-SOURCES = (kepler_source(1e-2, 2.0, 0.3, 0.2, 0.1, 0.4, 0.0), kepler_source(3e-3, -1.5, 1.4, 0.5, 0.3, 0.2, -1.0))
-
-
-def _members(n, seed=1):
-    rng = np.random.default_rng(seed)
-    models = [make_model((0.5 + 0.1 * rng.random(), 0.8 + 0.1 * rng.random(), 1.0), SOURCES) for _ in range(n)]
-    y0s = np.hstack([rng.normal(size=(n, 4)), 3.0 * rng.normal(size=(n, 3))])
-    return y0s, models, rng
 
 
 def _scalar(y0, t0, t_end, model, rtol):
@@ -34,9 +23,8 @@ def _scalar(y0, t0, t_end, model, rtol):
 @pytest.mark.parametrize("lanes", [1, 3, 4])
 def test_each_member_is_the_scalar_integrators_bits(lanes):
     """Own moments, spans (forward and backward), start times and rtols per member."""
-    y0s, models, rng = _members(7)
-    t0s = rng.uniform(-1.0, 1.0, 7)
-    t_ends = t0s + rng.choice([-1.0, 1.0], 7) * rng.uniform(2.0, 6.0, 7)
+    y0s, models, rng = members(7)
+    t0s, t_ends = spans(rng, 7)
     rtols = 10.0 ** -rng.uniform(6.0, 12.0, 7)
     ys, stats = integrate_quaternion_batch(y0s, t0s, t_ends, models, rtols, lanes=lanes)
     for m in range(7):
@@ -48,7 +36,7 @@ def test_each_member_is_the_scalar_integrators_bits(lanes):
 
 
 def test_a_members_result_does_not_depend_on_its_lane_mates():
-    y0s, models, _ = _members(6, seed=3)
+    y0s, models, _ = members(6, seed=3)
     ys, _ = integrate_quaternion_batch(y0s, 0.0, 4.0, models, 1e-10, lanes=4)
     order = [5, 2, 0, 4, 1, 3]
     shuffled, _ = integrate_quaternion_batch(y0s[order], 0.0, 4.0, [models[i] for i in order], 1e-10, lanes=2)
@@ -56,7 +44,7 @@ def test_a_members_result_does_not_depend_on_its_lane_mates():
 
 
 def test_one_model_for_all_members_and_per_component_atol():
-    y0s, models, _ = _members(3, seed=4)
+    y0s, models, _ = members(3, seed=4)
     atol = np.array([1e-9] * 4 + [1e-8] * 3)
     ys, _ = integrate_quaternion_batch(y0s, 0.0, 3.0, models[0], 1e-9, atol=atol, lanes=2)
     for m in range(3):
@@ -67,10 +55,8 @@ def test_one_model_for_all_members_and_per_component_atol():
 def test_a_failing_member_is_reported_and_leaves_the_others_alone():
     """A NaN in one member's perturber mass makes its torque NaN: the member stops NOT_FINITE, its row
     is NaN, its lane is refilled, and every other member keeps the scalar integrator's bits."""
-    y0s, models, _ = _members(5, seed=2)
-    broken = models[1].copy()
-    broken[MODEL_PERTURBERS + 1 + 1] = np.nan  # the first perturber's mu (its row's second entry)
-    models[1] = broken
+    y0s, models, _ = members(5, seed=2)
+    broken = break_mass(models, 1)
     with pytest.raises(IntegrationError, match="NaN/inf"):  # the scalar integrator stops on it too
         integrate_quaternion(y0s[1], 0.0, [3.0], broken, rtol=1e-10)
     ys, stats = integrate_quaternion_batch(y0s, 0.0, 3.0, models, 1e-10, lanes=2)
@@ -99,7 +85,7 @@ def test_a_failing_member_is_reported_and_leaves_the_others_alone():
     (dict(atol=-1.0), "atol: expected absolute tolerances ≥ 0"),
 ])
 def test_bad_input_is_refused_with_a_specific_message(kwargs, match):
-    y0s, models, _ = _members(3)
+    y0s, models, _ = members(3)
     arguments = dict(y0s=y0s, t0=0.0, t_end=2.0, models=models, rtol=1e-10)
     arguments.update(kwargs)
     with pytest.raises(ValueError, match=match):
@@ -107,7 +93,7 @@ def test_bad_input_is_refused_with_a_specific_message(kwargs, match):
 
 
 def test_bad_states_and_models_are_refused():
-    y0s, models, _ = _members(3)
+    y0s, models, _ = members(3)
     bad = y0s.copy()
     bad[2, 5] = np.inf
     with pytest.raises(ValueError, match=r"y0s: expected finite states \(q, ω\)"):

@@ -14,7 +14,8 @@ The stable entry points, importable from here (scripts written against them keep
   :func:`torque_free_states_many`;
 - the model builder :func:`make_model` and the perturber sources :func:`fixed_source`,
   :func:`kepler_source`, :func:`sampled_source`, :func:`sampled_source_from_callable`;
-- each integrator: :func:`integrate_quaternion` (and :func:`integrate_quaternion_batch` for many members), :func:`integrate_elements`, :func:`integrate_taylor`,
+- each integrator: :func:`integrate_quaternion` (and :func:`integrate_quaternion_batch` for many members), :func:`integrate_elements`, :func:`integrate_taylor` (and
+  :func:`integrate_taylor_batch`),
   :func:`integrate_splitting`, :func:`integrate_with_handover`, :func:`propagate_averaged`;
 - state transition matrices and moment-ratio sensitivities: :func:`free_flow_stm` (exact, through
   the elements), :func:`integrate_variational` (DOP853 with its variational equations) and
@@ -44,6 +45,7 @@ _ENTRY_POINTS = {
     "integrate_quaternion_batch": "spinorbit.core.integrators.batch_quaternion",
     "integrate_elements": "spinorbit.core.integrators.elements",
     "integrate_taylor": "spinorbit.core.integrators.taylor",
+    "integrate_taylor_batch": "spinorbit.core.integrators.batch_taylor",
     "integrate_splitting": "spinorbit.core.integrators.splitting",
     "integrate_with_handover": "spinorbit.core.integrators.handover",
     "propagate_averaged": "spinorbit.core.averaging.propagate",

@@ -313,7 +313,7 @@ def batch_dop853_kernel(y0s, t0s, t_ends, models, rtols, atols, max_steps, lanes
 # Python front end: validation only, then one call into the kernel.
 
 
-def _per_member(name, value, n, what):
+def per_member(name, value, n, what):
     """A scalar or N values as a float array (N,), or a ValueError naming the argument."""
     array = np.asarray(value, dtype=float)
     if array.ndim == 0:
@@ -362,24 +362,9 @@ def integrate_quaternion_batch(y0s, t0, t_end, models, rtol=1e-10, atol=None, ma
     ValueError
         Bad states, times, tolerances, models or lanes (before any integration).
     """
-    y0s = np.asarray(y0s, dtype=float)
-    if y0s.ndim != 2 or y0s.shape[1] != STATE_SIZE or y0s.shape[0] == 0:
-        raise ValueError(f"y0s: expected an (N, {STATE_SIZE}) array of states (q, ω), one row per member, "
-                         f"got shape {y0s.shape}.")
+    y0s, t0s, t_ends, models = validated_members(y0s, t0, t_end, models, lanes)
     n = y0s.shape[0]
-    y0s = _validated_states(y0s)
-    if isinstance(lanes, bool) or not isinstance(lanes, (int, np.integer)) or not 1 <= lanes <= MAX_LANES:
-        raise ValueError(f"lanes: expected a whole number of lanes from 1 to {MAX_LANES}, got {lanes!r}.")
-    t0s = _per_member("t0", t0, n, "start time")
-    t_ends = _per_member("t_end", t_end, n, "end time")
-    if not (np.all(np.isfinite(t0s)) and np.all(np.isfinite(t_ends))):
-        raise ValueError("t0/t_end: expected finite times, got NaN or inf.")
-    if np.any(t_ends == t0s):
-        bad = int(np.flatnonzero(t_ends == t0s)[0])
-        raise ValueError(f"t_end: expected an end time other than t0 for every member; member {bad} has "
-                         f"t0 = t_end = {float(t0s[bad])!r}.")
-    models = _stack_models(models, n)
-    rtols = _validated_rtols(_per_member("rtol", rtol, n, "relative tolerance"))
+    rtols = _validated_rtols(per_member("rtol", rtol, n, "relative tolerance"))
     spin = np.array([float(np.linalg.norm(row[4:])) for row in y0s])  # default_atol's and rotation_turns' |ω|
     atols = _validated_atols(atol, rtols, spin)
     for m in range(n):
@@ -391,6 +376,30 @@ def integrate_quaternion_batch(y0s, t0, t_end, models, rtol=1e-10, atol=None, ma
     ys, stats = batch_dop853_kernel(y0s, t0s, t_ends, models, rtols, atols, int(max_steps), int(lanes))
     return ys, {"accepted": stats[:, STAT_ACCEPTED].copy(), "rejected": stats[:, STAT_REJECTED].copy(),
                 "rhs_calls": stats[:, STAT_RHS_CALLS].copy(), "status": stats[:, STAT_STATUS].copy()}
+
+
+def validated_members(y0s, t0, t_end, models, lanes):
+    """The checks every batch integrator makes of its members, in this order: (y0s with q normalised as
+    :func:`validate_state` does it, t0s, t_ends, models as one (N, M) array), or a ValueError saying what
+    is wrong (NonFiniteError for NaN/inf states)."""
+    y0s = np.asarray(y0s, dtype=float)
+    if y0s.ndim != 2 or y0s.shape[1] != STATE_SIZE or y0s.shape[0] == 0:
+        raise ValueError(f"y0s: expected an (N, {STATE_SIZE}) array of states (q, ω), one row per member, "
+                         f"got shape {y0s.shape}.")
+    n = y0s.shape[0]
+    y0s = _validated_states(y0s)
+    if isinstance(lanes, bool) or not isinstance(lanes, (int, np.integer)) or not 1 <= lanes <= MAX_LANES:
+        raise ValueError(f"lanes: expected a whole number of lanes from 1 to {MAX_LANES}, got {lanes!r}.")
+    t0s = per_member("t0", t0, n, "start time")
+    t_ends = per_member("t_end", t_end, n, "end time")
+    if not (np.all(np.isfinite(t0s)) and np.all(np.isfinite(t_ends))):
+        raise ValueError("t0/t_end: expected finite times, got NaN or inf.")
+    if np.any(t_ends == t0s):
+        bad = int(np.flatnonzero(t_ends == t0s)[0])
+        raise ValueError(f"t_end: expected an end time other than t0 for every member; member {bad} has "
+                         f"t0 = t_end = {float(t0s[bad])!r}.")
+    models = _stack_models(models, n)
+    return y0s, t0s, t_ends, models
 
 
 def _validated_states(y0s):

@@ -282,6 +282,12 @@ def _fallback_reason(model):
     return f"degree-{int(model[BODY_NMAX])} Stokes terms"
 
 
+# The same checks under public names, for the batch Taylor integrator (batch_taylor.py), which makes them per member.
+validate_tolerance = _validate_tolerance
+validate_order_factor = _validate_order_factor
+fallback_reason = _fallback_reason
+
+
 #: Default raise of the order over heyoka's rule: higher orders take fewer steps but give larger errors
 #: at the same tol, for the same CPU per unit of accuracy (measured in scenes (a) and (b)).
 DEFAULT_ORDER_FACTOR = 1.0

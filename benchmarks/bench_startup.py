@@ -114,9 +114,16 @@ print(json.dumps(marks))
 """
 
 
+#: Where the measured processes keep their Python bytecode. An installed package has its ``.pyc``
+#: files (pip compiles them); a shell with ``PYTHONDONTWRITEBYTECODE`` set would instead recompile
+#: every spinorbit module in every run, which a user does not pay. Kept outside the checkout.
+BYTECODE_DIR = tempfile.mkdtemp(prefix="spinorbit-bench-pyc-")
+
+
 def _run(checkout: Path, argv, env=None):
     """(wall s, CPU s) of one fresh ``python argv`` importing ``checkout``'s package."""
-    environment = {**os.environ, "PYTHONPATH": str(checkout), **(env or {})}
+    environment = {key: value for key, value in os.environ.items() if key != "PYTHONDONTWRITEBYTECODE"}
+    environment.update({"PYTHONPATH": str(checkout), "PYTHONPYCACHEPREFIX": BYTECODE_DIR, **(env or {})})
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     subprocess.run([sys.executable, *argv], cwd=checkout, env=environment, check=True,
@@ -145,6 +152,7 @@ def _export(revision: str) -> Path:
 
 def measure(checkouts: dict, repeat: int, cold_repeat: int) -> dict:
     """Interleaved timings: {checkout label: {command: (wall Timing, CPU Timing)}}, compile and stage tables."""
+    load_before = os.getloadavg()[0]
     for checkout in checkouts.values():  # fill numba's cache (and the Python bytecode) untimed
         _run(checkout, COMMANDS["spinorbit moon (warm)"])
     walls = {label: {name: [] for name in [*COMMANDS, "spinorbit moon (cold cache)"]} for label in checkouts}
@@ -170,12 +178,13 @@ def measure(checkouts: dict, repeat: int, cold_repeat: int) -> dict:
             continue
         runs = []
         for _ in range(max(1, repeat)):
-            environment = {**os.environ, "PYTHONPATH": str(checkout)}
+            environment = {key: value for key, value in os.environ.items() if key != "PYTHONDONTWRITEBYTECODE"}
+            environment.update({"PYTHONPATH": str(checkout), "PYTHONPYCACHEPREFIX": BYTECODE_DIR})
             out = subprocess.run([sys.executable, "-c", STAGES], cwd=checkout, env=environment, check=True,
                                  capture_output=True, text=True).stdout
             runs.append(json.loads(out.strip().splitlines()[-1]))
         stages = {name: Timing(tuple(run[name] for run in runs)) for name in runs[0]}
-    return {"timings": timings, "compiled": compiled, "stages": stages}
+    return {"timings": timings, "compiled": compiled, "stages": stages, "load": (load_before, os.getloadavg()[0])}
 
 
 def _verdict(name: str, median: float) -> str:
@@ -191,7 +200,9 @@ def markdown(results: dict, repeat: int, cold_repeat: int, before: str | None) -
     lines = ["## Start-up (`benchmarks/bench_startup.py`)", "", machine_line(),
              f"Fresh processes, interleaved; median (min–max) of {repeat} rounds, cold runs of {cold_repeat}, "
              "each with empty `NUMBA_CACHE_DIR` and `SPINORBIT_CACHE_DIR`. Wall time; CPU (user + system) beside it."
-             + (f" *before* is revision `{before}`, measured in the same rounds." if before else ""), ""]
+             + (f" *before* is revision `{before}`, measured in the same rounds." if before else "")
+             + " The machine's 1-minute load average was {:.1f} before and {:.1f} after (its 2 cores are shared; "
+             "wall times grow with the load, CPU times less).".format(*results["load"]), ""]
     header = "| command | " + " | ".join(f"{label} wall (s) | {label} CPU (s)" for label in labels) + " | goal |"
     lines += [header, "|---|" + "---:|---:|" * len(labels) + "---|"]
     for name in timings[labels[-1]]:
@@ -234,6 +245,7 @@ def main(argv=None) -> None:
     finally:
         if args.before:
             shutil.rmtree(checkouts["before"], ignore_errors=True)
+        shutil.rmtree(BYTECODE_DIR, ignore_errors=True)
     text = markdown(results, args.repeat, args.cold_repeat, args.before)
     print(text)
     if not args.no_write:

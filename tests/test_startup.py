@@ -32,6 +32,19 @@ def test_the_de421_moon_route_does_not_load_rebound(module):
     assert "rebound" not in _loaded_after(f"import {module}")
 
 
+@pytest.mark.parametrize("module", ["spinorbit.coupling.moon", "spinorbit.commands.moon"])
+def test_the_de421_moon_route_does_not_load_astropy_coordinates(module):
+    # astropy.coordinates (and astropy.table with it) cost a fifth of a warm `spinorbit moon`; only
+    # writing the Moon table (--output) needs them (spinorbit.state_table, imported there).
+    code = (f"import sys, json\nimport {module}\n"
+            "print(json.dumps(sorted(m for m in sys.modules if m.startswith('astropy.'))))")
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, check=True, capture_output=True,
+                         text=True).stdout
+    loaded = set(json.loads(out.strip().splitlines()[-1]))
+    assert not loaded & {"astropy.coordinates", "astropy.table"}, loaded & {"astropy.coordinates", "astropy.table"}
+
+
 def test_startup_benchmark_writes_its_table(tmp_path):
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     out = subprocess.run([sys.executable, "benchmarks/bench_startup.py", "--repeat", "1", "--cold-repeat", "0",

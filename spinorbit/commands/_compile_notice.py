@@ -17,7 +17,7 @@ import sys
 
 #: What the notice says (one line).
 NOTICE = ("spinorbit: compiling the numba kernels (first run with this cache; they are cached for the next runs, "
-          "about half a minute on 2 cores for spinorbit moon) ...")
+          "about 15-30 s on 2 cores for spinorbit moon, longer on a loaded machine) ...")
 
 
 @contextlib.contextmanager

@@ -49,7 +49,6 @@ from spinorbit.ephemeris import (
     moon_orientation_raw,
 )
 from spinorbit.lunar_librations import euler313_from_attitudes, physical_librations
-from spinorbit.state_table import time_column
 from spinorbit.time import J2000_JD_TDB, tdb_day_and_fraction, time_from_tdb_days
 from spinorbit.coupling.sampling import de421_orbit, sample_from_ephemeris, sample_relative_states
 from spinorbit.coupling.lunar_core import cached_core_state, core_key
@@ -562,6 +561,7 @@ def comparison_table(comparison: LibrationComparison, model: str, coupled: bool)
     from astropy.table import QTable
 
     from spinorbit import __version__
+    from spinorbit.state_table import time_column  # here: it imports astropy.coordinates, a run needs neither
 
     columns = dict(TABLE_COLUMNS)
     for name in _ANGLE_NAMES + _LIBRATION_NAMES:

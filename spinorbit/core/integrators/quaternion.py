@@ -38,7 +38,7 @@ import math
 
 import numpy as np
 
-from spinorbit.core.dynamics.equations import STATE_SIZE, rhs_into
+from spinorbit.core.dynamics.equations import STATE_SIZE, lunar_rhs_into, rhs_into
 from spinorbit.core.dynamics.validation import (
     check_step_budget,
     rotation_turns,
@@ -131,6 +131,24 @@ def integrate_dop853_kernel(y0, t0, t_out, model, rtol, atol, max_steps, hit_out
     """
     ys, stats, _, _ = dop853_integrate(rhs_into, model, never_singular, _renormalise_after_step, _renormalise_output,
                                        y0, t0, t_out, rtol, atol, max_steps, hit_output_times, first_step, 0.0)
+    return ys, stats
+
+
+@jit
+def integrate_dop853_lunar_kernel(y0, t0, t_out, model, rtol, atol, max_steps, hit_output_times, first_step):
+    """:func:`integrate_dop853_kernel` for the mantle-and-core model (10-component state) alone.
+
+    The same engine and hooks with :func:`lunar_rhs_into` as the right-hand side, which
+    :func:`rhs_into` would call for this state anyway. Why a kernel of its own: the engine inlines its
+    right-hand side at every call site (five), and :func:`rhs_into` carries the rigid body's whole
+    torque (Kepler and sampled perturbers, thermal recoil) for the 7-component state, which a lunar run
+    never takes. Compiling those five dead copies was most of a first ``spinorbit moon``'s compile
+    time; here ``lunar_rhs_into`` is one compiled function that the five sites call. Same arithmetic,
+    same results to the bit.
+    """
+    ys, stats, _, _ = dop853_integrate(lunar_rhs_into, model, never_singular, _renormalise_after_step,
+                                       _renormalise_output, y0, t0, t_out, rtol, atol, max_steps, hit_output_times,
+                                       first_step, 0.0)
     return ys, stats
 
 
@@ -243,8 +261,8 @@ def integrate_quaternion(y0, t0, t_out, model, rtol=1e-10, atol=None, max_steps=
     validate_sampled_span(model, t0, t_out)
     check_step_budget("integrate_quaternion", minimum_steps(y0, t0, t_out[-1], rtol), max_steps,
                       "shorten the span or loosen rtol")
-    ys, stats = integrate_dop853_kernel(y0, t0, t_out, model, rtol, atol, int(max_steps),
-                                        bool(hit_output_times), float(first_step))
+    kernel = integrate_dop853_lunar_kernel if y0.shape[0] == INTERIOR_STATE_SIZE else integrate_dop853_kernel
+    ys, stats = kernel(y0, t0, t_out, model, rtol, atol, int(max_steps), bool(hit_output_times), float(first_step))
     raise_for_engine_status(stats)
     if return_stats:
         return ys, stats_record(stats)

@@ -42,7 +42,7 @@ import math
 import numpy as np
 
 from spinorbit.core.dynamics.equations import MODEL_PERTURBERS, STATE_SIZE
-from spinorbit.core.jit import jit
+from spinorbit.core.jit import FUSED_MULTIPLY_ADD, jit
 from spinorbit.core.model.gravity_field import BODY_A, BODY_B, BODY_C
 from spinorbit.core.model.perturbers import (
     K_A,
@@ -180,7 +180,43 @@ def seed_perturbers(t, model, s, n_pert, t_stop, direction, h_last, orbit_orders
     return t_stop
 
 
-@jit
+@jit(inline="always")
+def _orbit_series_into(s, b, kind, order, mu_orbit, h_bound, orbit_tol_sq):
+    """A perturber's orbit rows (r, |r|², |r|⁻⁵) to its truncation order m, which it returns.
+
+    Independent of the attitude, so computed before it. A Kepler perturber's two-body motion
+    r'' = −μ_orbit r |r|⁻³ fills r and v up to m (module docstring, *Truncated orbit series*); a
+    sampled one's r rows are given (cubic), m = order; a fixed one has m = 0.
+    """
+    m = 0 if kind == KIND_FIXED else order
+    r2 = s[b + _X, 0] * s[b + _X, 0] + s[b + _X + 1, 0] * s[b + _X + 1, 0] + s[b + _X + 2, 0] * s[b + _X + 2, 0]
+    inv_r2 = 1.0 / r2
+    inv_v2 = 1.0 / (s[b + _V, 0] ** 2 + s[b + _V + 1, 0] ** 2 + s[b + _V + 2, 0] ** 2)
+    h_pow_sq = 1.0  # h_bound^(2k), by one product per order (no power function in the loop)
+    for k in range(order):
+        if k > m:
+            break
+        h_pow_sq_next = h_pow_sq * h_bound * h_bound
+        s[b + _R2, k] = (_cauchy(s, b + _X, b + _X, k) + _cauchy(s, b + _X + 1, b + _X + 1, k)
+                         + _cauchy(s, b + _X + 2, b + _X + 2, k))
+        if k == 0:
+            s[b + _S5, 0] = 1.0 / (r2 * r2 * math.sqrt(r2))  # |r|⁻⁵ without a power function
+        else:
+            s[b + _S5, k] = _power(s, b + _S5, b + _R2, -2.5, k)
+        if kind == KIND_KEPLER and k < m:
+            s[b + _S3, k] = _cauchy(s, b + _S5, b + _R2, k)
+            inv = 1.0 / (k + 1)
+            for i in range(3):
+                s[b + _X + i, k + 1] = s[b + _V + i, k] * inv
+                s[b + _V + i, k + 1] = -mu_orbit * _cauchy(s, b + _S3, b + _X + i, k) * inv
+            if k >= 1 and _orbit_term_sq(s, b, k, inv_r2, inv_v2) * h_pow_sq < orbit_tol_sq \
+                    and _orbit_term_sq(s, b, k + 1, inv_r2, inv_v2) * h_pow_sq_next < orbit_tol_sq:
+                m = k + 1
+        h_pow_sq = h_pow_sq_next
+    return m
+
+
+@jit(fastmath=FUSED_MULTIPLY_ADD)
 def taylor_coefficients_into(t, model, s, n_pert, order, h_bound, orbit_tol, orbit_orders):
     """Fill the series array s (rows × ≥ order+1) with the Taylor coefficients at t.
 
@@ -190,43 +226,27 @@ def taylor_coefficients_into(t, model, s, n_pert, order, h_bound, orbit_tol, orb
     consecutive terms, at the largest step ``h_bound``, are below ``orbit_tol`` relative to |r| and |v|:
     the Sun's orbit varies ~300× slower than the attitude, so m ≈ 5 instead of p (module docstring).
     ``orbit_orders[p]`` receives m (``order`` for a sampled perturber, 0 for a fixed one); 0 < orbit_tol.
+
+    The orbit series do not depend on the attitude, so they are computed first, each to its own m
+    (:func:`_orbit_series_into`); then order by order the torque and the attitude. Fused multiply-adds
+    (``jit.FUSED_MULTIPLY_ADD``): the step is Cauchy products.
     """
     a_mom, b_mom, c_mom = model[BODY_A], model[BODY_B], model[BODY_C]
-    for p in range(n_pert):
-        kind = int(model[MODEL_PERTURBERS + 1 + p * PERTURBER_ROW])
-        orbit_orders[p] = 0 if kind == KIND_FIXED else order
     orbit_tol_sq = orbit_tol * orbit_tol
-    h_pow_sq = 1.0  # h_bound^(2k), by one product per order (no power function in the loop)
+    for p in range(n_pert):
+        row = MODEL_PERTURBERS + 1 + p * PERTURBER_ROW
+        kind = int(model[row])
+        orbit_orders[p] = _orbit_series_into(s, _HEAD_ROWS + p * _BLOCK_ROWS, kind, order, model[row + 2 + K_MU],
+                                             h_bound, orbit_tol_sq)
     for k in range(order):
-        h_pow_sq_next = h_pow_sq * h_bound * h_bound
         # --- torque N^[k]
         nx = 0.0
         ny = 0.0
         nz = 0.0
         for p in range(n_pert):
-            row = MODEL_PERTURBERS + 1 + p * PERTURBER_ROW
-            mu = model[row + 1]
+            mu = model[MODEL_PERTURBERS + 1 + p * PERTURBER_ROW + 1]
             b = _HEAD_ROWS + p * _BLOCK_ROWS
             m = orbit_orders[p]
-            if k <= m:
-                s[b + _R2, k] = (_cauchy(s, b + _X, b + _X, k) + _cauchy(s, b + _X + 1, b + _X + 1, k)
-                                 + _cauchy(s, b + _X + 2, b + _X + 2, k))
-                if k == 0:
-                    r2 = s[b + _R2, 0]
-                    s[b + _S5, 0] = 1.0 / (r2 * r2 * math.sqrt(r2))  # |r|⁻⁵ without a power function
-                else:
-                    s[b + _S5, k] = _power(s, b + _S5, b + _R2, -2.5, k)
-                if int(model[row]) == KIND_KEPLER and k < m:
-                    # Two-body motion of the relative position: r'' = −μ_orbit r |r|⁻³.
-                    s[b + _S3, k] = _cauchy(s, b + _S5, b + _R2, k)
-                    mu_orbit = model[row + 2 + K_MU]
-                    inv = 1.0 / (k + 1)
-                    for i in range(3):
-                        s[b + _X + i, k + 1] = s[b + _V + i, k] * inv
-                        s[b + _V + i, k + 1] = -mu_orbit * _cauchy(s, b + _S3, b + _X + i, k) * inv
-                    if k >= 1 and _orbit_term_sq(s, b, k) * h_pow_sq < orbit_tol_sq \
-                            and _orbit_term_sq(s, b, k + 1) * h_pow_sq_next < orbit_tol_sq:
-                        orbit_orders[p] = k + 1
             lo = max(0, k - m)  # r, |r|⁻⁵ are zero above order m
             # c = u × r, u = (q1, q2, q3)
             cx, cy, cz = _cauchy_cross(s, _Q0 + 1, b + _X, k, lo)
@@ -296,18 +316,17 @@ def taylor_coefficients_into(t, model, s, n_pert, order, h_bound, orbit_tol, orb
         s[_Q0 + 1, k + 1] = half * q1w
         s[_Q0 + 2, k + 1] = half * q2w
         s[_Q0 + 3, k + 1] = half * q3w
-        h_pow_sq = h_pow_sq_next
 
 
 @jit(inline="always")
-def _orbit_term_sq(s, b, k):
+def _orbit_term_sq(s, b, k, inv_r2, inv_v2):
     """max(|r^[k]|²/|r|², |v^[k]|²/|v|²) of the perturber block at row b: its k-th coefficient, relative, squared.
+
+    ``inv_r2``, ``inv_v2``: 1/|r|², 1/|v|² of the block's order-0 rows, computed once per step.
 
     Squared, so that the truncation test (times h^2k against orbit_tol²) needs no square root and
     no power function (the square roots and h**k were ~15 % of a Taylor step in scenes (a)–(c)).
     """
-    inv_r2 = 1.0 / s[b + _R2, 0]
-    inv_v2 = 1.0 / (s[b + _V, 0] ** 2 + s[b + _V + 1, 0] ** 2 + s[b + _V + 2, 0] ** 2)
     term = 0.0
     for i in range(3):
         term = max(term, s[b + _X + i, k] ** 2 * inv_r2, s[b + _V + i, k] ** 2 * inv_v2)
@@ -351,7 +370,7 @@ def orbit_radius(s, n_pert, orbit_orders, order):
     return rho
 
 
-@jit
+@jit(fastmath=FUSED_MULTIPLY_ADD)
 def horner(s, rows, order, dt, out):
     """out[i] = Σ_k s[i, k] dt^k for i < rows (the Taylor polynomial at t + dt)."""
     for i in range(rows):

@@ -292,11 +292,10 @@ def _rows(scenes, ends, normals):
 def run_group(group, shared, at_days, integrators=None):
     """Run one group [(index, Scene, parameters)] of a chunk by the batch route.
 
-    Returns (rows, failures, fallback): outcome rows and failure records by index, and the members
-    [(index, Scene, parameters)] that go to the per-member route (the plan cannot be shared with them,
-    or no batch integrator runs it). The scenes plan and sample within ``shared``.
+    Returns (rows, failures, fallback): outcome rows and the exceptions of failed members by index, and
+    the members [(index, Scene, parameters)] that go to the per-member route (the plan cannot be shared
+    with them, or no batch integrator runs it). The scenes plan and sample within ``shared``.
     """
-    from spinorbit.ensemble.ensemble import failure_record
     from spinorbit.coupling.one_way import one_way_days
     from spinorbit.core.integrators.dop853 import STATUS_MESSAGES, IntegrationError
     from spinorbit.scene.routes import scene_orbit_normals
@@ -369,9 +368,8 @@ def run_group(group, shared, at_days, integrators=None):
     ok = [m for m in range(len(batch)) if not status[m]]
     for m in range(len(batch)):
         if status[m]:
-            index, _, parameters = batch[m]
-            failures[index] = failure_record(index, parameters, IntegrationError(
-                f"the batch {plan.integrator} integration stopped: {STATUS_MESSAGES[int(status[m])]}"))
+            failures[batch[m][0]] = IntegrationError(
+                f"the batch {plan.integrator} integration stopped: {STATUS_MESSAGES[int(status[m])]}")
     if not ok:
         return rows, failures, fallback
     try:

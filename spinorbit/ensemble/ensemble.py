@@ -208,7 +208,7 @@ def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None,
         for group in groups.values():
             group_rows, group_failures, fallback = run_group(group, samples_of(group[0][1]), at_days, integrators)
             rows.update({i: {**row, "ensemble_route": "batch"} for i, row in group_rows.items()})
-            failures.update(group_failures)
+            failures.update({i: failure_record(i, p, group_failures[i]) for i, _, p in group if i in group_failures})
             single.extend(fallback)
         single.sort(key=lambda member: member[0])
     for index, scene, parameters in single:

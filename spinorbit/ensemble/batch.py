@@ -161,22 +161,12 @@ def _member_bounds(scenes, survey, kappas):
 
 
 def _kept_sources(leader, plan):
-    """The sources of the leader's run (run_one_way's order: named samples, fixed, user), and the samples."""
-    from spinorbit.core.model.perturbers import fixed_source
-    from spinorbit.scene.sampling import NoSamples, subset_samples
+    """The sources of the leader's run (:func:`spinorbit.scene.routes.one_way_sources`, in its order), the
+    samples, and whether a sampled perturber is kept (then the error estimate has a sampling part)."""
+    from spinorbit.scene.routes import one_way_sources
 
-    named = tuple(n for n in plan.kept if n in leader.named)
-    fixed = [fixed_source(p.gm_au3_day2, p.position_au) for p in leader.fixed if p.name in plan.kept]
-    moving = [p.name for p in leader.moving if p.name in plan.kept]
-    if moving:
-        fixed += leader.sample_perturbers("user", moving, leader.sample_tolerance).sources()
-    if named and plan.samples is not None:
-        samples = subset_samples(plan.samples, named)
-    else:
-        samples = leader.sample_perturbers(plan.orbit_source, named, leader.sample_tolerance) if named else None
-    if samples is None:
-        samples = NoSamples(leader.epoch_day, leader.output_days[-1])
-    return [*samples.sources(), *fixed], samples, bool(named or moving)
+    samples, extra, named, moving = one_way_sources(leader, plan)
+    return [*samples.sources(), *extra], samples, bool(named or moving)
 
 
 def _models(moments, sources):

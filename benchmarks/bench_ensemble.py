@@ -228,6 +228,7 @@ def markdown_free(f):
 # ------------------------------------------------------------------------------------ heyoka's ensemble
 
 PEER_MEMBERS = 64
+PEER_REPEATS = 5
 REFERENCE_TOL = 1e-15
 HEYOKA_TOLS = (1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12)
 
@@ -319,84 +320,104 @@ def measure_peer(members):
     core_error = _attitude_error(core_states[:, :4] / np.linalg.norm(core_states[:, :4], axis=1)[:, None],
                                  reference[:, :4])
 
-    stages = measure_stages(ek, rows)
+    stages = measure_stages(ek, rows[:Ensemble(ek.kepler_member, parameters).chunk_size])
 
-    # timed, each fresh: spinorbit serial and on a new pool of 2; heyoka threads and processes, 1 and 2
+    # the batch route's rows are the Scene runs' integration: their poles, bit for bit
+    batch_table = Ensemble(ek.kepler_member, parameters).run(executor="serial")
+    scene_pole = np.array([[float(end[c].to_value("deg")) for c in ("pole_ra", "pole_dec")] for end in ends])
+    batch_pole = np.stack([batch_table[c].to_value("deg") for c in ("pole_ra", "pole_dec")], axis=1)
+    batch_is_scene = batch_pole.tobytes() == scene_pole.tobytes()
+    routes = batch_table.meta["member_routes"]
+
+    # one new pool (its start, each worker's imports, compilation cache and sampling), timed once
     chunk = Ensemble(ek.kepler_member, parameters).chunk_size
-    spin = {}
-    clear_process_samplings()  # each timed run samples the orbit once per process, as a fresh run does
-    spin[1], table_1 = _timed_ensemble(lambda: Ensemble(ek.kepler_member, parameters).run(executor="serial"))
     clear_process_samplings()
-    spin[2], table_2 = _timed_ensemble(lambda: Ensemble(ek.kepler_member, parameters).run(executor=2))
+    fresh, table_2 = _timed_ensemble(lambda: Ensemble(ek.kepler_member, parameters).run(executor=2))
+    clear_process_samplings()  # a process's first member samples the orbits (survey and run), the later reuse them
+    cold, _ = _timed_ensemble(lambda: Ensemble(ek.kepler_member, parameters[:1]).run(executor="serial"))
+    warm, _ = _timed_ensemble(lambda: Ensemble(ek.kepler_member, parameters[:1]).run(executor="serial"))
+    sampling = cold - warm
+    # interleaved rounds, every process warm (compiled, the orbit sampled): spinorbit's batch route in this
+    # process and on a started pool of 2, its per-member route here; heyoka's threads and processes, 1 and 2
     with concurrent.futures.ProcessPoolExecutor(max_workers=2) as pool:
         for warming in [pool.submit(_warm_worker, rows[0]) for _ in range(2)]:
             warming.result()  # both workers imported and compiled, the orbit sampled
-        spin["warm 2"], _ = _timed_ensemble(lambda: Ensemble(ek.kepler_member, parameters).run(executor=pool))
+        engines = {("batch", 1): lambda: Ensemble(ek.kepler_member, parameters).run(executor="serial"),
+                   ("batch", 2): lambda: Ensemble(ek.kepler_member, parameters).run(executor=pool),
+                   ("member", 1): lambda: Ensemble(ek.kepler_member, parameters, route="member").run(executor="serial")}
+        for algorithm in ("thread", "process"):
+            for workers in (1, 2):
+                engines[algorithm, workers] = (lambda a=algorithm, w=workers: hy.ensemble_propagate_until(
+                    ta, t_end, members, setter, algorithm=a, max_workers=w))
+        timings, results = interleaved_timings(list(engines.values()), PEER_REPEATS)
+    timed = dict(zip(engines, timings))
+    table_1, pooled = results[0], results[1]
     same = all(np.asarray(getattr(table_1[n], "value", table_1[n])).tobytes()
-               == np.asarray(getattr(table_2[n], "value", table_2[n])).tobytes() for n in table_1.colnames)
-    heyoka = {}
-    for algorithm in ("thread", "process"):
-        for workers in (1, 2):
-            heyoka[algorithm, workers], _ = _timed_ensemble(lambda: hy.ensemble_propagate_until(
-                ta, t_end, members, setter, algorithm=algorithm, max_workers=workers))
+               == np.asarray(getattr(t[n], "value", t[n])).tobytes() for t in (pooled, table_2) for n in table_1.colnames)
     batch_cpu, batch_error, lanes = _heyoka_batch(ek, earth, sun, tol, compact, states, pars, t0, t_end, reference)
     shipped = [(i, rows[i]) for i in range(chunk)]
     sent = len(pickle.dumps((ek.kepler_member, shipped, None, False))) / chunk
     returned = len(pickle.dumps(run_chunk(ek.kepler_member, shipped))) / chunk
-    per_member = spin[1] / members
     load.append(os.getloadavg()[0])
-    return dict(members=members, chunk=chunk, spin=spin, heyoka=heyoka, tol=tol, compact=compact,
-                spin_error=spin_error, heyoka_error=errors[tol], same=same, per_member=per_member, sent=sent,
-                returned=returned, load=load, heyoka_cpu=mode_cpu[int(compact)].median / members,
+    return dict(members=members, chunk=chunk, timed=timed, fresh=fresh, tol=tol, compact=compact,
+                spin_error=spin_error, heyoka_error=errors[tol], same=same, per_member=timed["batch", 1].median / members,
+                sent=sent, returned=returned, load=load, heyoka_cpu=mode_cpu[int(compact)].median / members,
                 core_cpu=core_cpu[0].median / members, core_error=core_error, rtol=rtol, batch_cpu=batch_cpu,
-                copy_s=copy_s[0].median, stages=stages,
-                batch_error=batch_error, lanes=lanes)
+                copy_s=copy_s[0].median, stages=stages, batch_error=batch_error, lanes=lanes, routes=routes,
+                batch_is_scene=batch_is_scene, sampling=sampling,
+                repeats=len(timings[0].samples))
 
 
 def measure_stages(ek, rows, repeats=3):
-    """CPU ms per member of each stage of a chunk of Kepler members, warm, sharing one sampling as a worker does.
+    """CPU ms per member of each stage of the batch route on one chunk of Kepler members, warm, sharing one
+    sampling as a worker does (:mod:`spinorbit.ensemble.batch`).
 
-    Stages: building the member (``make_scene``: RotationState and Scene), its plan (survey bounds along its
-    free motion, sensitivities, integrator choice), its run (the integration, its check at 10× the tolerance,
-    the result table) and its outcome row; and the a priori grid of the shared sampling, which the plan used
-    to compute per member and now takes once per sampling (``SharedSamples.grid_of``).
+    Stages: building the member (``make_scene``: RotationState and Scene); the group plan (the leader's
+    Scene plan, once per chunk, divided among its members); the member's own bounds (κ from the vectorised
+    free flow, the worst-attitude bound of each perturber); its models and the integration (the run and
+    its check at 10× the rtol in one batch call); its outcome row from the end state.
     """
+    from spinorbit.core.integrators.batch_quaternion import integrate_quaternion_batch
+    from spinorbit.ensemble import batch
     from spinorbit.ensemble.ensemble import build_member
-    from spinorbit.ensemble.outcomes import outcome_row
-    from spinorbit.scene.sampling import SharedSamples, grid_of_samples
-    from spinorbit.scene.tolerances import SURVEY_TOLERANCE
+    from spinorbit.scene.sampling import SharedSamples
 
-    shared = SharedSamples()  # what a worker's chunk holds once the orbit is sampled (and its grid taken)
-    first = build_member(ek.kepler_member, rows[0])
-    with first.sharing_samples(shared):
-        first.run()
+    shared = SharedSamples()  # what a worker's chunk holds once the orbit is sampled
+    leader = build_member(ek.kepler_member, rows[0])
+    with leader.sharing_samples(shared):
+        leader.run()
 
     def chunk():
-        spent = dict(build=0.0, plan=0.0, run=0.0, outcome=0.0)
-        for row in rows:
-            clock = time.process_time()
-            scene = build_member(ek.kepler_member, row)
-            spent["build"] += time.process_time() - clock
-            with scene.sharing_samples(shared):
-                clock = time.process_time()
-                plan = scene.plan()
-                spent["plan"] += time.process_time() - clock
-                clock = time.process_time()
-                result = scene.run(plan)
-                spent["run"] += time.process_time() - clock
-            clock = time.process_time()
-            outcome_row(scene, result)
-            spent["outcome"] += time.process_time() - clock
+        spent = dict(build=0.0, plan=0.0, bounds=0.0, integration=0.0, rows=0.0)
+        clock = time.process_time()
+        scenes = [build_member(ek.kepler_member, row) for row in rows]
+        spent["build"] += time.process_time() - clock
+        clock = time.process_time()
+        with scenes[0].sharing_samples(shared):
+            plan = scenes[0].plan()
+            survey = batch._survey(scenes[0], plan)
+            sources, _, _ = batch._kept_sources(scenes[0], plan)
+        spent["plan"] += time.process_time() - clock
+        clock = time.process_time()
+        kappas = batch.group_sensitivities([s.state for s in scenes], scenes[0].span_days)
+        batch._member_bounds(scenes, survey, kappas)
+        spent["bounds"] += time.process_time() - clock
+        clock = time.process_time()
+        moments = [s.state.body.principal_moments for s in scenes]
+        y0s = np.array([s.state.core_state() for s in scenes])
+        n = len(scenes)
+        ends, _, _ = batch._integrate(plan.integrator, integrate_quaternion_batch, [s.state.body for s in scenes],
+                                      y0s, scenes[0].epoch_day, float(scenes[0].output_days[-1]),
+                                      batch._models(moments + moments, sources), np.full(n, plan.rtol),
+                                      np.full(n, plan.integration_share_rad))
+        spent["integration"] += time.process_time() - clock
+        clock = time.process_time()
+        batch._rows(scenes, ends, None)
+        spent["rows"] += time.process_time() - clock
         return spent
 
     rounds = [chunk() for _ in range(repeats)]
-    stages = {k: statistics.median(r[k] for r in rounds) / len(rows) for k in rounds[0]}
-    scene = ek.kepler_member(**rows[0])
-    samples = scene.sample_perturbers("user", [p.name for p in scene.moving], SURVEY_TOLERANCE)
-    grid, _ = interleaved_timings([lambda: grid_of_samples(samples, scene.sample_tolerance)], 5,
-                                  clock=time.process_time)
-    stages["grid"] = grid[0].median
-    return stages
+    return {k: statistics.median(r[k] for r in rounds) / len(rows) for k in rounds[0]}
 
 
 def _heyoka_batch(ek, earth, sun, tol, compact, states, pars, t0, t_end, reference):
@@ -516,31 +537,44 @@ def markdown_efficiency(e, overhead_pool):
 
 
 def _warm_worker(row):
-    """A worker's first member (imports, numba cache, the orbit's sampling), run and thrown away."""
+    """A worker's first member (imports, numba cache, the orbit's sampling), run and thrown away, by both
+    routes (the Scene's integrator and the batch one)."""
     import encounter_kepler as ek
+    from spinorbit.ensemble.ensemble import run_chunk
 
     time.sleep(0.2)  # keep this worker busy so that the pool hands the next warm-up to the other
+    run_chunk(ek.kepler_member, [(0, row)])
     return ek.kepler_member(**row).run().error_estimate
 
 
 def stages_text(p):
-    """Where a member's CPU goes, stage by stage (:func:`measure_stages`)."""
+    """Where a member's CPU goes on the batch route, stage by stage (:func:`measure_stages`)."""
     st = p["stages"]
-    total = st["build"] + st["plan"] + st["run"] + st["outcome"]
-    return (f"CPU per member by stage, in a warm chunk of {p['members']} sharing one sampling (median of 3): "
-            f"{total * 1e3:.2f} ms in all; building the member (`make_scene`: its RotationState and Scene) "
-            f"{st['build'] * 1e3:.2f} ms; its plan (the survey's bounds along its own free motion, its "
-            f"sensitivities, the integrator choice) {st['plan'] * 1e3:.2f} ms; its run {st['run'] * 1e3:.2f} ms "
-            f"(the integration and its check at 10× the tolerance, about 2 × {p['core_cpu'] * 1e3:.2f} ms; the rest "
-            f"the result table, its metadata and the error parts); its outcome row {st['outcome'] * 1e3:.2f} ms. "
-            f"The a priori grid of the shared sampling ({st['grid'] * 1e3:.2f} ms, which the plan used to compute "
-            "for every member) is taken once per sampling and kept with it (`SharedSamples.grid_of`), and the check "
-            "run builds no table.")
+    total = sum(st.values())
+    return (f"CPU per member by stage of the batch route, in a warm chunk of {p['chunk']} sharing one sampling "
+            f"(median of 3): {total * 1e3:.2f} ms in all; building the member (`make_scene`: its RotationState and "
+            f"Scene) {st['build'] * 1e3:.2f} ms; the group plan (the leader's Scene plan, once per chunk) "
+            f"{st['plan'] * 1e3:.2f} ms; the member's own bounds (κ from one vectorised free flow, the worst-attitude "
+            f"bound of each perturber) {st['bounds'] * 1e3:.2f} ms; its model and integration (the run and its check "
+            f"at 10× the rtol in one `integrate_quaternion_batch` call) {st['integration'] * 1e3:.2f} ms; its outcome "
+            f"row from the end state {st['rows'] * 1e3:.2f} ms.")
+
+
+def _label(key):
+    return {("batch", 1): "spinorbit `Ensemble`, batch route, in this process",
+            ("batch", 2): "spinorbit `Ensemble`, batch route, pool already started",
+            ("member", 1): "spinorbit `Ensemble`, per-member route (`route=\"member\"`), in this process"}.get(
+        key, f"heyoka `ensemble_propagate_until`, {key[0]} pool")
 
 
 def markdown_peer(p, overhead_pool):
     n = p["members"]
-    best_heyoka = max(n / t for t in p["heyoka"].values())
+    timed = p["timed"]
+    heyoka = {k: t for k, t in timed.items() if k[0] in ("thread", "process")}
+    best_key = max(heyoka, key=lambda k: n / heyoka[k].median)
+    best_heyoka = n / heyoka[best_key].median
+    best_spin_key = max((("batch", 1), ("batch", 2)), key=lambda k: n / timed[k].median)
+    best_spin = n / timed[best_spin_key].median
     lines = [
         "### Against heyoka's ensemble propagation", "",
         f"The Apophis encounter ensemble on Keplerian orbits (`benchmarks/encounter_kepler.py`): {n} members "
@@ -550,55 +584,62 @@ def markdown_peer(p, overhead_pool):
         "out by both). heyoka cannot call REBOUND; it gets the Sun from `kepE` and the Earth from the two-body "
         "ODE in its state, the moment ratios as runtime parameters (one compiled integrator), and its faster "
         f"mode (compact mode {'on' if p['compact'] else 'off'}). spinorbit runs each member as a Scene "
-        "(Earth and Sun as EphemerisPerturbers of the same Kepler states, sampled once per process) at 1 arcsec.",
+        "(Earth and Sun as EphemerisPerturbers of the same Kepler states, sampled once per process) at 1 arcsec, "
+        f"by the batch route (`spinorbit.ensemble.batch`, chunks of {p['chunk']}: members {p['routes']}) and, "
+        "for comparison, by the per-member route.",
         "",
         f"Accuracy against heyoka at tol {REFERENCE_TOL:g} (the attitude at the end, per member): spinorbit "
         f"worst {p['spin_error'].max():.2e} rad, median {np.median(p['spin_error']):.2e} rad; heyoka at tol "
         f"{p['tol']:g} (the loosest of {', '.join(f'{t:g}' for t in HEYOKA_TOLS)} whose worst member is as "
-        f"accurate) worst {p['heyoka_error'].max():.2e} rad, median {np.median(p['heyoka_error']):.2e} rad.", "",
-        "| engine | workers | wall (s) | members/s | against heyoka's best |", "|---|---|---|---|---|"]
-    for key, label in ((1, "spinorbit `Ensemble`, in this process"), (2, "spinorbit `Ensemble`, new process pool"),
-                       ("warm 2", "spinorbit `Ensemble`, pool already started")):
-        workers = 1 if key == 1 else 2
-        lines.append(f"| {label} | {workers} | {p['spin'][key]:.2f} | {n / p['spin'][key]:.1f} | "
-                     f"{n / p['spin'][key] / best_heyoka:.3f} |")
-    for (algorithm, workers), seconds in p["heyoka"].items():
-        lines.append(f"| heyoka `ensemble_propagate_until`, {algorithm} pool | {workers} | {seconds:.3f} | "
-                     f"{n / seconds:.0f} | {n / seconds / best_heyoka:.3f} |")
-    lines += [f"| heyoka batch mode (`taylor_adaptive_batch`, {p['lanes']} lanes), CPU | 1 | {n * p['batch_cpu']:.3f} | "
-              f"{1 / p['batch_cpu']:.0f} | {1 / p['batch_cpu'] / best_heyoka:.2f} |"]
-    lines += [f"| *floor:* spinorbit's core DOP853 alone, member after member on the Scene's model and rtol "
+        f"accurate) worst {p['heyoka_error'].max():.2e} rad, median {np.median(p['heyoka_error']):.2e} rad. "
+        "spinorbit's attitudes are those of each member's own Scene run; the batch route's rows are "
+        + ("the same integration (their poles the same bits, checked here)." if p["batch_is_scene"] else
+           "NOT the same bits as the Scene runs' poles here."),
+        "",
+        f"Wall time of the whole ensemble, every process warm (compiled, the orbits sampled), {p['repeats']} "
+        "interleaved rounds: median (min–max).", "",
+        "| engine | workers | wall (s) | members/s (median) | against heyoka's best |", "|---|---|---|---|---|"]
+    for key, t in timed.items():
+        workers = key[1]
+        lines.append(f"| {_label(key)} | {workers} | {t.median:.3f} ({t.min:.3f}–{t.max:.3f}) | "
+                     f"{n / t.median:.0f} | {n / t.median / best_heyoka:.2f} |")
+    lines += [f"| spinorbit `Ensemble`, batch route, new process pool (its start, imports and sampling; once) | 2 | "
+              f"{p['fresh']:.2f} | {n / p['fresh']:.0f} | {n / p['fresh'] / best_heyoka:.2f} |",
+              f"| heyoka batch mode (`taylor_adaptive_batch`, {p['lanes']} lanes), CPU | 1 | {n * p['batch_cpu']:.3f} | "
+              f"{1 / p['batch_cpu']:.0f} | {1 / p['batch_cpu'] / best_heyoka:.2f} |",
+              f"| *floor:* spinorbit's core DOP853 alone, member after member on the Scene's model and rtol "
               f"({p['rtol']:.2g}), CPU | 1 | {n * p['core_cpu']:.3f} | {1 / p['core_cpu']:.0f} | "
               f"{1 / p['core_cpu'] / best_heyoka:.2f} |",
               f"| *floor:* heyoka's integrator alone, reused member after member, CPU | 1 | {n * p['heyoka_cpu']:.3f} | "
               f"{1 / p['heyoka_cpu']:.0f} | {1 / p['heyoka_cpu'] / best_heyoka:.2f} |"]
-    warm_efficiency = p["spin"][1] / (2 * p["spin"]["warm 2"])
-    model_2 = n * p["per_member"] / 2 + -(-n // p["chunk"]) * overhead_pool / 2
+    ratio = best_spin / best_heyoka
+    speedup = timed["member", 1].median / timed["batch", 1].median
     lines += [
-        "", f"The serial and pooled tables are {'the same bits' if p['same'] else 'NOT the same bits'}. "
-        f"The 1-minute load average was {p['load'][0]:.2f} before and {p['load'][1]:.2f} after.", "",
-        f"The core integrator alone is as accurate (worst {p['core_error'].max():.2e} rad), and so is heyoka's "
-        f"batch mode at the same tolerance (worst {p['batch_error'].max():.2e} rad). spinorbit's batch DOP853 "
-        "(`integrate_quaternion_batch`) is measured against it on the same members in the 'batch' section below "
-        "(`benchmarks/bench_batch.py`); the Ensemble does not use it yet. "
-        f"The goal (≥ 1.5× heyoka's ensemble throughput at equal accuracy) is "
-        + (f"met on one core ({n / p['spin'][1] / best_heyoka:.2f}×)." if n / p['spin'][1] >= 1.5 * best_heyoka else
-           f"missed by a factor {1.5 * best_heyoka / (n / p['spin'][1]):.1f} on one core. A member's integration "
-           f"costs {p['core_cpu'] * 1e3:.2f} ms of CPU alone against heyoka's {p['heyoka_cpu'] * 1e3:.2f} ms; "
-           f"a member of the Ensemble costs {p['per_member'] * 1e3:.1f} ms of wall, of which its two integrations "
-           f"(the run and its check at 10× the tolerance, about 2 × {p['core_cpu'] * 1e3:.2f} ms) are "
-           f"{100 * 2 * p['core_cpu'] / p['per_member']:.0f}%: the rest is the Scene around them. " + stages_text(p) +
-           " heyoka's thread ensemble in turn copies the integrator once per member "
-           f"(`deepcopy`, {p['copy_s'] * 1e3:.2f} ms, median of 20) and runs the member's generator in Python: "
-           f"{p['heyoka'][('thread', 1)] / n * 1e3:.2f} ms per member on one worker. A batch route that plans a chunk "
-           "once and integrates its members at the core, with no table per member, is what would close the gap "
-           "(not done)."), "",
-        f"Scaling model of the spinorbit ensemble on a started pool: T(2) = n c / 2 + (n / chunk) o / 2 with "
-        f"c = {p['per_member'] * 1e3:.1f} ms (the serial run's time per member), o = {overhead_pool * 1e3:.2f} ms "
-        f"(an empty task's round trip) and chunks of {p['chunk']}: {model_2:.2f} s predicted, "
-        f"{p['spin']['warm 2']:.2f} s measured (parallel efficiency {warm_efficiency:.2f}; with the pool's start "
-        f"{p['spin'][1] / (2 * p['spin'][2]):.2f}). Data moved per member: {p['sent']:.0f} bytes out "
-        f"(the orbits travel as parameter strings), {p['returned']:.0f} bytes back."]
+        "", f"The serial, pooled and new-pool tables are {'the same bits' if p['same'] else 'NOT the same bits'}. "
+        f"The 1-minute load average was {p['load'][0]:.2f} before and {p['load'][1]:.2f} after (the 2 cores are "
+        "shared with other work). A process's first member also samples the two orbits (survey and run): "
+        f"{p['sampling']:.2f} s once per process, not in the rows above except the new pool's.", "",
+        f"The batch route runs a member {speedup:.1f}× faster than the per-member route. The goal (≥ 1.5× "
+        f"heyoka's ensemble throughput at equal accuracy) is "
+        + (f"met: spinorbit's best ({_label(best_spin_key)}) is {ratio:.2f}× heyoka's best ({_label(best_key)}, "
+           f"{best_key[1]} workers)." if ratio >= 1.5 else
+           f"missed: spinorbit's best ({_label(best_spin_key)}, {best_spin:.0f} members/s) is {ratio:.2f}× heyoka's "
+           f"best ({_label(best_key)}, {best_key[1]} workers, {best_heyoka:.0f} members/s), a factor "
+           f"{1.5 / ratio:.2f} short. ")
+        + stages_text(p) + f" The integration is {100 * p['stages']['integration'] / sum(p['stages'].values()):.0f}% "
+        f"of it: two DOP853 integrations per member (the run and its a posteriori check), each costing about the "
+        f"core floor above ({p['core_cpu'] * 1e3:.2f} ms of CPU against heyoka's integrator alone "
+        f"{p['heyoka_cpu'] * 1e3:.2f} ms). heyoka's thread ensemble copies the integrator once per member "
+        f"(`deepcopy`, {p['copy_s'] * 1e3:.2f} ms, median of 20) and runs the member's generator in Python. What "
+        "is left to gain is mostly in the integrator (a batch Taylor method may replace DOP853 through "
+        "`Ensemble(batch_integrators=...)`) and in building the Scene per member.", "",
+        f"Scaling model of the batch route on a started pool: T(W) = n c / W + (n / chunk) o / W with "
+        f"c = {p['per_member'] * 1e3:.2f} ms (the serial batch run's median time per member), o = "
+        f"{overhead_pool * 1e3:.2f} ms (an empty task's round trip) and chunks of {p['chunk']}: T(2) = "
+        f"{n * p['per_member'] / 2 + -(-n // p['chunk']) * overhead_pool / 2:.3f} s predicted, "
+        f"{timed['batch', 2].median:.3f} s measured (parallel efficiency "
+        f"{timed['batch', 1].median / (2 * timed['batch', 2].median):.2f}). Data moved per member: "
+        f"{p['sent']:.0f} bytes out (the orbits travel as parameter strings), {p['returned']:.0f} bytes back."]
     return "\n".join(lines)
 
 

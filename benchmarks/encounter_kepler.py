@@ -166,14 +166,23 @@ def kepler_member(q_w, q_x, q_y, q_z, omega_x, omega_y, omega_z, i1_i3, i2_i3, e
                   tolerance_arcsec=1.0):
     """One member's Scene: the state given, the Earth and the Sun on their Kepler orbits (:func:`encounter_orbits`)."""
     from spinorbit.body import RigidBody
-    from spinorbit.data.asteroids import APOPHIS_2029, APOPHIS_STATE_EPOCH
+    from spinorbit.data.asteroids import APOPHIS_STATE_EPOCH
     from spinorbit.scene import Scene
     from spinorbit.state import RotationState
 
     state = RotationState(RigidBody([i1_i3, i2_i3, 1.0], name="Apophis"), [q_w, q_x, q_y, q_z],
                           [omega_x, omega_y, omega_z] * (u.rad / u.day))
-    return Scene(state, APOPHIS_STATE_EPOCH, APOPHIS_2029.time_tdb + 0.5 * span * u.day,
-                 perturbers=_perturbers(earth, sun), tolerance=tolerance_arcsec * u.arcsec)
+    return Scene(state, APOPHIS_STATE_EPOCH, end_time(span), perturbers=_perturbers(earth, sun),
+                 tolerance=tolerance_arcsec * u.arcsec)
+
+
+@functools.cache
+def end_time(span=4.0):
+    """The members' last output time, ``span / 2`` after the perigee: one Time per process and span (its
+    arithmetic costs more than the rest of a member's Scene), the same value each member computed."""
+    from spinorbit.data.asteroids import APOPHIS_2029
+
+    return APOPHIS_2029.time_tdb + 0.5 * span * u.day
 
 
 # ------------------------------------------------------------------------------------------ heyoka

@@ -44,11 +44,17 @@ from spinorbit.ensemble.free import torque_free_rows
 from spinorbit.ensemble.samplers import SEED_COLUMNS, sample_parameters
 from spinorbit.ensemble.store import ChunkStore
 
-__all__ = ["Ensemble", "EnsembleError", "EnsembleInterrupted", "clear_process_samplings", "run_chunk", "torque_free"]
+__all__ = ["ROUTES", "Ensemble", "EnsembleError", "EnsembleInterrupted", "clear_process_samplings", "run_chunk",
+           "torque_free"]
 
 #: Most members in a default chunk; the default is ceil(n / 32) up to this (chunks few enough to
 #: spread over many workers, large enough that a chunk's shared sampling pays).
 MAX_DEFAULT_CHUNK = 16
+#: With the batch route a chunk's group is planned once and integrated in one call per attempt, so its
+#: default chunks are larger: ceil(n / BATCH_CHUNKS) members, at most MAX_BATCH_CHUNK (4 chunks share 2
+#: workers evenly; the plan and the calls are paid once per chunk: benchmarks/bench_ensemble.py).
+BATCH_CHUNKS = 4
+MAX_BATCH_CHUNK = 64
 
 
 def _plain_value(value):
@@ -143,12 +149,19 @@ def free_rows(free, at_days, rows, failures):
     if not free:
         return
     try:
-        rows.update(zip((i for i, _, _ in free), torque_free_rows([s for _, s, _ in free], at_days)))
+        rows.update((i, {**row, "ensemble_route": "torque-free"})
+                    for (i, _, _), row in zip(free, torque_free_rows([s for _, s, _ in free], at_days)))
     except Exception as error:  # noqa: BLE001 — recorded like a worker's failure
         failures.update({i: failure_record(i, p, error) for i, _, p in free})
 
 
-def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None):
+#: The ensemble's routes: "auto" plans the members that can share a plan as groups and integrates each
+#: group together (:mod:`spinorbit.ensemble.batch`), the rest through their own Scene; "member" runs
+#: every member through its own Scene.
+ROUTES = ("auto", "member")
+
+
+def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None, route="auto", integrators=None):
     """Run one chunk of members in this process (what a worker does): (rows, failures, tables).
 
     ``members`` is a list of (index, parameter dict); ``scenes`` optionally ``{index: Scene}`` of
@@ -160,23 +173,49 @@ def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None)
     memo (:class:`~spinorbit.scene.sampling.SharedSamples`), so a worker samples the orbit once, and
     every chunk's numbers are those it gives alone. Torque-free members (unless ``keep_tables``) take
     one vectorised call for the chunk (:func:`~spinorbit.ensemble.free.torque_free_rows`; the same
-    bits in any process or batch).
+    bits in any process or batch). With ``route="auto"`` (and no tables kept) the members that can
+    share a plan run as groups by the batch route (:func:`spinorbit.ensemble.batch.run_group`, its
+    batch integrators ``integrators``, default :data:`~spinorbit.ensemble.batch.BATCH_INTEGRATORS`);
+    every row records its route in ``ensemble_route`` ("batch", "scene" or "torque-free").
     """
+    from spinorbit.ensemble.batch import group_key, run_group
     from spinorbit.scene.sampling import SharedSamples
 
-    rows, failures, tables, shared, free = {}, {}, {}, {}, []
+    rows, failures, tables, shared, free, built = {}, {}, {}, {}, [], []
     scenes = scenes or {}
     for index, parameters in members:
         try:
             scene = scenes[index] if index in scenes else build_member(make_scene, parameters)
-            if not keep_tables and torque_free(scene):
-                free.append((index, scene, parameters))
-                continue
-            # the scene stays referenced with its samples, so an id() in the key is never reused in the chunk
-            _, samples = shared.setdefault(_sharing_key(scene), (scene, SharedSamples(_process_memo(scene))))
-            with scene.sharing_samples(samples):
+        except Exception as error:  # noqa: BLE001 — a member's failure is recorded, the chunk goes on
+            failures[index] = failure_record(index, parameters, error)
+            continue
+        if not keep_tables and torque_free(scene):
+            free.append((index, scene, parameters))
+        else:
+            built.append((index, scene, parameters))
+
+    def samples_of(scene):
+        # the scene stays referenced with its samples, so an id() in the key is never reused in the chunk
+        return shared.setdefault(_sharing_key(scene), (scene, SharedSamples(_process_memo(scene))))[1]
+
+    single = built
+    if route == "auto" and not keep_tables:
+        groups, single = {}, []
+        for member in built:
+            key = group_key(member[1], at_days)
+            (single.append(member) if key is None else
+             groups.setdefault((_sharing_key(member[1]), key), []).append(member))
+        for group in groups.values():
+            group_rows, group_failures, fallback = run_group(group, samples_of(group[0][1]), at_days, integrators)
+            rows.update({i: {**row, "ensemble_route": "batch"} for i, row in group_rows.items()})
+            failures.update({i: failure_record(i, p, group_failures[i]) for i, _, p in group if i in group_failures})
+            single.extend(fallback)
+        single.sort(key=lambda member: member[0])
+    for index, scene, parameters in single:
+        try:
+            with scene.sharing_samples(samples_of(scene)):
                 result = scene.run()
-            rows[index] = outcome_row(scene, result, at_days)
+            rows[index] = {**outcome_row(scene, result, at_days), "ensemble_route": "scene"}
             if keep_tables:
                 tables[index] = result.table
         except Exception as error:  # noqa: BLE001 — a member's failure is recorded, the chunk goes on
@@ -203,11 +242,23 @@ class Ensemble:
         ``seed_entropy`` and ``seed_spawn_key`` of :func:`~spinorbit.ensemble.samplers.sample_parameters`,
         which are recorded, not passed).
     chunk_size : int, optional
-        Members per chunk; default ``min(16, ceil(n / 32))``. It fixes the work units, so results do
-        not depend on the executor or the number of workers.
+        Members per chunk; default ``min(64, ceil(n / 4))`` with ``route="auto"`` (a chunk's group is
+        planned once), ``min(16, ceil(n / 32))`` with ``route="member"``. It fixes the work units, so
+        results do not depend on the executor or the number of workers.
     at : astropy.time.Time, optional
         Times (among every member's output times) at which to report the outcome; default the last
         output time. With ``at`` the time-dependent columns are suffixed ``_t0``, ``_t1``, …
+    route : {"auto", "member"}
+        "auto": the members of a chunk that can share a plan (:func:`~spinorbit.ensemble.batch.group_key`)
+        are planned as a group and integrated together at the core, with no result table per member
+        (:mod:`spinorbit.ensemble.batch`); the others, and every member with ``keep_tables``, run
+        through their own Scene. "member": every member through its own Scene. The table's
+        ``meta["member_routes"]`` counts the members of each route.
+    batch_integrators : dict, optional
+        ``{plan integrator name: function}`` of the batch route, each with
+        :func:`~spinorbit.core.integrators.batch_quaternion.integrate_quaternion_batch`'s signature
+        (module-level, so that workers can import it); default
+        :data:`~spinorbit.ensemble.batch.BATCH_INTEGRATORS`.
 
     Attributes
     ----------
@@ -220,14 +271,23 @@ class Ensemble:
         ``wall_seconds`` and ``executor`` of the last :meth:`run` or :meth:`rerun`.
     """
 
-    def __init__(self, make_scene, parameters, chunk_size=None, at=None):
+    def __init__(self, make_scene, parameters, chunk_size=None, at=None, route="auto", batch_integrators=None):
         if not callable(make_scene):
             raise EnsembleError(f"make_scene expects a callable returning a Scene; got {make_scene!r}.")
+        if route not in ROUTES:
+            raise EnsembleError(f"route expects one of {ROUTES}; got {route!r}. 'auto' batches the members that can "
+                                "share a plan, 'member' runs every member through its own Scene.")
+        if batch_integrators is not None and not (isinstance(batch_integrators, dict) and all(
+                isinstance(k, str) and callable(f) for k, f in batch_integrators.items())):
+            raise EnsembleError(f"batch_integrators expects a dict {{plan integrator name: batch function}} (e.g. "
+                                f"{{'quaternion': integrate_quaternion_batch}}); got {batch_integrators!r}.")
+        self.route, self.batch_integrators = route, batch_integrators
         self.make_scene = make_scene
         self.parameters = _parameter_table(parameters)
         n = len(self.parameters)
         if chunk_size is None:
-            chunk_size = min(MAX_DEFAULT_CHUNK, math.ceil(n / 32))
+            chunk_size = (min(MAX_BATCH_CHUNK, math.ceil(n / BATCH_CHUNKS)) if route == "auto" else
+                          min(MAX_DEFAULT_CHUNK, math.ceil(n / 32)))
         if not (isinstance(chunk_size, (int, np.integer)) and not isinstance(chunk_size, bool) and chunk_size >= 1):
             raise EnsembleError(f"chunk_size expects a positive number of members; got {chunk_size!r}.")
         self.chunk_size = int(chunk_size)
@@ -237,10 +297,12 @@ class Ensemble:
         self._complete = set()  # chunks whose every member has a row or a failure
 
     @classmethod
-    def sampled(cls, make_scene, n, seed=None, chunk_size=None, at=None, **distributions):
+    def sampled(cls, make_scene, n, seed=None, chunk_size=None, at=None, route="auto", batch_integrators=None,
+                **distributions):
         """An ensemble of ``n`` members whose parameters are drawn, each from its own seed
         (:func:`~spinorbit.ensemble.samplers.sample_parameters`; the seeds are columns of the result)."""
-        return cls(make_scene, sample_parameters(n, seed, **distributions), chunk_size=chunk_size, at=at)
+        return cls(make_scene, sample_parameters(n, seed, **distributions), chunk_size=chunk_size, at=at, route=route,
+                   batch_integrators=batch_integrators)
 
     # ------------------------------------------------------------------------------------------
     @property
@@ -265,6 +327,10 @@ class Ensemble:
         digest = hashlib.sha256()
         digest.update(f"{getattr(self.make_scene, '__module__', '')}.{getattr(self.make_scene, '__qualname__', '')}"
                       f"|{self.chunk_size}|{self.n_members}|".encode())
+        if self.route != "auto" or self.batch_integrators is not None:  # the route decides the bits too
+            names = sorted((k, f"{getattr(f, '__module__', '')}.{getattr(f, '__qualname__', '')}")
+                           for k, f in (self.batch_integrators or {}).items())
+            digest.update(f"route={self.route}|{names}|".encode())
         if self.at_days is not None:
             digest.update(self.at_days.tobytes())
         for index in range(self.n_members):
@@ -389,11 +455,13 @@ class Ensemble:
                 if not ship:
                     finish(chunk, rows, failures, {})
                 elif pool is None:
-                    more_rows, more_failures, tables = run_chunk(self.make_scene, ship, self.at_days, keep_tables, scenes)
+                    more_rows, more_failures, tables = run_chunk(self.make_scene, ship, self.at_days, keep_tables, scenes,
+                                                                 self.route, self.batch_integrators)
                     finish(chunk, {**rows, **more_rows}, {**failures, **more_failures}, tables)
                 else:  # submitted at once: the workers start while the next chunks are prepared
                     partial[chunk] = (rows, failures)
-                    futures[pool.submit(run_chunk, self.make_scene, ship, self.at_days, keep_tables)] = chunk
+                    futures[pool.submit(run_chunk, self.make_scene, ship, self.at_days, keep_tables, None, self.route,
+                                        self.batch_integrators)] = chunk
             for future in concurrent.futures.as_completed(futures):
                 chunk = futures[future]
                 try:
@@ -436,9 +504,11 @@ class Ensemble:
             for index in indices:  # each alone, by the same path as in run(): torque-free ones in this process
                 rows, failures, ship, scenes = self._split([index])
                 if ship:
-                    job = (pool.submit(run_chunk, self.make_scene, ship, self.at_days) if pool is not None else None)
+                    job = (pool.submit(run_chunk, self.make_scene, ship, self.at_days, False, None, self.route,
+                                       self.batch_integrators) if pool is not None else None)
                     rows, failures, _ = (job.result() if job is not None else
-                                         run_chunk(self.make_scene, ship, self.at_days, scenes=scenes))
+                                         run_chunk(self.make_scene, ship, self.at_days, False, scenes, self.route,
+                                                   self.batch_integrators))
                 results.append((rows, failures, {}))
         for index, (rows, failures, _) in zip(indices, results):
             self._rows.pop(index, None)
@@ -463,6 +533,15 @@ class Ensemble:
         names += [*INITIAL_COLUMNS, *RUN_COLUMNS]
         present = {name for row in self._rows.values() for name in row}
         return [name for name in names if name in present]
+
+    def member_routes(self):
+        """{route: members} of the members with a row: "batch" (planned as a group and integrated together,
+        :mod:`spinorbit.ensemble.batch`), "scene" (their own Scene run) or "torque-free" (vectorised)."""
+        counts = {}
+        for row in self._rows.values():
+            route = row.get("ensemble_route", "scene")
+            counts[route] = counts.get(route, 0) + 1
+        return dict(sorted(counts.items()))
 
     def table(self):
         """One row per member in member order: parameters, outcome columns, ``error`` ("" when it ran).
@@ -493,5 +572,6 @@ class Ensemble:
         table.meta.update({"members": n, "chunk_size": self.chunk_size, "fingerprint": self.fingerprint,
                            "failures": self.failures,
                            "outcome_times_tdb_days": None if self.at_days is None else self.at_days.tolist(),
-                           "outcome_time": "last output time" if self.at_days is None else "named times (_t<k>)"})
+                           "outcome_time": "last output time" if self.at_days is None else "named times (_t<k>)",
+                           "route": self.route, "member_routes": self.member_routes()})
         return table

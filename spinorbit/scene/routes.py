@@ -23,7 +23,8 @@ from spinorbit.scene.tolerances import MAX_RTOL_RETRIES, refine, sampling_error_
 from spinorbit.state_table import OMEGA_COLUMNS, from_principal, table_columns, time_column
 from spinorbit.time import time_from_tdb_days
 
-__all__ = ["attitude_angles", "result_table", "run_coupled", "run_one_way", "run_torque_free", "scene_orbit_normals"]
+__all__ = ["attitude_angles", "one_way_sources", "result_table", "run_coupled", "run_one_way", "run_torque_free",
+           "scene_orbit_normals"]
 
 
 def attitude_angles(q1, q2):
@@ -84,10 +85,14 @@ def run_torque_free(scene, plan):
     return table, {"dropped": plan.dropped_bound_rad, "integration": 0.0, "sampling": 0.0}, {}
 
 
-def run_one_way(scene, plan, report):
-    """The one-way integration under the plan's kept perturbers, checked a posteriori; ``report(fraction)``."""
+def one_way_sources(scene, plan):
+    """What the one-way run integrates under: (samples of the kept named perturbers, or NoSamples; the extra
+    sources of the kept fixed perturbers and user ephemerides; the kept named and user names).
+
+    The model's sources are ``[*samples.sources(), *extra]``, in that order (:func:`run_one_way`, and the
+    ensemble's batch route, which builds one such model per member).
+    """
     from spinorbit.core.model.perturbers import fixed_source
-    from spinorbit.coupling.one_way import integrate_one_way, one_way_days, one_way_quaternions, one_way_table
 
     named = tuple(n for n in plan.kept if n in scene.named)
     fixed = [fixed_source(p.gm_au3_day2, p.position_au) for p in scene.fixed if p.name in plan.kept]
@@ -100,6 +105,14 @@ def run_one_way(scene, plan, report):
         samples = scene.sample_perturbers(plan.orbit_source, named, scene.sample_tolerance) if named else None
     if samples is None:
         samples = NoSamples(scene.epoch_day, scene.output_days[-1])
+    return samples, fixed, named, moving
+
+
+def run_one_way(scene, plan, report):
+    """The one-way integration under the plan's kept perturbers, checked a posteriori; ``report(fraction)``."""
+    from spinorbit.coupling.one_way import integrate_one_way, one_way_days, one_way_quaternions, one_way_table
+
+    samples, fixed, named, moving = one_way_sources(scene, plan)
     report(0.3)
     epoch = time_from_tdb_days(scene.epoch_day)
     t0, t_out = one_way_days(epoch, time_from_tdb_days(scene.output_days))  # propagate_one_way's days, once

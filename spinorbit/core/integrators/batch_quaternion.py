@@ -448,17 +448,20 @@ def _validated_atols(atol, rtols, spin):
 
 def _stack_models(models, n):
     """The members' models as one (N, M) float array, or a ValueError saying what is wrong."""
-    if isinstance(models, np.ndarray) and models.ndim == 1 or (
-            not isinstance(models, np.ndarray) and len(models) > 0 and np.ndim(models[0]) == 0):
-        models = [np.asarray(models, dtype=float)] * n
-    models = list(models)
-    if len(models) != n:
-        raise ValueError(f"models: expected one model per member ({n}) or one for all, got {len(models)}.")
-    sizes = {np.asarray(model).size for model in models}
-    if len(sizes) != 1:
-        raise ValueError(f"models: expected model arrays of one length (the same perturber layout), got lengths "
-                         f"{sorted(sizes)}; build the members' models from the same kinds of sources.")
-    stacked = np.ascontiguousarray(np.array([np.asarray(model, dtype=float).ravel() for model in models]))
+    if isinstance(models, np.ndarray) and models.ndim == 2 and models.shape[0] == n:
+        stacked = np.ascontiguousarray(models, dtype=float)  # stacked already (the ensemble's groups): no copy
+    else:
+        if isinstance(models, np.ndarray) and models.ndim == 1 or (
+                not isinstance(models, np.ndarray) and len(models) > 0 and np.ndim(models[0]) == 0):
+            models = [np.asarray(models, dtype=float)] * n
+        models = list(models)
+        if len(models) != n:
+            raise ValueError(f"models: expected one model per member ({n}) or one for all, got {len(models)}.")
+        sizes = {np.asarray(model).size for model in models}
+        if len(sizes) != 1:
+            raise ValueError(f"models: expected model arrays of one length (the same perturber layout), got lengths "
+                             f"{sorted(sizes)}; build the members' models from the same kinds of sources.")
+        stacked = np.ascontiguousarray(np.array([np.asarray(model, dtype=float).ravel() for model in models]))
     for m, model in enumerate(stacked):
         if has_interior(model):
             raise ValueError(f"models: member {m} has a mantle-and-core interior block; the batch integrator "

@@ -17,13 +17,13 @@ from spinorbit.shape.mass import (
     rigid_body_from_shape,
     shape_mass_properties,
 )
-from spinorbit.shape.mesh import Shape, box_shape, ellipsoid_shape, gaussian_random_sphere, icosphere
-from spinorbit.shape.thermal import principal_facets, thermal_block
+from spinorbit.shape.mesh import Shape, box_shape, ellipsoid_shape, gaussian_random_sphere, icosphere, voxel_shape
+from spinorbit.shape.thermal import principal_facets, principal_vertices, thermal_block
 
 __all__ = [
     "Shape", "InvalidMeshError", "ShapeFileError", "InertiaMismatchError", "ShapeMassProperties",
     "read_obj", "write_obj", "read_icq", "write_icq", "icq_grid", "icq_mesh",
-    "box_shape", "ellipsoid_shape", "gaussian_random_sphere", "icosphere",
+    "box_shape", "ellipsoid_shape", "gaussian_random_sphere", "icosphere", "voxel_shape",
     "shape_mass_properties", "rigid_body_from_shape", "principal_shape", "check_moments",
-    "thermal_block", "principal_facets",
+    "thermal_block", "principal_facets", "principal_vertices",
 ]

@@ -7,6 +7,10 @@ a Shape can rely on it. Generated shapes, for tests and examples:
 - :func:`ellipsoid_shape`: a triaxial ellipsoid from a subdivided icosahedron. The icosahedron
   (0, ±1, ±φ) and its cyclic permutations is symmetric under each coordinate mirror, and so is every
   subdivision: the mesh keeps the ellipsoid's three mirror planes exactly.
+- :func:`voxel_shape`: the surface of a union of cubes on a grid, for non-convex test bodies whose
+  shadows have closed forms (an L-shaped block casts a rectangle on its floor). Each exposed square
+  is split into four triangles about its centre, so every mirror symmetry of the voxel set is kept
+  by the mesh.
 - :func:`gaussian_random_sphere`: Muinonen's Gaussian random sphere (Muinonen 1998, Astron.
   Astrophys. 332, 1087; Muinonen & Lagerros 1998, A&A 333, 753): r = a exp(s − β²/2), s a Gaussian
   random field on the sphere with Legendre power c_l ∝ l^(−ν) for l = 2..l_max and variance β²,
@@ -24,7 +28,8 @@ from astropy import units as u
 from spinorbit.core.model.polyhedron import check_closed_mesh, regular_solid_harmonics
 from spinorbit.quantities import value_in
 
-__all__ = ["Shape", "box_shape", "ellipsoid_shape", "gaussian_random_sphere", "icosphere", "directions_to_shape"]
+__all__ = ["Shape", "box_shape", "ellipsoid_shape", "gaussian_random_sphere", "icosphere", "directions_to_shape",
+           "voxel_shape"]
 
 #: Highest icosphere subdivision: 20·4^7 = 327 680 faces, already far past what a torque needs.
 MAX_SUBDIVISIONS = 7
@@ -228,3 +233,66 @@ def gaussian_random_sphere(radius, sigma, seed, nu=4.0, degree_max=10, subdivisi
                 field_values += spread * norm * rng.standard_normal() * sin_part[n, m]
     radii = mean_radius * np.exp(field_values - 0.5 * beta2)
     return directions_to_shape(directions, faces, radii, name=name or f"gaussian random sphere (seed {seed})")
+
+
+def voxel_shape(occupied, pitch, name=None):
+    """The surface of a union of cubes: voxel (i, j, k) fills [i, i + 1] × [j, j + 1] × [k, k + 1] · pitch.
+
+    Parameters
+    ----------
+    occupied : array_like of bool, shape (nx, ny, nz)
+        Which voxels are solid.
+    pitch : Quantity
+        Edge of a voxel (length).
+
+    Returns
+    -------
+    Shape
+        Every square between a solid and an empty voxel as four outward triangles about its centre.
+
+    Raises
+    ------
+    ValueError
+        ``occupied`` is not a 3-d boolean array with a solid voxel.
+    InvalidMeshError
+        The voxels touch only along an edge or at a corner somewhere (the surface is not a manifold there).
+    """
+    grid = np.asarray(occupied)
+    if grid.ndim != 3 or grid.dtype != bool or not grid.any():
+        raise ValueError(f"occupied: expected a 3-d boolean array with at least one True voxel; got shape "
+                         f"{grid.shape}, dtype {grid.dtype}.")
+    size = value_in("pitch", pitch, u.km, "0.1 * u.km", plain_unit=u.km, shape=())
+    if not size > 0:
+        raise ValueError(f"pitch: expected a positive length; got {size!r} km.")
+    padded = np.pad(grid, 1)
+    index, vertices, faces = {}, [], []
+
+    def vertex(point):  # half-integer grid coordinates, doubled to stay exact integers as keys
+        key = tuple(round(2.0 * float(c)) for c in point)
+        if key not in index:
+            index[key] = len(vertices)
+            vertices.append(np.array(key, dtype=float) / 2.0)
+        return index[key]
+
+    for axis in range(3):
+        first, second = [k for k in range(3) if k != axis]
+        step = np.eye(3, dtype=int)[axis]
+        for cell in zip(*np.nonzero(grid)):
+            for sign in (1, -1):
+                neighbour = tuple(np.array(cell) + 1 + sign * step)
+                if padded[neighbour]:
+                    continue
+                base = np.array(cell, dtype=float)
+                base[axis] += 1.0 if sign > 0 else 0.0
+                corners = []
+                for a, b in ((0, 0), (1, 0), (1, 1), (0, 1)):
+                    corner = base.copy()
+                    corner[first] += a
+                    corner[second] += b
+                    corners.append(corner)
+                if np.cross(np.eye(3)[first], np.eye(3)[second])[axis] * sign < 0:  # counter-clockwise from outside
+                    corners.reverse()
+                centre = vertex(sum(corners) / 4.0)
+                ids = [vertex(c) for c in corners]
+                faces += [[ids[i], ids[(i + 1) % 4], centre] for i in range(4)]
+    return Shape(np.array(vertices) * size * u.km, np.array(faces, dtype=np.int64), name=name or "voxels")

@@ -13,27 +13,37 @@ import numpy as np
 from astropy import units as u
 
 from spinorbit.core.model.polyhedron import face_geometry
+from spinorbit.core.model.shadowing import shadow_geometry
 from spinorbit.core.model.thermal import pack_thermal, recoil_pressure
 from spinorbit.shape.mass import ShapeMassProperties
 from spinorbit.shape.mesh import Shape
 
-__all__ = ["thermal_block", "principal_facets", "DEFAULT_THERMAL_DEGREE"]
+__all__ = ["thermal_block", "principal_facets", "principal_vertices", "DEFAULT_THERMAL_DEGREE", "DEFAULT_SHADOW_SAMPLES"]
 
 #: Degree of the default representation: its spin-averaged torque's error against the facet sum and
 #: its cost per evaluation, degree by degree, are in docs/thermal.md (benchmarks/thermal_validation.py).
 DEFAULT_THERMAL_DEGREE = 8
+#: Sample points per facet edge of a shadowed fit (q² rays per facet and direction): the centroid
+#: alone (q = 1) decides a facet's shadow all or nothing; q = 2 halves that step at four times the rays.
+DEFAULT_SHADOW_SAMPLES = 2
 SECONDS_PER_DAY = 86400.0
 METRES_PER_KM = 1000.0
 
 
+def principal_vertices(shape: Shape, properties: ShapeMassProperties):
+    """Vertex positions (m) on the principal axes about the centre of mass."""
+    vertices = (shape.vertices_km - properties.center_of_mass.to_value(u.km)) @ properties.to_principal.T
+    return vertices * METRES_PER_KM
+
+
 def principal_facets(shape: Shape, properties: ShapeMassProperties):
     """Unit normals, areas (m²) and centroids (m) of the facets on the principal axes about the centre of mass."""
-    vertices = (shape.vertices_km - properties.center_of_mass.to_value(u.km)) @ properties.to_principal.T
-    normals, areas, centroids = face_geometry(vertices * METRES_PER_KM, shape.faces)
+    normals, areas, centroids = face_geometry(principal_vertices(shape, properties), shape.faces)
     return normals, areas, centroids
 
 
-def thermal_block(shape: Shape, properties: ShapeMassProperties, degree=DEFAULT_THERMAL_DEGREE, efficiency=1.0):
+def thermal_block(shape: Shape, properties: ShapeMassProperties, degree=DEFAULT_THERMAL_DEGREE, efficiency=1.0, *,
+                  self_shadowing=False, shadow_samples=DEFAULT_SHADOW_SAMPLES, shadow_grid=None):
     """The thermal block of a shape for ``make_model(..., thermal=block)`` in au, day and kg m².
 
     Parameters
@@ -46,6 +56,16 @@ def thermal_block(shape: Shape, properties: ShapeMassProperties, degree=DEFAULT_
     efficiency : float
         η of :func:`spinorbit.core.model.thermal.recoil_pressure` (1: everything re-emitted or
         scattered Lambertian).
+    self_shadowing : bool
+        Count only the lit share of each facet (:mod:`spinorbit.core.model.shadowing`); the shadows
+        are fitted into the representation once (an evaluation costs what one of the same degree with
+        odd degrees present costs; docs/thermal.md). A convex shape is
+        detected and gets the unshadowed block unchanged.
+    shadow_samples : int
+        q: q² shadow rays per facet and Sun direction (1: the centroid).
+    shadow_grid : int, optional
+        Latitudes of the fit's Sun-direction grid (default
+        :func:`spinorbit.core.model.thermal.default_shadow_grid`).
 
     Returns
     -------
@@ -54,6 +74,11 @@ def thermal_block(shape: Shape, properties: ShapeMassProperties, degree=DEFAULT_
     """
     if not 0.0 < efficiency <= 1.0:
         raise ValueError(f"efficiency: expected 0 < η ≤ 1 (the Lambertian share of the sunlight); got {efficiency!r}.")
-    normals, areas, centroids = principal_facets(shape, properties)
+    if not isinstance(self_shadowing, (bool, np.bool_)):
+        raise TypeError(f"self_shadowing: expected True or False; got {self_shadowing!r}.")
+    vertices = principal_vertices(shape, properties)
+    normals, areas, centroids = face_geometry(vertices, shape.faces)
+    shadowing = shadow_geometry(vertices, shape.faces, shadow_samples) if self_shadowing else None
     pressure_model = recoil_pressure(efficiency) * SECONDS_PER_DAY**2  # kg m⁻¹ s⁻² → kg m⁻¹ day⁻²
-    return pack_thermal(normals, areas, centroids, int(degree), pressure_model, 1.0)
+    return pack_thermal(normals, areas, centroids, int(degree), pressure_model, 1.0, shadowing=shadowing,
+                        shadow_grid=shadow_grid)

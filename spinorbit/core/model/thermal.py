@@ -10,7 +10,8 @@ recoil pressure (Φ₀ the solar flux at d₀)::
     F(ŝ, d) = −P(d) Σ_k A_k max(0, n_k·ŝ) n_k
     T(ŝ, d) = −P(d) Σ_k A_k max(0, n_k·ŝ) (r_k × n_k)
 
-No self-shadowing (exact for convex shapes); the incident momentum's own torque is left out, as in
+Without self-shadowing the sum is exact for convex shapes. With it (:mod:`spinorbit.core.model.shadowing`)
+each facet counts only its lit share; the incident momentum's own torque is left out, as in
 the YORP literature (it has no mean effect on a convex body, Rubincam 2000 §2). Zero conductivity
 makes the emission instantaneous, so the force has no diurnal lag: its Yarkovsky drift of the
 semi-major axis vanishes and finite conductivity (the linear theory) is needed for da/dt.
@@ -30,12 +31,21 @@ orbit-averaged torques, which YORP's evolution needs, are carried almost entirel
     block[base + TH_SUN_ROW]      absolute index of the Sun's perturber row in the model (−1: none)
     block[base + TH_PRESSURE]     P(d₀) in the caller's force / length² unit
     block[base + TH_DISTANCE]     d₀, the distance of P(d₀), in the model's length unit
+    block[base + TH_ALL_DEGREES]  1 when odd degrees ≥ 3 carry terms (a shadowed fit), 0 when they are zero
     block[base + TH_RECURRENCE …]      the Legendre recurrence coefficients (2l − 1)/(l − m), then (l + m − 1)/(l − m),
                                   (L + 1)² values each
     then, per harmonic, N_lm g_lm for the torque (3 values) and for the force (3 values), with
     N_lm the normalisation of Y_lm = N_lm P_lm(sin φ) (cos, sin) mλ
 
 Harmonics are indexed l² (order 0), l² + 2m − 1 (cos mλ) and l² + 2m (sin mλ), m = 1..l.
+
+**With self-shadowing** Funk–Hecke no longer applies: a facet's lit share depends on the whole
+surface. The coefficients are then the projections g_lm = ∫ T(ŝ) Y_lm(ŝ) dΩ of the shadowed facet
+sum, by a product rule over the Sun's directions (Gauss–Legendre in sin φ, equal steps in λ), and
+odd degrees no longer vanish. The shadows are baked in at this precompute; an evaluation's cost is
+that of a block of the same degree with all degrees present. A shadow's edge makes T(ŝ) kinked
+(its derivative jumps where a facet's lit share starts to fall), so the truncation error falls as a
+power of L, not geometrically (docs/thermal.md measures it).
 """
 
 import math
@@ -45,15 +55,17 @@ from numpy.polynomial import legendre
 
 from spinorbit.core.jit import jit
 from spinorbit.core.model.polyhedron import regular_solid_harmonics
+from spinorbit.core.model.shadowing import shadowed_recoil_sums
 
 __all__ = [
-    "TH_DEGREE", "TH_SUN_ROW", "TH_PRESSURE", "TH_DISTANCE", "TH_RECURRENCE", "MAX_THERMAL_DEGREE",
+    "TH_DEGREE", "TH_SUN_ROW", "TH_PRESSURE", "TH_DISTANCE", "TH_ALL_DEGREES", "TH_RECURRENCE", "MAX_THERMAL_DEGREE",
     "clamped_cosine_coefficient", "harmonic_count", "real_harmonics", "pack_thermal", "thermal_block_size",
-    "facet_force_torque", "thermal_force_torque_xyz", "recoil_pressure",
+    "facet_force_torque", "thermal_force_torque_xyz", "recoil_pressure", "sun_direction_grid",
+    "default_shadow_grid",
 ]
 
-TH_DEGREE, TH_SUN_ROW, TH_PRESSURE, TH_DISTANCE = 0, 1, 2, 3
-TH_RECURRENCE = 4
+TH_DEGREE, TH_SUN_ROW, TH_PRESSURE, TH_DISTANCE, TH_ALL_DEGREES = 0, 1, 2, 3, 4
+TH_RECURRENCE = 5
 #: Highest degree of the representation: P_LL grows like (2L − 1)!!, far from overflow at 40.
 MAX_THERMAL_DEGREE = 40
 #: Speed of light (m/s, exact, SI) and the nominal total solar irradiance at 1 au (W/m², IAU 2015
@@ -90,6 +102,40 @@ def thermal_block_size(degree_max):
     return TH_RECURRENCE + 8 * harmonic_count(degree_max)
 
 
+def default_shadow_grid(degree_max):
+    """Latitudes of the default Sun-direction grid of a shadowed fit of degree L: 2(L + 1), at least 8.
+
+    The product rule then integrates degree ≤ 4L + 3 exactly, more than the L + L a degree-L fit of a
+    degree-L field needs; the kinked shadowed torque's higher harmonics alias into the fit, but
+    doubling the grid again changed the fit's error by less than a tenth of the truncation error
+    (docs/thermal.md measures both).
+    """
+    return max(8, 2 * (int(degree_max) + 1))
+
+
+def sun_direction_grid(latitudes):
+    """Product rule on the sphere: Gauss–Legendre in sin φ (``latitudes`` nodes) × 2·latitudes equal steps in λ.
+
+    Returns
+    -------
+    directions : ndarray (2 n², 3)
+        Unit vectors.
+    weights : ndarray (2 n²,)
+        Quadrature weights summing to 4π; exact for spherical harmonics of degree ≤ 2n − 1 (Gauss–Legendre
+        integrates polynomials of degree 2n − 1 in sin φ, and 2n equal steps integrate cos mλ, sin mλ
+        exactly for m < 2n).
+    """
+    if not (isinstance(latitudes, (int, np.integer)) and latitudes >= 2):
+        raise ValueError(f"shadow_grid: expected an integer ≥ 2 (Gauss–Legendre latitudes); got {latitudes!r}.")
+    z, w = legendre.leggauss(int(latitudes))
+    longitudes = 2.0 * math.pi * np.arange(2 * latitudes) / (2 * latitudes)
+    rho = np.sqrt(1.0 - z * z)
+    directions = np.stack([np.outer(rho, np.cos(longitudes)), np.outer(rho, np.sin(longitudes)),
+                           np.outer(z, np.ones_like(longitudes))], axis=-1).reshape(-1, 3)
+    weights = np.outer(w, np.full(longitudes.size, 2.0 * math.pi / longitudes.size)).ravel()
+    return directions, weights
+
+
 def _norms(degree_max):
     out = np.empty(harmonic_count(degree_max))
     for n in range(degree_max + 1):
@@ -116,7 +162,8 @@ def real_harmonics(directions, degree_max):
     return out * norms
 
 
-def pack_thermal(normals, areas, centroids, degree_max, pressure, distance, sun_row=-1):
+def pack_thermal(normals, areas, centroids, degree_max, pressure, distance, sun_row=-1, *, shadowing=None,
+                 shadow_grid=None):
     """The thermal block of a shape: the compact representation of F(ŝ) and T(ŝ).
 
     Parameters
@@ -132,6 +179,14 @@ def pack_thermal(normals, areas, centroids, degree_max, pressure, distance, sun_
         d₀ (the model's length unit).
     sun_row : int
         Absolute index of the Sun's perturber row in the model array (set by ``make_model``).
+    shadowing : ShadowGeometry, optional
+        The same surface (:func:`spinorbit.core.model.shadowing.shadow_geometry`, vertices from the
+        centre of mass on the principal axes, length L): fit the shadowed sums over the Sun's
+        directions. A convex surface is never shadowed, and its block is the unshadowed one, bit
+        for bit.
+    shadow_grid : int, optional
+        Latitudes of the fit's direction grid (:func:`sun_direction_grid`); default
+        :func:`default_shadow_grid`.
 
     Returns
     -------
@@ -143,11 +198,23 @@ def pack_thermal(normals, areas, centroids, degree_max, pressure, distance, sun_
     if not (pressure > 0 and distance > 0 and math.isfinite(pressure) and math.isfinite(distance)):
         raise ValueError(f"pressure and distance: expected positive finite numbers; got {pressure!r}, {distance!r}.")
     count = harmonic_count(degree_max)
-    lam = np.empty(count)
-    for n in range(degree_max + 1):
-        lam[n * n:(n + 1) ** 2] = 0.0 if n >= 3 and n % 2 else clamped_cosine_coefficient(n)
-    weights = real_harmonics(normals, degree_max) * areas[:, None] * lam  # (m, count)
-    coefficients = np.concatenate([weights.T @ np.cross(centroids, normals), weights.T @ normals], axis=1)
+    if shadowing is not None and not shadowing.convex:
+        if shadowing.faces.shape[0] != np.asarray(areas).shape[0]:
+            raise ValueError(f"shadowing: expected the geometry of the same {np.asarray(areas).shape[0]} facets; got "
+                             f"{shadowing.faces.shape[0]}. Build it from the vertices the facets came from.")
+        directions, weights = sun_direction_grid(default_shadow_grid(degree_max) if shadow_grid is None
+                                                 else shadow_grid)
+        force, torque = shadowed_recoil_sums(shadowing, directions)
+        projector = real_harmonics(directions, degree_max) * weights[:, None]  # (k, count): ∫ · Y_lm dΩ
+        coefficients = np.concatenate([projector.T @ torque, projector.T @ force], axis=1)
+        all_degrees = 1.0
+    else:
+        lam = np.empty(count)
+        for n in range(degree_max + 1):
+            lam[n * n:(n + 1) ** 2] = 0.0 if n >= 3 and n % 2 else clamped_cosine_coefficient(n)
+        weights = real_harmonics(normals, degree_max) * areas[:, None] * lam  # (m, count)
+        coefficients = np.concatenate([weights.T @ np.cross(centroids, normals), weights.T @ normals], axis=1)
+        all_degrees = 0.0
     coefficients *= _norms(degree_max)[:, None]  # the kernel sums unnormalised harmonics
     rec_a, rec_b = np.zeros(count), np.zeros(count)
     for n in range(1, degree_max + 1):
@@ -155,7 +222,7 @@ def pack_thermal(normals, areas, centroids, degree_max, pressure, distance, sun_
             k = n * n + 2 * m - 1 if m > 0 else n * n
             rec_a[k] = (2.0 * n - 1.0) / (n - m)
             rec_b[k] = (n + m - 1.0) / (n - m)
-    header = np.array([float(degree_max), float(sun_row), float(pressure), float(distance)])
+    header = np.array([float(degree_max), float(sun_row), float(pressure), float(distance), all_degrees])
     return np.concatenate([header, rec_a, rec_b, coefficients.ravel()])
 
 
@@ -179,9 +246,11 @@ def thermal_force_torque_xyz(sx, sy, sz, distance, block, base):
     (sx, sy, sz) need not be unit; ``distance`` is the heliocentric distance in the block's d₀ unit.
     Allocation-free: the unnormalised harmonics are generated order by order with the Legendre
     recurrences (their coefficients precomputed in the block, the normalisation folded into the
-    torque and force coefficients) and summed on the fly; odd degrees ≥ 3 carry no term (λ_l = 0).
+    torque and force coefficients) and summed on the fly; odd degrees ≥ 3 carry no term (λ_l = 0)
+    unless the block is a shadowed fit (``TH_ALL_DEGREES``).
     """
     degree_max = int(block[base + TH_DEGREE])
+    odd_degrees = block[base + TH_ALL_DEGREES] != 0.0
     count = (degree_max + 1) * (degree_max + 1)
     rec_a = base + TH_RECURRENCE
     rec_b = rec_a + count
@@ -201,7 +270,7 @@ def thermal_force_torque_xyz(sx, sy, sz, distance, block, base):
             if n > m:
                 a, b = block[rec_a + k] * z, block[rec_b + k]
                 prev_re, prev_im, cur_re, cur_im = cur_re, cur_im, a * cur_re - b * prev_re, a * cur_im - b * prev_im
-            if n >= 3 and n % 2 == 1:
+            if n >= 3 and n % 2 == 1 and not odd_degrees:
                 continue
             for part in range(2 if m > 0 else 1):  # cos mλ, then sin mλ (the next harmonic's row)
                 value = cur_re if part == 0 else cur_im

@@ -21,7 +21,7 @@ from astropy import units as u
 
 from spinorbit.scene.errors import SceneError
 
-__all__ = ["ThermalModel", "ThermalInputError", "DEFAULT_K3_SQUARED", "validate_thermal"]
+__all__ = ["ThermalModel", "ThermalInputError", "DEFAULT_K3_SQUARED", "MOMENT_RTOL", "validate_thermal"]
 
 #: Burns & Safronov's (1973) shape factor K₃² ≈ 0.01 for a moderately elongated body, the value
 #: Harris (1994) uses for the damping time scales of tumbling asteroids.

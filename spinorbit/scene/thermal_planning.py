@@ -22,7 +22,7 @@ parts (rad; the direction of L as an angle, Z and S relative to Z):
   the torus, bounded: (|T|max + |N|max)/(Z ν), ν the slowest free-motion frequency.
 - ``averaging``: the first-order theory's error of the secular change, :data:`MEAN_CHANGE_ERROR` ×
   the change over the span estimated from the initial rates (docs/thermal.md's table).
-- ``integration``: a posteriori, the run against one at twice its step.
+- ``integration``: a posteriori, the run against one at half its step.
 
 ``auto`` takes the mean route when it is cheaper (right-hand sides counted for both and priced at
 their measured CPU times, :data:`FULL_RHS_SECONDS`, :data:`MEAN_RHS_SECONDS`) and
@@ -265,7 +265,7 @@ def plan_thermal(scene, skip=True):
         step = min(max(MEAN_STEP_SHARE * evolution, setup.period_orbit), span)
         intervals = np.diff(np.concatenate([[setup.t0], scene.output_days]))
         mean_steps = int(np.sum(np.ceil(intervals / step - 1e-9)))  # each output is landed on
-        check_steps = int(np.sum(np.ceil(intervals / (2.0 * step) - 1e-9)))  # the check at twice the step
+        check_steps = int(np.sum(np.ceil(intervals / (0.5 * step) - 1e-9)))  # the check at half the step
         grid = THERMAL_POINTS_S * THERMAL_POINTS_Z * THERMAL_POINTS_ORBIT
         mean_rhs = float(mean_steps + check_steps) * STAGES * grid
         short_orbit = orbit_short_period(setup)
@@ -340,7 +340,7 @@ def plan_thermal(scene, skip=True):
     n_s, n_z, n_orbit = mean_info["n_grid"]
     decisions.append(Decision(
         "integrator", f"mean DOP853, fixed step {_years(mean_info['step'])} ({mean_info['steps']} steps; checked "
-        f"against twice the step), grid {n_s} × {n_z} × {n_orbit}, gravity's mean precession"
+        f"against half the step), grid {n_s} × {n_z} × {n_orbit}, gravity's mean precession"
         + (", nutation damping" if setup.damping else ""),
         f"step = {MEAN_STEP_SHARE:g} × the evolution time (at least one orbit); the grid converges geometrically "
         "(tests/test_thermal_mean.py)"))

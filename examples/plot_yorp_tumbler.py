@@ -64,17 +64,17 @@ for label, thermal in models.items():
         print(plan)  # why the mean route, with the costs of both
     result = scene.run()
     tables[label] = table = result.table
-    z0 = state.angular_momentum.to_value(u.kg * u.m**2 / u.day)
+    z0 = state.angular_momentum.to_value(u.kg * u.m**2 * u.rad / u.day)
     print(f"{label}: route {plan.route}, {result.stats['steps']} mean steps, {result.wall_seconds:.1f} s; "
           f"Z/Z0 {table['Z'][-1].value / np.linalg.norm(z0):.3f}, obliquity → {table['obliquity'][-1]:.1f}, "
           f"S/Z → {(table['S'][-1] / table['Z'][-1]).value:.4f}, mode {table['mode'][-1]}; error estimate "
-          f"{result.error_estimate.to(u.deg):.3f} ({', '.join(f'{k} {v.to(u.deg):.2g}' for k, v in result.error_parts.items() if v)})")
+          f"{result.error_estimate.to(u.deg):.3f} ({', '.join(f'{k} {v.to(u.deg):.2g}' for k, v in result.error_parts.items() if v.value)})")
 
 # %%
 # The mean evolution
 # ------------------
 figure, axes = plt.subplots(4, 1, figsize=(8, 10), sharex=True, layout="constrained")
-z0 = np.linalg.norm(state.angular_momentum.to_value(u.kg * u.m**2 / u.day))
+z0 = np.linalg.norm(state.angular_momentum.to_value(u.kg * u.m**2 * u.rad / u.day))
 for label, table in tables.items():
     kyr = (table["time"] - epoch).to_value(u.yr) / 1e3
     axes[0].plot(kyr, table["Z"].value / z0, label=label)

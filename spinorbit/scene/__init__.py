@@ -19,6 +19,9 @@ One module per concept:
 - :mod:`~spinorbit.scene.routes` — the runners of the torque-free, one-way and coupled routes;
 - :mod:`~spinorbit.scene.epochs` — output times before the epoch: the backward leg in mirrored time;
 - :mod:`~spinorbit.scene.many` — several bodies (:class:`ScenePlans`, :class:`SceneResults`);
+- :mod:`~spinorbit.scene.thermal` — :class:`ThermalModel`: the body feels sunlight (recoil, damping);
+- :mod:`~spinorbit.scene.thermal_planning` — full or mean YORP, and why;
+- :mod:`~spinorbit.scene.thermal_routes` — the runners of those two routes;
 - :mod:`~spinorbit.scene.scene` — :class:`Scene` and :class:`SceneResult`.
 """
 
@@ -33,6 +36,8 @@ from spinorbit.scene.orbit import ApproachError
 from spinorbit.scene.many import ScenePlans, SceneResults
 from spinorbit.scene.plan import Decision, PerturberEstimate, Plan, PlanError
 from spinorbit.scene.scene import Scene, SceneResult
+from spinorbit.scene.thermal import ThermalInputError, ThermalModel
+from spinorbit.scene.thermal_planning import SeparatrixCrossingError
 
 __all__ = [
     "QUANTITIES",
@@ -49,6 +54,9 @@ __all__ = [
     "ScenePlans",
     "SceneResult",
     "SceneResults",
+    "SeparatrixCrossingError",
+    "ThermalInputError",
+    "ThermalModel",
 ]
 
 

@@ -239,7 +239,7 @@ def resolve_perturbers(orbit, names):
 
 def gm_in_orbit_model(orbit):
     """The body's G·M (au³/day²) in the orbit model: 0 for a test particle or a given ephemeris."""
-    if orbit is None or orbit.kind == "ephemeris":
+    if orbit is None or orbit.kind in ("ephemeris", "kepler"):
         return 0.0
     if orbit.kind == "rebound":
         from spinorbit.coupling.rebound import body_index

@@ -90,6 +90,8 @@ class Orbit:
     description: str = ""
     #: Built here among DE421's planets: runs stay inside DE421's span (:meth:`check_span`).
     de421_planets: bool = False
+    #: Of kind "kepler": the heliocentric ellipse as ICRF elements (a au, e, i, Ω, ω, M rad, epoch TDB day).
+    kepler: tuple | None = None
 
     @classmethod
     def de421(cls, name):
@@ -125,6 +127,68 @@ class Orbit:
             return r * np.stack([c, s, zero], axis=1), r * n * np.stack([-s, c, zero], axis=1)
 
         return cls("ephemeris", str(name), function=orbit)
+
+    @classmethod
+    def kepler(cls, a, e, inc, raan, argp, mean_anomaly, epoch, frame="ecliptic", name="body"):
+        """A fixed heliocentric Kepler ellipse: the Sun alone, exact at any time (thermal scenes over 10⁶ yr).
+
+        The elements and frames are those of :meth:`from_elements`, but nothing is integrated: the Sun
+        moves on the two-body ellipse of DE421's GM_Sun relative to the body, with no planets and no
+        limit of span. It is the orbit a mean YORP run averages over
+        (:func:`spinorbit.core.averaging.thermal_mean.propagate_mean_thermal`), and the full route
+        integrates under the same analytic Sun (:mod:`spinorbit.scene.thermal_planning`).
+
+        Raises
+        ------
+        spinorbit.orbital_elements.OrbitElementsError
+            Elements out of range (e ≥ 1, a ≤ 0, an angle outside its range) or an unknown frame.
+        SceneError
+            An epoch that is not a scalar Time.
+        """
+        from spinorbit.orbital_elements import check_elements, frame_to_icrf_matrix
+
+        a_km, e, inc, raan, argp, mean_anomaly = check_elements(a, e, inc, raan, argp, mean_anomaly)
+        epoch_day = _scalar_time("epoch", epoch)
+        # The perifocal axes P, Q, W in ICRF, then the ICRF angles the core's Kepler source takes.
+        cos_o, sin_o, cos_i, sin_i, cos_w, sin_w = (math.cos(raan), math.sin(raan), math.cos(inc), math.sin(inc),
+                                                    math.cos(argp), math.sin(argp))
+        p = np.array([cos_o * cos_w - sin_o * sin_w * cos_i, sin_o * cos_w + cos_o * sin_w * cos_i, sin_w * sin_i])
+        w = np.array([sin_o * sin_i, -cos_o * sin_i, cos_i])
+        to_icrf = frame_to_icrf_matrix(frame)
+        p, w = to_icrf @ p, to_icrf @ w
+        inc_icrf = math.acos(max(-1.0, min(1.0, float(w[2]))))
+        if math.hypot(w[0], w[1]) > 1e-15:
+            node = math.atan2(w[0], -w[1])
+            n_vec = np.array([math.cos(node), math.sin(node), 0.0])
+            argp_icrf = math.atan2(float(np.cross(n_vec, p) @ w), float(p @ n_vec))
+        else:  # an orbit in the ICRF equator: the node is undefined, take Ω = 0
+            node, argp_icrf = 0.0, math.atan2(p[1], p[0]) * (1.0 if w[2] > 0 else -1.0)
+        au_km = float((1 * u.au).to_value(u.km))
+        description = (f"heliocentric Kepler ellipse a = {a:.6g}, e = {e:.6g}, i = {math.degrees(inc):.6g} deg "
+                       f"({frame}) at {epoch.tdb.iso} TDB, the Sun alone, no planets")
+        return cls("kepler", str(name), description=description,
+                   kepler=(a_km / au_km, e, inc_icrf, node % (2 * math.pi), argp_icrf, mean_anomaly, epoch_day))
+
+    def kepler_sun(self):
+        """The core Kepler source of the Sun relative to the body (au, day; :func:`~spinorbit.core.model.perturbers.kepler_source`)."""
+        from spinorbit.core.model.perturbers import kepler_source
+        from spinorbit.ephemeris import de421_constants
+
+        if self.kind != "kepler":
+            raise SceneError(f"kepler_sun needs an Orbit.kepler; this orbit is of kind {self.kind!r}.")
+        a, e, inc, node, argp, mean_anomaly, epoch_day = self.kepler
+        return kepler_source(de421_constants().gm["sun"], a, e, inc, node, argp, mean_anomaly, epoch=epoch_day,
+                             sign=-1.0)
+
+    def kepler_frame(self):
+        """Inertial (ICRF) → orbit frame (P, Q, W) of an Orbit.kepler: W, the orbit normal, is its z."""
+        _, _, inc, node, argp, _, _ = self.kepler
+        cos_o, sin_o, cos_i, sin_i, cos_w, sin_w = (math.cos(node), math.sin(node), math.cos(inc), math.sin(inc),
+                                                    math.cos(argp), math.sin(argp))
+        p = [cos_o * cos_w - sin_o * sin_w * cos_i, sin_o * cos_w + cos_o * sin_w * cos_i, sin_w * sin_i]
+        q = [-cos_o * sin_w - sin_o * cos_w * cos_i, -sin_o * sin_w + cos_o * cos_w * cos_i, cos_w * sin_i]
+        w = [sin_o * sin_i, -cos_o * sin_i, cos_i]
+        return np.array([p, q, w])
 
     @classmethod
     def rebound(cls, simulation, particle):

@@ -60,9 +60,11 @@ class Plan:
 
     Attributes
     ----------
-    route : {"torque-free", "one-way", "coupled"}
-        Exact free motion (no integration), the one-way integration under the kept perturbers, or the
-        fully coupled REBOUND run (BS, :class:`~spinorbit.coupling.rigid_body.CoupledRigidBody`).
+    route : {"torque-free", "one-way", "coupled", "thermal-full", "thermal-mean"}
+        Exact free motion (no integration), the one-way integration under the kept perturbers, the
+        fully coupled REBOUND run (BS, :class:`~spinorbit.coupling.rigid_body.CoupledRigidBody`), or,
+        for a body that feels sunlight, the full integration or the mean YORP run
+        (:mod:`spinorbit.scene.thermal_planning`).
     orbit_source : {"none", "de421", "ephemeris", "rebound"}
         Where the positions come from: none needed, DE421, a user ephemeris, a REBOUND (N-body) run.
     kept, dropped : tuple of str
@@ -109,6 +111,9 @@ class Plan:
     samples: object = field(default=None, repr=False)
     back_reaction_rad: float = 0.0
     back_reaction_bound_rad: float | None = None
+    #: For the "thermal-full" and "thermal-mean" routes: the core set-up and the mean route's estimates
+    #: (:mod:`spinorbit.scene.thermal_planning`).
+    thermal: object = field(default=None, repr=False)
 
     @property
     def integration_share_rad(self):

@@ -159,6 +159,14 @@ class Scene:
         perturbers' knots are few against the rotation's own steps).
     sample_tolerance : float
         Relative interpolation error of the sampled perturbers in the run.
+    thermal : spinorbit.scene.ThermalModel, optional
+        The body feels sunlight: Rubincam's recoil of its shape (and nutation damping if the model
+        has μQ). Needs ``orbit=Orbit.kepler(...)`` and output times after the epoch; the body's
+        moments must be its shape's (``rigid_body_from_shape``). Planned by
+        :mod:`spinorbit.scene.thermal_planning` (docs/thermal.md).
+    thermal_route : {"auto", "full", "mean"}
+        "auto" lets the planner choose between the full integration and the mean YORP run; the
+        others force one.
 
     Raises
     ------
@@ -167,21 +175,27 @@ class Scene:
     """
 
     def __init__(self, state, epoch, times, perturbers=(), orbit=None, tolerance=1 * u.arcsec,
-                 quantities=QUANTITIES, integrator="auto", sample_tolerance=1e-10):
+                 quantities=QUANTITIES, integrator="auto", sample_tolerance=1e-10, thermal=None,
+                 thermal_route="auto"):
         self.members, self._cache = None, None  # _cache: the SharedSamples of the plan() / run() under way
         self._report_planning = None  # plan()'s progress callback while it plans
+        self.thermal, self.thermal_route = thermal, thermal_route
         if isinstance(state, (list, tuple, dict)):
             from spinorbit.scene import many
 
             def make(member_state, member_orbit):
                 return Scene(member_state, epoch, times, perturbers, member_orbit, tolerance, quantities, integrator,
-                             sample_tolerance)
+                             sample_tolerance, thermal, thermal_route)
 
             self.members = many.members(state, orbit, make)
             self.epoch, self.times, self.tolerance_rad, self.output_days, self.epoch_day = (
                 many.common_times(self.members))
             return
         self.state = inputs.validate_state(state)
+        if thermal is not None or (orbit is not None and getattr(orbit, "kind", None) == "kepler"):
+            from spinorbit.scene.thermal import validate_thermal
+
+            validate_thermal(self.state, thermal, thermal_route, orbit, perturbers, epoch, times)
         self.epoch_day, self.output_days, self.end_only = inputs.validate_times(epoch, times, either_side=True)
         self.epoch, self.times = epoch, times
         self.tolerance_rad, self.quantities = inputs.validate_options(tolerance, quantities, integrator,
@@ -291,7 +305,11 @@ class Scene:
         report(0.0)
         self._report_planning = report
         try:
-            if self.in_legs:
+            if self.thermal is not None:
+                from spinorbit.scene.thermal_planning import plan_thermal
+
+                plan = plan_thermal(self, skip)
+            elif self.in_legs:
                 from spinorbit.scene.epochs import plan_legs
 
                 plan = plan_legs(self, skip)
@@ -343,7 +361,12 @@ class Scene:
             raise SceneError(f"plan expects a spinorbit.scene.Plan from Scene.plan(); got {type(plan).__name__}.")
         report = progress or (lambda fraction: None)
         report(0.0)
-        if plan.route == "torque-free":
+        if plan.route in ("thermal-full", "thermal-mean"):
+            from spinorbit.scene.thermal_routes import run_thermal_full, run_thermal_mean
+
+            runner = run_thermal_full if plan.route == "thermal-full" else run_thermal_mean
+            table, parts, stats = runner(self, plan, report)
+        elif plan.route == "torque-free":
             table, parts, stats = run_torque_free(self, plan)
         elif plan.route == "coupled":
             table, parts, stats = run_coupled(self, plan, report)

@@ -178,6 +178,13 @@ def _slow_kernel(el0, t0, t_out, step, model, recoil_model, frame, n_s, n_z, n_o
             remaining = abs(target - t)
             h = landing_step(step, remaining)
             dop853_step(_slow_rhs, params, t, y, direction * h, k, tmp, y_new)
+            if recoil_model[FIG_THERMAL] > 0.0:
+                # A step may jump across the separatrix band (SAM ↔ LAM) without starting inside it:
+                # its rates came from one side's torus, so it is not taken.
+                before = motion_from_elements(abs(y[EL_S]), y[EL_Z], ic)[MO_MODE]
+                after = motion_from_elements(abs(y_new[EL_S]), y_new[EL_Z], ic)[MO_MODE]
+                if after != before:
+                    return i, t, steps
             t = target if h == remaining else t + direction * h
             for c in range(6):
                 y[c] = y_new[c]
@@ -223,7 +230,8 @@ def propagate_mean_thermal(el0, t0, t_out, model, frame, step, n_s=THERMAL_POINT
     Raises
     ------
     SeparatrixReachedError
-        The motion reached the separatrix (1 − m below MIN_SEPARATRIX_DISTANCE) before the last output.
+        The motion reached the separatrix (1 − m below MIN_SEPARATRIX_DISTANCE) before the last output,
+        or a step would jump across it (its end in the other rotation mode).
     ValueError
         A model without a thermal block or without the Sun on a Kepler orbit, bad elements or step.
     """
@@ -250,7 +258,8 @@ def propagate_mean_thermal(el0, t0, t_out, model, frame, step, n_s=THERMAL_POINT
     if written < t_out.size:
         raise SeparatrixReachedError(
             f"propagate_mean_thermal: at t = {t_stop!r} the mean motion is within 1 − m < {MIN_SEPARATRIX_DISTANCE:g} "
-            "of the separatrix (or a permanent rotation), where the torus average is undefined; the "
+            "of the separatrix (or a permanent rotation), or the next step would cross it, where the torus "
+            "average is undefined; the "
             f"{written} outputs before it are in the error's .times and .elements. Continue across it with a "
             "full integrator (integrate_quaternion) and restart the mean run on the other side.",
             t_out[:written].copy(), out[:written].copy(), float(t_stop))

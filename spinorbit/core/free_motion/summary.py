@@ -35,8 +35,8 @@ from spinorbit.core.elements.canonical import (
     inertia_constants,
     motion_from_momentum,
 )
-from spinorbit.core.free_motion.flow_constants import complete_k_pi_dd
 from spinorbit.core.jit import jit
+from spinorbit.core.math.elliptic_integrals import complete_k_pi
 
 #: Mode code of a motion on the separatrix (SAM formulas at 1 − m = 0 exactly), next to
 #: ``canonical.MODE_SAM``, ``MODE_LAM`` and ``MODE_UNIFORM`` (permanent rotation).
@@ -89,10 +89,9 @@ def polhode_rates(mo, big_c):
     ⟨ġ⟩ = c G + PN_COEFF · Π(n|p)/K(p) · ν is the Andoyer g's rate (C-axis reference, paper eq. 7)
     averaged over that period.
     """
-    # K(p) and Π(n|p) (n ≤ 0 in both modes) from one AGM (DLMF 19.8.5–8), rounded once from double-double,
-    # instead of a second AGM for K and Carlson's R_F and R_J for Π (a third of the cost)
-    kh, kl, pih, pil = complete_k_pi_dd(-mo[MO_PN_N], 0.0, mo[MO_PARAM_C], 0.0)
-    quarter, complete_pi = kh + kl, pih + pil
+    # K(p) and Π(n|p) (n ≤ 0 in both modes) from one AGM in doubles (DLMF 19.8.5–8), instead of a
+    # double-double AGM for K and Carlson's R_F and R_J for Π: the periods are doubles (a few ε)
+    quarter, complete_pi = complete_k_pi(-mo[MO_PN_N], mo[MO_PARAM_C])
     nu = mo[MO_ARG_PER_S] * mo[MO_S_RATE]
     return 4.0 * quarter / nu, mo[MO_G] / big_c + mo[MO_PN_COEFF] * complete_pi / quarter * nu
 

@@ -24,7 +24,7 @@ from spinorbit.core.free_motion.flow_constants import (
     complete_k_pi_dd,
     flow_constants,
 )
-from spinorbit.core.math.elliptic_integrals import NK_N
+from spinorbit.core.math.elliptic_integrals import NK_N, complete_k_pi
 from spinorbit.core.math.elliptic_periods import MK_K_HI, MK_M
 from spinorbit.core.math.pn_fourier import FOURIER_MAX_TERMS, FOURIER_RHO_MAX, FOURIER_TAIL, pn_fourier_ratio
 from spinorbit.core.math.rotations import quat_to_attitude
@@ -105,6 +105,23 @@ def test_complete_integrals_double_double_match_mpmath(mc, f):
         k_ref, pi_ref = mp.ellipk(1 - mc_mp), mp.ellippi(-f_mp, 1 - mc_mp)
         assert abs((mp.mpf(k_hi) + k_lo - k_ref) / k_ref) < AGM_TOLERANCE
         assert abs((mp.mpf(pi_hi) + pi_lo - pi_ref) / pi_ref) < AGM_TOLERANCE
+
+
+# The double AGM of the periods (elliptic_integrals.complete_k_pi): measured ≤ 1.6 ε (K) and ≤ 5.5 ε (Π)
+# on 400 random (m_c ∈ [1e-12, 1], f ∈ [1e-8, 1e6]); 8 ε leaves room for the cases below.
+DOUBLE_AGM_TOLERANCE = 8 * 2.0**-52
+
+
+@pytest.mark.parametrize("mc", ["1", "0.5", "1e-3", "1e-8", "1e-16", "0.999999"])
+@pytest.mark.parametrize("f", ["0", "1e-12", "0.3", "7.5", "1e3", "1e9", "1e30"])
+def test_complete_integrals_double_match_mpmath(mc, f):
+    with mp.workdps(50):
+        mc_value, f_value = float(mc), float(f)
+        k, pi = complete_k_pi(f_value, mc_value)
+        k_ref = mp.ellipk(1 - mp.mpf(mc_value))
+        pi_ref = mp.ellippi(-mp.mpf(f_value), 1 - mp.mpf(mc_value))
+        assert abs((k - k_ref) / k_ref) < DOUBLE_AGM_TOLERANCE
+        assert abs((pi - pi_ref) / pi_ref) < DOUBLE_AGM_TOLERANCE
 
 
 # --------------------------------------------------------------------------------------------------

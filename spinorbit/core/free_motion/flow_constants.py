@@ -21,11 +21,10 @@ from spinorbit.core.elements.canonical import (
     amplitude_from_momentum,
     body_from_argument,
     elliptic_constants,
-    flip_attitude,
     flip_signs,
     inertia_constants,
     motion_from_momentum,
-    node_angles,
+    node_angles_of,
 )
 from spinorbit.core.jit import jit
 from spinorbit.core.math.ddouble import (
@@ -59,7 +58,7 @@ from spinorbit.core.math.elliptic_periods import (
 )
 from spinorbit.core.math.jacobi import sncndn_reduced
 from spinorbit.core.math.pn_fourier import FOURIER_MAX_TERMS, pn_fourier_coefficients, sine_series
-from spinorbit.core.math.rotations import matrix_to_quat, quat_to_attitude
+from spinorbit.core.math.rotations import matrix_to_quat, quat_to_matrix
 
 # The double-double AGM for K and Π stops when both the AGM gap and the last term of the Π series
 # are below this fraction of the result: the double-double unit roundoff is 2^-106 ≈ 1.2e-32.
@@ -318,11 +317,16 @@ def flow_constants(quaternion, momentum, big_a, big_b, big_c):
     else:  # the separatrix: the kernels' closed forms, from the motion constants
         mk, pk = elliptic_constants(mo)
         periodic = False
-    working = flip_attitude(quat_to_attitude(quaternion), flip)
+    # the working attitude diag(flip) · M(q)ᵀ as a view of M(q) with its columns signed (one array,
+    # not three: per-state allocations were a third of the set-up)
+    matrix = quat_to_matrix(quaternion)
+    matrix[:, 0] *= fx
+    matrix[:, 1] *= fy
+    matrix[:, 2] *= fz
     arg0 = ellipf_k(amplitude_from_momentum(mx, my, mz, mo, ic), mk)
     _, _, _, sin_l, cos_l = body_from_argument(arg0, mo, mk)
-    _, cos_i, sin_i, h, g0 = node_angles(working, np.array([mx, my, mz]), sin_l, cos_l)
-    qn = matrix_to_quat(node_frame(cos_i, sin_i, h).T.copy())
+    _, cos_i, sin_i, h, g0 = node_angles_of(matrix.T, mx, my, mz, sin_l, cos_l)
+    qn = matrix_to_quat(node_frame(cos_i, sin_i, h).T)
     flow[FL_QN_W], flow[FL_QN_X], flow[FL_QN_Y], flow[FL_QN_Z] = qn[0], qn[1], qn[2], qn[3]
     flow[FL_ARG0] = arg0
     flow[FL_PERIODIC] = 1.0 if periodic else 0.0

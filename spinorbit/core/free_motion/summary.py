@@ -36,8 +36,7 @@ from spinorbit.core.elements.canonical import (
     motion_from_momentum,
 )
 from spinorbit.core.jit import jit
-from spinorbit.core.math.elliptic_integrals import NK_COMPLETE, characteristic_constants
-from spinorbit.core.math.elliptic_periods import ellipk
+from spinorbit.core.math.elliptic_integrals import complete_k_pi
 
 #: Mode code of a motion on the separatrix (SAM formulas at 1 − m = 0 exactly), next to
 #: ``canonical.MODE_SAM``, ``MODE_LAM`` and ``MODE_UNIFORM`` (permanent rotation).
@@ -90,9 +89,9 @@ def polhode_rates(mo, big_c):
     ⟨ġ⟩ = c G + PN_COEFF · Π(n|p)/K(p) · ν is the Andoyer g's rate (C-axis reference, paper eq. 7)
     averaged over that period.
     """
-    param, param_c = mo[MO_PARAM], mo[MO_PARAM_C]
-    quarter = ellipk(param, param_c)
-    complete_pi = characteristic_constants(mo[MO_PN_N], param, param_c)[NK_COMPLETE]
+    # K(p) and Π(n|p) (n ≤ 0 in both modes) from one AGM in doubles (DLMF 19.8.5–8), instead of a
+    # double-double AGM for K and Carlson's R_F and R_J for Π: the periods are doubles (a few ε)
+    quarter, complete_pi = complete_k_pi(-mo[MO_PN_N], mo[MO_PARAM_C])
     nu = mo[MO_ARG_PER_S] * mo[MO_S_RATE]
     return 4.0 * quarter / nu, mo[MO_G] / big_c + mo[MO_PN_COEFF] * complete_pi / quarter * nu
 

@@ -264,3 +264,58 @@ def pn_k(u, mk, pk):
 def pn(u, n, m, mc):
     """pn(u, n | m) (computes the constants; use pn_k in loops)."""
     return pn_k(u, parameter_constants(m, mc), pn_constants(n, m, mc))
+
+
+# The double AGM below stops once a − g ≤ this fraction of a (the next gap, ≈ (a − g)²/(8a), is then
+# below 1e-31 of a) and the last Π term is below ε/2 of the sum.
+AGM_GAP_DOUBLE = 1e-15
+AGM_TERM_DOUBLE = 1.1e-16
+# f = −n up to 1e30 needs ≈ 50 halvings of p_k before the quadratic phase; 200 is never reached.
+AGM_MAX_STEPS_DOUBLE = 200
+
+
+@jit
+def complete_k_pi(f, mc):
+    """K(m) and Π(n | m) for n = −f ≤ 0, 0 < mc = 1 − m ≤ 1, in double precision from one AGM.
+
+    The algorithm of :func:`spinorbit.core.free_motion.flow_constants.complete_k_pi_dd` (DLMF 19.8.5,
+    19.8.6–8, written as sums of positive terms so nothing cancels for f → ∞), in doubles: for callers
+    that need the two complete integrals as doubles (the periods of :mod:`spinorbit.core.free_motion.summary`),
+    at a fraction of the double-double's cost and of Carlson's R_F and R_J. Relative error a few ε
+    (``tests/test_torque_free.py`` checks it against mpmath).
+
+    Parameters
+    ----------
+    f : float
+        −n ≥ 0 (dimensionless).
+    mc : float
+        Complementary parameter 1 − m, 0 < mc ≤ 1.
+
+    Returns
+    -------
+    k, pi : float
+        K(m) and Π(n | m).
+    """
+    a = 1.0
+    g = math.sqrt(mc)
+    one_f = 1.0 + f
+    p = math.sqrt(one_f)
+    prod = 1.0  # Π_{i<k} ε_i = 1 − D_k
+    d = 0.0  # D_k
+    t = 0.0  # partial sum of T = Σ 2^-k D_k
+    weight = 1.0
+    for _ in range(AGM_MAX_STEPS_DOUBLE):
+        ag = a * g
+        p2 = p * p
+        den = p2 + ag
+        d += (2.0 * ag / den) * prod
+        prod *= (p2 - ag) / den
+        weight *= 0.5
+        t += weight * d
+        p = den / (2.0 * p)
+        a, g = 0.5 * (a + g), math.sqrt(ag)
+        if prod * weight <= AGM_TERM_DOUBLE * t and a - g <= AGM_GAP_DOUBLE * a:
+            break
+    t += weight
+    k = math.pi / (a + g)
+    return k, 0.5 * k * (2.0 + f * t) / one_f

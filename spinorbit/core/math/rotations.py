@@ -114,7 +114,11 @@ def matrix_to_quat(m):
         q[1] = (m[0, 2] + m[2, 0]) / z4
         q[2] = (m[1, 2] + m[2, 1]) / z4
         q[3] = 0.25 * z4
-    return quat_normalize(q)
+    # q / |q| in place (quat_normalize's arithmetic without its second array)
+    norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    for k in range(4):
+        q[k] /= norm
+    return q
 
 
 @jit

@@ -121,11 +121,12 @@ def pn_fourier_coefficients(f, m, k_quarter, one_minus_ratio, scale, out):
     q = nome(m, k_quarter)
     sigma = q * q / rho
     q2 = q * q
-    # N from ρ^N ≤ FOURIER_TAIL (ρ ≤ FOURIER_RHO_MAX keeps N ≤ FOURIER_MAX_TERMS)
-    terms = min(FOURIER_MAX_TERMS, max(1, math.ceil(math.log(FOURIER_TAIL) / math.log(rho))))
+    # N: the first with ρ^N ≤ FOURIER_TAIL, found by the loop that forms ρ^k anyway (no log, no
+    # division; ρ ≤ FOURIER_RHO_MAX keeps N ≤ FOURIER_MAX_TERMS)
     rho_k, sigma_k, q2_k = 1.0, 1.0, 1.0
     slope = 0.0  # Σ k c_k / C
-    for k in range(terms):
+    terms = FOURIER_MAX_TERMS
+    for k in range(FOURIER_MAX_TERMS):
         rho_k *= rho
         sigma_k *= sigma
         b = rho_k - sigma_k
@@ -134,6 +135,9 @@ def pn_fourier_coefficients(f, m, k_quarter, one_minus_ratio, scale, out):
             b /= 1.0 - q2_k
         out[k] = b * _RECIPROCALS[k]
         slope += b
+        if rho_k <= FOURIER_TAIL:
+            terms = k + 1
+            break
     norm = scale * one_minus_ratio * k_quarter / (math.pi * slope)
     for k in range(terms):
         out[k] *= norm

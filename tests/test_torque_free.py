@@ -26,7 +26,15 @@ from spinorbit.core.free_motion.flow_constants import (
 )
 from spinorbit.core.math.elliptic_integrals import NK_N, complete_k_pi
 from spinorbit.core.math.elliptic_periods import MK_K_HI, MK_M
-from spinorbit.core.math.pn_fourier import FOURIER_MAX_TERMS, FOURIER_RHO_MAX, FOURIER_TAIL, pn_fourier_ratio
+from spinorbit.core.math.elliptic_periods import ellipk
+from spinorbit.core.math.pn_fourier import (
+    FOURIER_MAX_TERMS,
+    FOURIER_RHO_MAX,
+    FOURIER_TAIL,
+    NOME_LAMBDA_MAX,
+    nome,
+    pn_fourier_ratio,
+)
 from spinorbit.core.math.rotations import quat_to_attitude
 
 # Goal of the long-span work: attitude error after 1e4 rotation periods (rad). Measured against
@@ -381,6 +389,25 @@ def test_pn_series_rule_both_sides_against_mpmath(sign, side):
     q_ref, m_ref = exact_states(TILTED, momentum, HLW_MOMENTS, times)
     assert rotation_angle(q_ref, q).max() < MP_TOLERANCE
     assert np.abs(m - m_ref).max() < MP_TOLERANCE * np.linalg.norm(momentum)
+
+
+# The nome enters the series coefficients through q² and 1/(1 − q^{2k}); the modulus series is cut
+# at < 1e-19 relative, so the double result is within a few ulp of mpmath's on both of its paths.
+NOME_TOLERANCE = 4e-16  # relative
+
+
+@pytest.mark.parametrize("m", [1e-12, 1e-4, 0.3, 0.9, 0.97, 0.9725, 0.99, 1.0 - 1e-9])
+def test_nome_against_mpmath(m):
+    """q(m) from the λ series (λ ≤ NOME_LAMBDA_MAX, up to m ≈ 0.972) and from R_F beyond, vs mpmath.qfrom."""
+    with mp.workdps(40):
+        reference = mp.qfrom(m=mp.mpf(m))
+    value = nome(m, ellipk(m, 1.0 - m))
+    assert abs(value - float(reference)) <= NOME_TOLERANCE * float(reference), (m, value, reference)
+
+
+def test_nome_series_covers_the_pn_series():
+    """The series path of the nome reaches every q the pn series can meet (q ≤ ρ ≤ FOURIER_RHO_MAX)."""
+    assert NOME_LAMBDA_MAX > FOURIER_RHO_MAX  # λ < q, so q ≤ FOURIER_RHO_MAX has λ below the bound
 
 
 def test_typical_and_nearly_symmetric_states_take_the_series():

@@ -96,6 +96,7 @@ from spinorbit.core.free_motion.flow_constants import (
     FLOW_SIZE,
     flow_constants,
     flow_kappa_pn,
+    half_angles,
 )
 from spinorbit.core.free_motion.regular_precession import (
     NO_SYMMETRY_AXIS,
@@ -135,16 +136,6 @@ __all__ = [
     "torque_free_attitudes", "torque_free_states", "torque_free_states_many", "uniform_rotation",
 ]
 
-
-
-@jit
-def _half_angles(sin_x, cos_x):
-    """(cos(x/2), sin(x/2)) for x ∈ (−π, π] from (sin x, cos x) on the unit circle, no cancellation."""
-    if cos_x >= 0.0:
-        ch = math.sqrt(0.5 * (1.0 + cos_x))
-        return ch, sin_x / (2.0 * ch)
-    sh = math.copysign(math.sqrt(0.5 * (1.0 - cos_x)), sin_x)
-    return sin_x / (2.0 * sh), sh
 
 
 @jit
@@ -202,7 +193,7 @@ def flow_state(t, flow, mo, mk, pk):
         gh, gl = dd_add(gh, gl, ph, pl)
     half_g = _reduced_half(gh, gl)
     mx, my, mz, sin_l, cos_l = body_from_sncndn(s, c, d, mo)
-    cl, sl = _half_angles(sin_l, cos_l)
+    cl, sl = half_angles(sin_l, cos_l)
     # half angles of J (cos J = M_z/G), from whichever of G ± M_z does not cancel
     big_g = mo[MO_G]
     perp = math.hypot(mx, my)

@@ -59,6 +59,36 @@ def pn_fourier_ratio(f, m, k_quarter):
     return math.exp(-math.pi * beta / k_quarter)
 
 
+# Nome from the modulus (DLMF 20.9.4 inverted, q = Σ a_j λ^{4j+1}, OEIS A005797), where it converges fast:
+# 11 terms leave < 1e-19 relative for λ ≤ NOME_LAMBDA_MAX (checked against mpmath.qfrom in
+# tests/test_torque_free.py); the series path replaces an R_F and an exp (≈ 80 ns of the set-up).
+_NOME_SERIES = (1.0, 2.0, 15.0, 150.0, 1707.0, 20910.0, 268616.0, 3567400.0, 48555069.0, 673458874.0,
+                9481557398.0)
+NOME_LAMBDA_MAX = 0.2
+
+
+@jit
+def nome(m, k_quarter):
+    """The nome q = e^{−πK'/K} of the parameter 0 ≤ m < 1 (dimensionless), K = ``k_quarter``.
+
+    λ = (1 − √k')/(2(1 + √k')) with k' = √(1 − m), written as m / (2 (1 + k') (1 + √k')²) so that
+    it keeps its relative accuracy as m → 0; then q = λ (1 + 2λ⁴ + 15λ⁸ + …) for λ ≤
+    NOME_LAMBDA_MAX, else e^{−πK'/K} with K' = R_F(0, m, 1).
+    """
+    if not m > 0.0:
+        return 0.0
+    kp = math.sqrt(1.0 - m)
+    skp = 1.0 + math.sqrt(kp)
+    lam = m / (2.0 * (1.0 + kp) * (skp * skp))
+    if lam <= NOME_LAMBDA_MAX:
+        l4 = (lam * lam) * (lam * lam)
+        acc = _NOME_SERIES[10]
+        for j in range(9, -1, -1):
+            acc = acc * l4 + _NOME_SERIES[j]
+        return lam * acc
+    return math.exp(-math.pi * rf(0.0, m, 1.0) / k_quarter)  # K' = K(1 − m) = R_F(0, m, 1)
+
+
 @jit
 def pn_fourier_coefficients(f, m, k_quarter, one_minus_ratio, scale, out):
     """Write scale · c_k, k = 1..N, into out[0:N] and return N (0 if the series is not used).
@@ -88,16 +118,15 @@ def pn_fourier_coefficients(f, m, k_quarter, one_minus_ratio, scale, out):
     rho = pn_fourier_ratio(f, m, k_quarter)
     if not (0.0 < rho <= FOURIER_RHO_MAX):  # ρ underflows only for m < 1e-200 (K'/K > 237); NaN too
         return 0
-    q = 0.0
-    if m > 0.0:
-        q = math.exp(-math.pi * rf(0.0, m, 1.0) / k_quarter)  # K' = K(1 − m) = R_F(0, m, 1)
+    q = nome(m, k_quarter)
     sigma = q * q / rho
     q2 = q * q
-    # N from ρ^N ≤ FOURIER_TAIL (ρ ≤ FOURIER_RHO_MAX keeps N ≤ FOURIER_MAX_TERMS)
-    terms = min(FOURIER_MAX_TERMS, max(1, math.ceil(math.log(FOURIER_TAIL) / math.log(rho))))
+    # N: the first with ρ^N ≤ FOURIER_TAIL, found by the loop that forms ρ^k anyway (no log, no
+    # division; ρ ≤ FOURIER_RHO_MAX keeps N ≤ FOURIER_MAX_TERMS)
     rho_k, sigma_k, q2_k = 1.0, 1.0, 1.0
     slope = 0.0  # Σ k c_k / C
-    for k in range(terms):
+    terms = FOURIER_MAX_TERMS
+    for k in range(FOURIER_MAX_TERMS):
         rho_k *= rho
         sigma_k *= sigma
         b = rho_k - sigma_k
@@ -106,6 +135,9 @@ def pn_fourier_coefficients(f, m, k_quarter, one_minus_ratio, scale, out):
             b /= 1.0 - q2_k
         out[k] = b * _RECIPROCALS[k]
         slope += b
+        if rho_k <= FOURIER_TAIL:
+            terms = k + 1
+            break
     norm = scale * one_minus_ratio * k_quarter / (math.pi * slope)
     for k in range(terms):
         out[k] *= norm

@@ -18,6 +18,12 @@ carry μ = 0, so only the thermal block's torque is left), averaged
   representation of :mod:`spinorbit.core.model.thermal` has finite degree, so the integrand is smooth
   in time and the trapezoidal rule converges geometrically too).
 
+The grid point (s, z) fixes the attitude for all orbit times and (S, Z) the free motion for all grid
+points, and the rates are linear in the body torque at a fixed attitude
+(:func:`spinorbit.core.elements.equations.elements_rhs_of_torque`): so the backward map runs once per
+(s, z), the torque is averaged over the orbit there, and one gradient follows (the same sums as the
+point-by-point average in another order; tests/test_thermal_mean.py holds them to rounding).
+
 The slow state is (S, Z, H, h). Gravity's mean torque (degree 2, orbit-averaged closed form of
 :func:`spinorbit.core.averaging.mean_equations.degree2_mean_rhs`) is added for dh/dt: it precesses L
 about the orbit normal without changing (S, Z, H). The fast phases s and z are not propagated (their

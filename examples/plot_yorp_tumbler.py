@@ -10,8 +10,19 @@ with ``thermal=`` plans the run: over 10⁶ years it takes the mean YORP route (
 over the torus of the exact free motion and over the orbit) and says why, with its error estimate.
 Nutation damping (Burns & Safronov's time scale) pulls the tumbler back toward rotation about its
 axis of largest moment; μQ = 10⁹ Pa and K₃² = 0.01 are illustrative values for a weak rubble pile.
-Each 10⁶-year run takes tens of seconds; the full integration would take hours (the plan says how
-many).
+Each 10⁶-year run costs a few CPU seconds (docs/thermal.md, "Cost at matched accuracy"; the wall
+time printed below also carries the load of the machine it ran on); the full integration would take
+hours (the plan says how many).
+
+The attitude and spin of the :class:`~spinorbit.RotationState` are in the Scene's inertial frame
+(ICRS, equatorial), while :meth:`~spinorbit.scene.Orbit.kepler` takes ecliptic elements, so this
+orbit's plane is the ecliptic, tilted by 23.44° from the frame's equator: the spin starts at an
+obliquity of 21.0°. Before this example ran through the Scene, the same quaternion was given in the
+orbit frame itself (obliquity 31.0°), which is why its history then was different (Z/Z₀ 1.076 and
+ε → 74.5° after 10⁶ yr, against 1.291 and 66.8° now). The inputs differ on purpose, not the theory:
+the Scene's mean route is the core's ``propagate_mean_thermal`` on the Scene's starting elements
+(tests/test_scene_thermal.py), and the old orbit-frame model started at the Scene's elements gives
+the Scene's numbers.
 """
 
 # %%
@@ -53,6 +64,9 @@ omega = 2 * math.pi / 0.25  # rad/day: a 6-h rotation
 q = np.array([0.9, 0.2, -0.3, 0.25])
 state = RotationState(body, q / np.linalg.norm(q), np.array([0.3, 0.1, 1.0]) * omega * u.rad / u.day)
 years = np.linspace(0.0, 1e6, 101)[1:]
+# The state is in ICRS, the orbit's normal W on the ecliptic: the starting obliquity is their angle.
+start_obliquity = math.degrees(math.acos(np.dot(state.angular_momentum_direction, orbit.kepler_frame()[2])))
+print(f"obliquity at the start {start_obliquity:.1f}° (the orbit plane is the ecliptic, the state in ICRS)")
 print(f"damping time at the start {models['YORP + damping'].damping_time(omega * u.rad / u.day):.3g}")
 tables = {}
 for label, thermal in models.items():

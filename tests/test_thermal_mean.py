@@ -126,3 +126,32 @@ def test_bad_input_to_the_mean_yorp():
     fixed, _, _ = tumbler(ellipsoid_shape([0.2, 0.15, 0.12] * u.km, subdivisions=1), fixed_source(1.0, [1.0, 0, 0]))
     with pytest.raises(ValueError, match="Kepler orbit"):
         orbital_period(fixed)
+
+
+#: The grid average reordered (torque summed over the orbit before the linear map to the rates) against
+#: the plain average of eq. (11) point by point: the same sums in another order, so rounding only.
+REORDERED_RTOL = 1e-12
+
+
+def test_orbit_averaged_torque_equals_the_pointwise_average_of_eq_11():
+    from spinorbit.core.averaging.mean_equations import torus_frequencies
+    from spinorbit.core.elements.equations import elements_rhs_into
+
+    sun = kepler_source(GM_SUN, 1.0, 0.1, 0.0, 0.0, 0.0, 0.0, sign=-1.0)
+    model, y0, ic = tumbler(gaussian_random_sphere(0.2 * u.km, 0.15, seed=5, subdivisions=3), sun)
+    recoil, period_orbit = recoil_only_model(model), orbital_period(model)
+    for el in (elements_of_state(y0, model, ORBIT_FRAME), elements_of_state(y0 * [1, 1, 1, 1, -1, -1, -1], model,
+                                                                              ORBIT_FRAME)):
+        fast = np.empty(4)
+        mean_thermal_rates(12.3, el, recoil, ORBIT_FRAME, ic, 6, 4, 5, period_orbit, fast)
+        period, _, _ = torus_frequencies(el[0], el[1], ic)
+        point, buf, total = el.copy(), np.empty(6), np.zeros(6)
+        for i in range(5):
+            for j in range(6):
+                point[3] = math.copysign(1.0, el[0]) * period * j / 6
+                for k in range(4):
+                    point[4] = 2 * math.pi * k / 4
+                    elements_rhs_into(12.3 + period_orbit * i / 5, point, recoil, ORBIT_FRAME, ic, buf)
+                    total += buf
+        plain = total / (5 * 6 * 4)
+        np.testing.assert_allclose(fast, plain[[0, 1, 2, 5]], rtol=REORDERED_RTOL)

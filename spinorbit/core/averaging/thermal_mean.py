@@ -18,6 +18,12 @@ carry μ = 0, so only the thermal block's torque is left), averaged
   representation of :mod:`spinorbit.core.model.thermal` has finite degree, so the integrand is smooth
   in time and the trapezoidal rule converges geometrically too).
 
+The grid point (s, z) fixes the attitude for all orbit times and (S, Z) the free motion for all grid
+points, and the rates are linear in the body torque at a fixed attitude
+(:func:`spinorbit.core.elements.equations.elements_rhs_of_torque`): so the backward map runs once per
+(s, z), the torque is averaged over the orbit there, and one gradient follows (the same sums as the
+point-by-point average in another order; tests/test_thermal_mean.py holds them to rounding).
+
 The slow state is (S, Z, H, h). Gravity's mean torque (degree 2, orbit-averaged closed form of
 :func:`spinorbit.core.averaging.mean_equations.degree2_mean_rhs`) is added for dh/dt: it precesses L
 about the orbit normal without changing (S, Z, H). The fast phases s and z are not propagated (their
@@ -30,10 +36,11 @@ import numpy as np
 
 from spinorbit.core.averaging.dissipation import damping_rate_of_s
 from spinorbit.core.averaging.mean_equations import degree2_mean_rhs, mean_constants, torus_frequencies
-from spinorbit.core.dynamics.equations import MODEL_PERTURBERS
-from spinorbit.core.elements.canonical import MO_MODE, MO_PARAM_C, MODE_UNIFORM, inertia_constants, motion_from_elements
+from spinorbit.core.dynamics.equations import MODEL_PERTURBERS, force_function_and_torque_xyz
+from spinorbit.core.elements.canonical import (MO_MODE, MO_PARAM_C, MODE_UNIFORM, elliptic_constants, inertia_constants,
+                                               motion_from_elements, state_from_elements_motion)
 from spinorbit.core.errors import SpinorbitError
-from spinorbit.core.elements.equations import elements_rhs_into
+from spinorbit.core.elements.equations import elements_rhs_of_torque, inertial_quaternion, working_elements
 from spinorbit.core.integrators.dop853 import dop853_scratch, dop853_step, landing_step
 from spinorbit.core.jit import jit
 from spinorbit.core.model.gravity_field import BODY_A, BODY_B, BODY_C, FIG_THERMAL
@@ -112,19 +119,33 @@ def mean_thermal_rates(t, elements, recoil_model, frame, ic, n_s, n_z, n_orbit, 
     sign = 1.0 if elements[0] >= 0.0 else -1.0
     point = elements.copy()
     buf = np.empty(6)
+    # (S, Z) are the same at every grid point: the free motion's constants once per call. At each (s, z)
+    # the attitude is the same at every orbit time, and the rates are linear in the body torque
+    # (elements_rhs_of_torque), so the torque is averaged over the orbit before the one gradient.
+    work, _ = working_elements(point)
+    mo = motion_from_elements(work[EL_S], work[EL_Z], ic)
+    mk, pk = elliptic_constants(mo)
     acc_s = acc_z = acc_big_h = acc_h = 0.0
-    for i in range(n_orbit):
-        time = t + period_orbit * i / n_orbit
-        for j in range(n_s):
-            point[EL_SMALL_S] = sign * period * j / n_s if math.isfinite(period) else 0.0
-            for k in range(n_z):
-                point[EL_SMALL_Z] = 2.0 * math.pi * k / n_z
-                elements_rhs_into(time, point, recoil_model, frame, ic, buf)
-                acc_s += buf[EL_S]
-                acc_z += buf[EL_Z]
-                acc_big_h += buf[EL_H]
-                acc_h += buf[EL_SMALL_H]
-    count = n_orbit * n_s * n_z
+    for j in range(n_s):
+        point[EL_SMALL_S] = sign * period * j / n_s if math.isfinite(period) else 0.0
+        for k in range(n_z):
+            point[EL_SMALL_Z] = 2.0 * math.pi * k / n_z
+            work, flip = working_elements(point)
+            attitude, momentum = state_from_elements_motion(work, flip, mo, mk, pk)
+            q = inertial_quaternion(attitude, frame)
+            tx = ty = tz = 0.0
+            for i in range(n_orbit):
+                _, nx, ny, nz = force_function_and_torque_xyz(t + period_orbit * i / n_orbit, q[0], q[1], q[2], q[3],
+                                                              recoil_model)
+                tx += nx
+                ty += ny
+                tz += nz
+            elements_rhs_of_torque(point, ic, mo, mk, attitude, momentum, tx / n_orbit, ty / n_orbit, tz / n_orbit, buf)
+            acc_s += buf[EL_S]
+            acc_z += buf[EL_Z]
+            acc_big_h += buf[EL_H]
+            acc_h += buf[EL_SMALL_H]
+    count = n_s * n_z
     out[0] = acc_s / count
     out[1] = acc_z / count
     out[2] = acc_big_h / count

@@ -222,6 +222,19 @@ def elements_rhs_into(t, elements, model, frame, ic, dy):
     attitude, momentum = state_from_elements_motion(work, flip, mo, mk, pk)
     q = inertial_quaternion(attitude, frame)
     _, nx, ny, nz = force_function_and_torque_xyz(t, q[0], q[1], q[2], q[3], model)
+    elements_rhs_of_torque(elements, ic, mo, mk, attitude, momentum, nx, ny, nz, dy)
+    return singularity_distances_of_motion(mo, attitude, momentum, ic)
+
+
+@jit
+def elements_rhs_of_torque(elements, ic, mo, mk, attitude, momentum, nx, ny, nz, dy):
+    """Eq. (11) at one point of the elements from a given body torque N: d(S, Z, H, s, z, h)/dt into ``dy``.
+
+    The tail of :func:`elements_rhs_into` once the backward map (``mo``, ``mk``, ``attitude``,
+    ``momentum``) is known. Apart from ds/dt's a S, the rates are linear in N, so a caller that needs
+    the mean over many torques at one attitude (the orbit average of the recoil,
+    :func:`spinorbit.core.averaging.thermal_mean.mean_thermal_rates`) may pass their mean.
+    """
     du_andoyer = andoyer_gradient_from_torque(attitude, momentum, nx, ny, nz)
     du = canonical_gradient(du_andoyer, andoyer_jacobian_motion(elements, ic, mo, mk))
     a, _b, _c, _a_b, _b_c, _a_c = ic  # inertia_constants: (a, b, c, a − b, b − c, a − c)
@@ -231,7 +244,6 @@ def elements_rhs_into(t, elements, model, frame, ic, dy):
     dy[EL_SMALL_S] = a * elements[EL_S] - du[EL_S]
     dy[EL_SMALL_Z] = -du[EL_Z]
     dy[EL_SMALL_H] = -du[EL_H]
-    return singularity_distances_of_motion(mo, attitude, momentum, ic)
 
 
 @jit

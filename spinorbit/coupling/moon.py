@@ -51,6 +51,7 @@ from spinorbit.ephemeris import (
 from spinorbit.lunar_librations import euler313_from_attitudes, physical_librations
 from spinorbit.time import J2000_JD_TDB, tdb_day_and_fraction, time_from_tdb_days
 from spinorbit.coupling.sampling import de421_orbit, sample_from_ephemeris, sample_relative_states
+from spinorbit.coupling.dense_output import rotation_at
 from spinorbit.coupling.lunar_core import cached_core_state, core_key
 
 __all__ = [
@@ -285,8 +286,15 @@ def _euler313_near(attitudes, reference_angles):
 
 
 def compare_with_de421(moon, span_days: float, step_days: float = 1.0,
-                       progress=None, schedule=None, resume=None, settings=None) -> LibrationComparison:
+                       progress=None, schedule=None, resume=None, settings=None,
+                       cut_steps: bool = False) -> LibrationComparison:
     """Integrate ``moon`` over ``span_days`` and compare its attitude with DE421 every ``step_days``.
+
+    By default BS takes its natural steps (≈ 5 d) and the outputs are interpolated from the step
+    ends relative to DE421's attitude (:mod:`spinorbit.coupling.dense_output`; its error against
+    the cut-step run: ``tests/test_moon_dense_output.py``). With ``cut_steps``, or with checkpoints
+    (``schedule``/``resume``: a resumed run must take the same chunks), each output time ends a
+    chunk instead (:func:`spinorbit.coupling.long_run.integrate_to_outputs`).
 
     Parameters
     ----------
@@ -300,17 +308,30 @@ def compare_with_de421(moon, span_days: float, step_days: float = 1.0,
     schedule, resume, settings
         Checkpoints (:func:`spinorbit.coupling.long_run.integrate_to_outputs`): each output time
         is a chunk; an interrupted run resumed from its checkpoint ends with the same bits.
+    cut_steps : bool
+        End a chunk at each output time even without checkpoints (the former route, slower for
+        outputs closer than BS's step).
 
     Returns
     -------
     LibrationComparison
     """
-    from spinorbit.coupling.long_run import integrate_to_outputs
+    from spinorbit.coupling.long_run import integrate_step_ends, integrate_to_outputs
 
     times = _output_times(moon.sim.t, span_days, step_days)
-    _, quaternions, wall = integrate_to_outputs(moon, times, lambda body: body.quaternion, 4, schedule=schedule,
-                                                resume=resume, settings=settings, progress=progress)
-    return _comparison(times, quaternions, wall)
+    if cut_steps or schedule is not None or resume is not None or times.size < 2:
+        _, quaternions, wall = integrate_to_outputs(moon, times, lambda body: body.quaternion, 4, schedule=schedule,
+                                                    resume=resume, settings=settings, progress=progress)
+        return _comparison(times, quaternions, wall)
+    node_times, node_states, wall = integrate_step_ends(moon, times[-1], times=times, progress=progress)
+    quaternions, reference = rotation_at(times, node_times, node_states, _de421_orientation)
+    return _comparison(times, quaternions, wall, reference=reference)
+
+
+def _de421_orientation(times):
+    """DE421's mantle (q, ω) at float TDB days since J2000 (two-float form for jplephem)."""
+    days = np.round(times)
+    return moon_orientation_raw(days, times - days)
 
 
 def _output_times(start, span_days, step_days):
@@ -318,10 +339,12 @@ def _output_times(start, span_days, step_days):
     return start + step_days * np.arange(count)
 
 
-def _comparison(times, quaternions, wall):
-    """The model's attitudes against DE421's at the same times."""
+def _comparison(times, quaternions, wall, reference=None):
+    """The model's attitudes against DE421's at the same times (``reference``: DE421's quaternions
+    there, if the caller has them)."""
     days = np.round(times)
-    reference, _ = moon_orientation_raw(days, times - days)
+    if reference is None:
+        reference, _ = moon_orientation_raw(days, times - days)
     # δq = conj(q_DE421) ⊗ q_model: the model frame seen from the DE421 frame (mantle axes).
     w = np.einsum("ij,ij->i", reference, quaternions)
     vec = (reference[:, :1] * quaternions[:, 1:] - quaternions[:, :1] * reference[:, 1:]

@@ -423,7 +423,8 @@ def interior_model(start_day, end_day, perturbers=INTERIOR_PERTURBERS,
 
     sources = [sample_relative_states(earth, ("earth",), start, end, sample_tolerance).sources()[0]]
     distant = max(sample_tolerance, DISTANT_SAMPLE_TOLERANCE)
-    sources += [sample_from_ephemeris(de421_orbit("moon"), start, end, (name,), tolerance=distant).sources()[0]
+    moon = _remembering(de421_orbit("moon"))  # the distant perturbers' pilots share their times
+    sources += [sample_from_ephemeris(moon, start, end, (name,), tolerance=distant).sources()[0]
                 for name in perturbers[1:]]
     figure = moon_figure(constants.gm["moon"] / gravitational_constant, "rigid", 4)
     body = np.concatenate([figure, pack_perturbers(sources, base=MODEL_PERTURBERS)])
@@ -438,6 +439,24 @@ def interior_model(start_day, end_day, perturbers=INTERIOR_PERTURBERS,
         earth_j2=constants.earth_j2, earth_radius=constants.earth_radius_km / constants.au_km,
         distortion_rows=2)
     return np.concatenate([body, interior])
+
+
+def _remembering(orbit):
+    """``orbit`` (days -> (positions, velocities)) that returns its earlier result for the same days.
+
+    Each distant perturber is sampled on its own grids, but all start with the same pilot times;
+    the Moon's barycentric state there (two Chebyshev series) is then evaluated once, not per body.
+    """
+    seen = {}
+
+    def remembered(days):
+        days = np.asarray(days, dtype=float)
+        key = days.tobytes()
+        if key not in seen:
+            seen[key] = orbit(days)
+        return seen[key]
+
+    return remembered
 
 
 def _epoch_day():

@@ -353,6 +353,18 @@ def moon_libration_angles(time):
     return angles << u.rad, rates << (u.rad / u.day)
 
 
+@jit
+def _mantle_attitudes(angles, rates, psi):
+    """Attitude matrices and body angular velocities of 3-1-3 angles (φ, θ, reduced ψ) and rates, per row."""
+    n = angles.shape[0]
+    attitudes = np.empty((n, 3, 3))
+    omega = np.empty((n, 3))
+    for i in range(n):
+        attitudes[i] = euler313_to_attitude(angles[i, 0], angles[i, 1], psi[i])
+        omega[i] = euler313_rates_to_omega(angles[i, 0], angles[i, 1], psi[i], rates[i, 0], rates[i, 1], rates[i, 2])
+    return attitudes, omega
+
+
 def moon_orientation_raw(day, fraction=0.0):
     """Quaternion and body angular velocity of the Moon's mantle frame from plain TDB floats.
 
@@ -367,17 +379,10 @@ def moon_orientation_raw(day, fraction=0.0):
     """
     angles, rates = moon_libration_angles_raw(day, fraction)
     shape = angles.shape[:-1]
-    flat_angles = angles.reshape(-1, 3)
-    flat_rates = rates.reshape(-1, 3)
-    attitudes = np.empty((flat_angles.shape[0], 3, 3))
-    omega = np.empty((flat_angles.shape[0], 3))
-    for i, ((phi, theta, psi), (phi_dot, theta_dot, psi_dot)) in enumerate(
-        zip(flat_angles, flat_rates)
-    ):
-        # ψ grows without bound; reduce it first so the kernels' sin/cos see a small argument.
-        psi = math.remainder(psi, 2.0 * math.pi)
-        attitudes[i] = euler313_to_attitude(phi, theta, psi)
-        omega[i] = euler313_rates_to_omega(phi, theta, psi, phi_dot, theta_dot, psi_dot)
+    flat_angles = np.ascontiguousarray(angles.reshape(-1, 3))
+    # ψ grows without bound; reduce it first so the kernels' sin/cos see a small argument.
+    psi = np.array([math.remainder(value, 2.0 * math.pi) for value in flat_angles[:, 2].tolist()])
+    attitudes, omega = _mantle_attitudes(flat_angles, np.ascontiguousarray(rates.reshape(-1, 3)), psi)
     quaternion = attitude_to_quat_many(attitudes)
     return quaternion.reshape(shape + (4,)), omega.reshape(shape + (3,))
 

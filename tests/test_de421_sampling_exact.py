@@ -31,3 +31,24 @@ def test_scalar_interp_equals_numpy_interp_bit_for_bit():
     points = np.concatenate([rng.uniform(-20.0, 420.0, 20000), nodes, [nodes[0], nodes[-1]]])
     ours = np.array([interpolate(float(x)) for x in points])
     np.testing.assert_array_equal(ours, np.interp(points, nodes, values))
+
+
+def test_moon_orientation_equals_the_scalar_kernels_bit_for_bit():
+    """The compiled loop of moon_orientation_raw against the scalar kernels called one time at a time."""
+    import math
+
+    from spinorbit.core.math.rotations import attitude_to_quat_many, euler313_rates_to_omega, euler313_to_attitude
+    from spinorbit.ephemeris import moon_libration_angles_raw, moon_orientation_raw
+
+    rng = np.random.default_rng(11)
+    day = np.round(rng.uniform(-30000.0, 30000.0, 300))
+    fraction = rng.uniform(-0.5, 0.5, day.size)
+    angles, rates = moon_libration_angles_raw(day, fraction)
+    attitudes, omega = np.empty((day.size, 3, 3)), np.empty((day.size, 3))
+    for i, ((phi, theta, psi), (phi_dot, theta_dot, psi_dot)) in enumerate(zip(angles, rates)):
+        psi = math.remainder(psi, 2.0 * math.pi)
+        attitudes[i] = euler313_to_attitude(phi, theta, psi)
+        omega[i] = euler313_rates_to_omega(phi, theta, psi, phi_dot, theta_dot, psi_dot)
+    quaternion, omega_fast = moon_orientation_raw(day, fraction)
+    np.testing.assert_array_equal(quaternion, attitude_to_quat_many(attitudes))
+    np.testing.assert_array_equal(omega_fast, omega)

@@ -551,15 +551,15 @@ def compare_interior_with_de421(span_days: float, step_days: float = 1.0, start_
 
 def compare_model_with_de421(model: str, span_days: float, step_days: float = 1.0, coupled: bool = True,
                              progress=None, schedule=None, resume=None, settings=None,
-                             start_day: float = 0.0) -> LibrationComparison:
+                             start_day: float = 0.0, cut_steps: bool = False) -> LibrationComparison:
     """Any of :data:`MOON_MODELS` from ``start_day`` against DE421 (the CLI's and the example's entry point).
 
     The input is checked first (:func:`check_run`). "de421" starts from DE421's mantle at
     ``start_day`` and the core carried there (:func:`core_angular_velocity`); the rigid models from
     DE421's attitude and rates and the orbits at ``start_day``. ``coupled`` applies to the rigid
     models (REBOUND); "de421" is always driven by DE421's orbits. ``schedule``, ``resume`` and
-    ``settings`` (checkpoints, as in :func:`compare_with_de421`) apply to the rigid models only: the
-    "de421" model runs at ≈ 0.1 s per simulated year and has none.
+    ``settings`` (checkpoints, as in :func:`compare_with_de421`) and ``cut_steps`` apply to the rigid
+    models only: the "de421" model runs in a few hundredths of a second per simulated year and has none.
     """
     check_run(model, float(start_day), float(span_days), float(step_days))
     if model == "de421":
@@ -569,7 +569,7 @@ def compare_model_with_de421(model: str, span_days: float, step_days: float = 1.
         return compare_interior_with_de421(span_days, step_days, start_day=start_day, progress=progress)
     moon = moon_at_de421(epoch=time_from_tdb_days(float(start_day)), model=model, coupled=coupled)
     return compare_with_de421(moon, span_days, step_days, progress=progress,
-                              schedule=schedule, resume=resume, settings=settings)
+                              schedule=schedule, resume=resume, settings=settings, cut_steps=cut_steps)
 
 
 #: One line per column of :func:`comparison_table` (also written to ``table.meta['columns']``).

@@ -10,7 +10,9 @@ ends with the same bits (``tests/test_checkpoint_runs.py`` checks it across proc
 The checkpoint holds the body's checkpoint, the rows done so far, the chunk count, a fingerprint of
 the output times and the caller's settings; a resume with other times or settings is refused.
 :func:`coupled_run` is the short form the scene planner uses: the fully coupled rotation of a body at
-output times, on a copy of a simulation, without checkpoints.
+output times, on a copy of a simulation, without checkpoints. :func:`integrate_step_ends` is the
+other route, without checkpoints: BS's natural steps, each step end kept, outputs interpolated
+afterwards (:mod:`spinorbit.coupling.dense_output`), so outputs closer than a step cut none.
 """
 
 from __future__ import annotations
@@ -173,6 +175,8 @@ def integrate_step_ends(body, end, times=None, progress=None):
         last = sim.t + sim.dt >= end  # the next step would pass the end: finish there exactly
         body.integrate(end) if last else body.step()
         wall += _time.perf_counter() - begin
+        if sim.t == node_times[-1]:
+            continue  # a step BS rejected: t did not move, so there is no new step end
         node_times.append(sim.t)
         node_states.append(body.state)
         if progress is not None and times is not None:

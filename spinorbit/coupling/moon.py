@@ -20,6 +20,11 @@ compiled force), plus the lunar figure's back-reaction (fully coupled). Figure (
   started from DE421's published initial conditions (JDEPOC; ``spinorbit.core.model.lunar_interior``).
 
 Units: au (DE421), TDB days since J2000, masses GM/G ("AU", "day", "Msun"), ω in rad/day.
+
+Past the size rule (docs/architecture.md) as one concept: the three Moon models, each run and
+compared with DE421 by one entry point (:func:`compare_model_with_de421`) that the CLI, the
+examples, the benchmarks and the Moon table share; the route pieces live elsewhere (orbits:
+``coupling.rebound``, outputs: ``long_run`` and ``dense_output``, sampling: ``sampling``).
 """
 
 from __future__ import annotations
@@ -50,7 +55,7 @@ from spinorbit.ephemeris import (
 )
 from spinorbit.lunar_librations import euler313_from_attitudes, physical_librations
 from spinorbit.time import J2000_JD_TDB, tdb_day_and_fraction, time_from_tdb_days
-from spinorbit.coupling.sampling import de421_orbit, sample_from_ephemeris, sample_relative_states
+from spinorbit.coupling.sampling import de421_orbit, remembering, sample_from_ephemeris, sample_relative_states
 from spinorbit.coupling.dense_output import rotation_at
 from spinorbit.coupling.lunar_core import cached_core_state, core_key
 
@@ -290,11 +295,9 @@ def compare_with_de421(moon, span_days: float, step_days: float = 1.0,
                        cut_steps: bool = False) -> LibrationComparison:
     """Integrate ``moon`` over ``span_days`` and compare its attitude with DE421 every ``step_days``.
 
-    By default BS takes its natural steps (≈ 5 d) and the outputs are interpolated from the step
-    ends relative to DE421's attitude (:mod:`spinorbit.coupling.dense_output`; its error against
-    the cut-step run: ``tests/test_moon_dense_output.py``). With ``cut_steps``, or with checkpoints
-    (``schedule``/``resume``: a resumed run must take the same chunks), each output time ends a
-    chunk instead (:func:`spinorbit.coupling.long_run.integrate_to_outputs`).
+    By default BS takes its natural steps (≈ 6 d), the outputs interpolated from the step ends
+    relative to DE421's attitude (:mod:`spinorbit.coupling.dense_output`). With ``cut_steps`` or
+    checkpoints (a resumed run must take the same chunks) each output time ends a chunk instead.
 
     Parameters
     ----------
@@ -309,8 +312,7 @@ def compare_with_de421(moon, span_days: float, step_days: float = 1.0,
         Checkpoints (:func:`spinorbit.coupling.long_run.integrate_to_outputs`): each output time
         is a chunk; an interrupted run resumed from its checkpoint ends with the same bits.
     cut_steps : bool
-        End a chunk at each output time even without checkpoints (the former route, slower for
-        outputs closer than BS's step).
+        End a chunk at each output time even without checkpoints (the former, slower route).
 
     Returns
     -------
@@ -340,8 +342,7 @@ def _output_times(start, span_days, step_days):
 
 
 def _comparison(times, quaternions, wall, reference=None):
-    """The model's attitudes against DE421's at the same times (``reference``: DE421's quaternions
-    there, if the caller has them)."""
+    """The model's attitudes against DE421's at the same times (``reference``: DE421's q, if known)."""
     days = np.round(times)
     if reference is None:
         reference, _ = moon_orientation_raw(days, times - days)
@@ -423,7 +424,7 @@ def interior_model(start_day, end_day, perturbers=INTERIOR_PERTURBERS,
 
     sources = [sample_relative_states(earth, ("earth",), start, end, sample_tolerance).sources()[0]]
     distant = max(sample_tolerance, DISTANT_SAMPLE_TOLERANCE)
-    moon = _remembering(de421_orbit("moon"))  # the distant perturbers' pilots share their times
+    moon = remembering(de421_orbit("moon"))  # the distant perturbers' pilots share their times
     sources += [sample_from_ephemeris(moon, start, end, (name,), tolerance=distant).sources()[0]
                 for name in perturbers[1:]]
     figure = moon_figure(constants.gm["moon"] / gravitational_constant, "rigid", 4)
@@ -439,24 +440,6 @@ def interior_model(start_day, end_day, perturbers=INTERIOR_PERTURBERS,
         earth_j2=constants.earth_j2, earth_radius=constants.earth_radius_km / constants.au_km,
         distortion_rows=2)
     return np.concatenate([body, interior])
-
-
-def _remembering(orbit):
-    """``orbit`` (days -> (positions, velocities)) that returns its earlier result for the same days.
-
-    Each distant perturber is sampled on its own grids, but all start with the same pilot times;
-    the Moon's barycentric state there (two Chebyshev series) is then evaluated once, not per body.
-    """
-    seen = {}
-
-    def remembered(days):
-        days = np.asarray(days, dtype=float)
-        key = days.tobytes()
-        if key not in seen:
-            seen[key] = orbit(days)
-        return seen[key]
-
-    return remembered
 
 
 def _epoch_day():

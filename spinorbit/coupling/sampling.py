@@ -280,6 +280,24 @@ def de421_orbit(name):
     return orbit
 
 
+def remembering(orbit):
+    """``orbit`` (days -> (positions, velocities)) returning its earlier result for the same days.
+
+    The "de421" Moon model samples each distant perturber on its own grids, but all start from the
+    same pilot times: the Moon's barycentric state there (two Chebyshev series) is evaluated once.
+    """
+    seen = {}
+
+    def remembered(days):
+        days = np.asarray(days, dtype=float)
+        key = days.tobytes()
+        if key not in seen:
+            seen[key] = orbit(days)
+        return seen[key]
+
+    return remembered
+
+
 def _as_days_span(start, end):
     if not isinstance(start, Time) or not isinstance(end, Time):
         raise TypeError("start and end must be astropy Time objects (any scale convertible to TDB).")

@@ -114,7 +114,7 @@ def rotation_at(times, node_times, node_states, reference, nodes: int = HERMITE_
         ``reference(times) -> (q_ref (·, 4), ω_ref (·, 3))``, a smooth attitude close to the body's
         (same conventions), e.g. DE421's lunar mantle; any sign of q_ref.
     nodes : int
-        Step ends per Hermite fit (:data:`HERMITE_NODES`).
+        Step ends per Hermite fit (:data:`HERMITE_NODES`; all of them if there are fewer).
 
     Returns
     -------
@@ -129,5 +129,7 @@ def rotation_at(times, node_times, node_states, reference, nodes: int = HERMITE_
     delta *= np.where(delta[:, :1] < 0.0, -1.0, 1.0)  # one sign along the run (q_ref's may flip)
     rate = 0.5 * (quaternion_product(delta, _pure(node_states[:, 4:])) - quaternion_product(_pure(omega_ref), delta))
     out_ref, _ = reference(times)
-    result = quaternion_product(out_ref, hermite_interpolate(node_times, delta, (rate,), times, nodes))
+    # A span shorter than ``nodes`` steps (e.g. a few days from a body whose step has grown) has fewer.
+    fitted = hermite_interpolate(node_times, delta, (rate,), times, min(nodes, node_times.size))
+    result = quaternion_product(out_ref, fitted)
     return result / np.linalg.norm(result, axis=1)[:, None], out_ref

@@ -35,6 +35,7 @@ import astropy.units as u
 import numpy as np
 
 from spinorbit.core.errors import SpinorbitError
+from spinorbit.core.jit import jit
 from spinorbit.core.math.rotations import attitude_to_quat_many, euler313_rates_to_omega, euler313_to_attitude
 from spinorbit.time import J2000_JD_TDB, tdb_day_and_fraction
 
@@ -141,6 +142,82 @@ def _check_span(day, fraction):
         )
 
 
+@jit
+def _numpy_pairwise_sum(values, count):
+    """``values[:count].sum()`` in numpy's order (its ``pairwise_sum`` below 128 terms): term by term
+    under eight terms, else eight running partial sums, combined as a tree, then the leftover terms."""
+    if count < 8:
+        total = 0.0
+        for i in range(count):
+            total += values[i]
+        return total
+    r0, r1, r2, r3 = values[0], values[1], values[2], values[3]
+    r4, r5, r6, r7 = values[4], values[5], values[6], values[7]
+    i = 8
+    while i < count - count % 8:
+        r0 += values[i]
+        r1 += values[i + 1]
+        r2 += values[i + 2]
+        r3 += values[i + 3]
+        r4 += values[i + 4]
+        r5 += values[i + 5]
+        r6 += values[i + 6]
+        r7 += values[i + 7]
+        i += 8
+    total = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < count:
+        total += values[i]
+        i += 1
+    return total
+
+
+@jit
+def chebyshev_sums(coefficients, chebyshev, twice_t, days_per_set):
+    """Position and rate of Chebyshev series, as jplephem's ``position/velocity_from_bundle``.
+
+    Parameters
+    ----------
+    coefficients : ndarray, shape (axes, n, k)
+        Each time's segment coefficients.
+    chebyshev : ndarray, shape (k, n)
+        T_0 … T_{k−1} at each time's scaled argument t.
+    twice_t : ndarray, shape (n,)
+        2t.
+    days_per_set : float
+        Segment length (days): the rate is per day.
+
+    Returns
+    -------
+    position, rate : ndarray, shape (axes, n)
+        k ≤ 128 (DE421's series have at most 13 coefficients).
+    """
+    axes, n, k = coefficients.shape
+    position = np.empty((axes, n))
+    rate = np.empty((axes, n))
+    derivative = np.empty(k)
+    terms = np.empty(k)
+    for j in range(n):
+        # dT_0 = 0, dT_1 = 1, dT_i = 2t dT_{i−1} − dT_{i−2} + 2 T_{i−1}, then times 2 / segment length.
+        derivative[0] = 0.0
+        if k > 1:
+            derivative[1] = 1.0
+        if k > 2:
+            derivative[2] = twice_t[j] + twice_t[j]
+        for i in range(3, k):
+            derivative[i] = twice_t[j] * derivative[i - 1] - derivative[i - 2] + chebyshev[i - 1, j] + chebyshev[i - 1, j]
+        for i in range(k):
+            derivative[i] = derivative[i] * 2.0
+            derivative[i] = derivative[i] / days_per_set
+        for a in range(axes):
+            for i in range(k):
+                terms[i] = chebyshev[i, j] * coefficients[a, j, i]
+            position[a, j] = _numpy_pairwise_sum(terms, k)
+            for i in range(k):
+                terms[i] = derivative[i] * coefficients[a, j, i]
+            rate[a, j] = _numpy_pairwise_sum(terms, k)
+    return position, rate
+
+
 def _evaluate(series: str, day, fraction):
     """Chebyshev evaluation of one series: (position, rate), each shape (..., n_axes)."""
     ephemeris = _ephemeris()
@@ -151,7 +228,12 @@ def _evaluate(series: str, day, fraction):
     # J2000 + whole days and the fraction separately keeps the two-float precision.
     jd1 = np.ravel(J2000_JD_TDB + np.broadcast_to(day, shape))
     jd2 = np.ravel(np.broadcast_to(fraction, shape))
-    position, rate = ephemeris.position_and_velocity(series, jd1, jd2)
+    # jplephem's bundle (segment, Chebyshev T_k), then both sums in one compiled pass: the same
+    # arithmetic as its position/velocity_from_bundle, bit for bit (tests/test_de421_sampling_exact.py),
+    # without the (axes, n, k) temporaries that dominated the "de421" Moon model's sampling.
+    coefficients, days_per_set, chebyshev, twice_t = ephemeris.compute_bundle(series, jd1, jd2)
+    position, rate = chebyshev_sums(np.ascontiguousarray(coefficients), np.ascontiguousarray(chebyshev),
+                                    np.ascontiguousarray(twice_t), float(days_per_set))
     n_axes = position.shape[0]
     return (
         np.moveaxis(position, 0, -1).reshape(shape + (n_axes,)),
@@ -271,6 +353,18 @@ def moon_libration_angles(time):
     return angles << u.rad, rates << (u.rad / u.day)
 
 
+@jit
+def _mantle_attitudes(angles, rates, psi):
+    """Attitude matrices and body angular velocities of 3-1-3 angles (φ, θ, reduced ψ) and rates, per row."""
+    n = angles.shape[0]
+    attitudes = np.empty((n, 3, 3))
+    omega = np.empty((n, 3))
+    for i in range(n):
+        attitudes[i] = euler313_to_attitude(angles[i, 0], angles[i, 1], psi[i])
+        omega[i] = euler313_rates_to_omega(angles[i, 0], angles[i, 1], psi[i], rates[i, 0], rates[i, 1], rates[i, 2])
+    return attitudes, omega
+
+
 def moon_orientation_raw(day, fraction=0.0):
     """Quaternion and body angular velocity of the Moon's mantle frame from plain TDB floats.
 
@@ -285,17 +379,10 @@ def moon_orientation_raw(day, fraction=0.0):
     """
     angles, rates = moon_libration_angles_raw(day, fraction)
     shape = angles.shape[:-1]
-    flat_angles = angles.reshape(-1, 3)
-    flat_rates = rates.reshape(-1, 3)
-    attitudes = np.empty((flat_angles.shape[0], 3, 3))
-    omega = np.empty((flat_angles.shape[0], 3))
-    for i, ((phi, theta, psi), (phi_dot, theta_dot, psi_dot)) in enumerate(
-        zip(flat_angles, flat_rates)
-    ):
-        # ψ grows without bound; reduce it first so the kernels' sin/cos see a small argument.
-        psi = math.remainder(psi, 2.0 * math.pi)
-        attitudes[i] = euler313_to_attitude(phi, theta, psi)
-        omega[i] = euler313_rates_to_omega(phi, theta, psi, phi_dot, theta_dot, psi_dot)
+    flat_angles = np.ascontiguousarray(angles.reshape(-1, 3))
+    # ψ grows without bound; reduce it first so the kernels' sin/cos see a small argument.
+    psi = np.array([math.remainder(value, 2.0 * math.pi) for value in flat_angles[:, 2].tolist()])
+    attitudes, omega = _mantle_attitudes(flat_angles, np.ascontiguousarray(rates.reshape(-1, 3)), psi)
     quaternion = attitude_to_quat_many(attitudes)
     return quaternion.reshape(shape + (4,)), omega.reshape(shape + (3,))
 

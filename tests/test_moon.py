@@ -271,8 +271,9 @@ STEP_SEQUENCE_SPREAD_ARCSEC = 1e-4
 
 
 def test_daily_outputs_take_one_bs_step_a_day(monkeypatch):
-    """REBOUND restores dt to the last full step after an output; without the growth of
-    ``long_run.reach_in_one_step`` every day took a full and a cut step (measured 2 per day)."""
+    """Cut-step route (checkpointed runs): REBOUND restores dt to the last full step after an output;
+    without the growth of ``long_run.reach_in_one_step`` every day took a full and a cut step
+    (measured 2 per day)."""
     import spinorbit.coupling.long_run as long_run
 
     days = 30
@@ -280,7 +281,7 @@ def test_daily_outputs_take_one_bs_step_a_day(monkeypatch):
     def run():
         moon = moon_at_de421(model="rigid")
         start = moon.sim.steps_done
-        comparison = compare_with_de421(moon, days, step_days=1.0)
+        comparison = compare_with_de421(moon, days, step_days=1.0, cut_steps=True)
         return moon.sim.steps_done - start, comparison
 
     steps, comparison = run()

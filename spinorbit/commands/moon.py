@@ -186,7 +186,7 @@ def run(args) -> int:
     schedule, settings = _checkpoint_schedule(args, span_days, step, start)
     if schedule is not None and args.model == "de421":
         raise CommandError("--checkpoint/--resume apply to the REBOUND-coupled models (--model rigid or "
-                           "core-corrected); the de421 model runs at ≈ 0.1 s per simulated year and needs none.")
+                           "core-corrected); the de421 model runs in a few hundredths of a second per simulated year and needs none.")
     progress = Progress(count, "integrating")
     done = [0]
 

@@ -10,7 +10,9 @@ ends with the same bits (``tests/test_checkpoint_runs.py`` checks it across proc
 The checkpoint holds the body's checkpoint, the rows done so far, the chunk count, a fingerprint of
 the output times and the caller's settings; a resume with other times or settings is refused.
 :func:`coupled_run` is the short form the scene planner uses: the fully coupled rotation of a body at
-output times, on a copy of a simulation, without checkpoints.
+output times, on a copy of a simulation, without checkpoints. :func:`integrate_step_ends` is the
+other route, without checkpoints: BS's natural steps, each step end kept, outputs interpolated
+afterwards (:mod:`spinorbit.coupling.dense_output`), so outputs closer than a step cut none.
 """
 
 from __future__ import annotations
@@ -25,7 +27,8 @@ from spinorbit.coupling.rebound import ROTATION_STATE_SIZE, SimulationSnapshot, 
 from spinorbit.coupling.rigid_body import CoupledRigidBody
 from spinorbit.runs.checkpoint import Checkpoint, CheckpointSchedule, fingerprint
 
-__all__ = ["CHUNKED_RUN_KIND", "OUTPUT_STEP_GROWTH", "integrate_to_outputs", "coupled_run", "reach_in_one_step"]
+__all__ = ["CHUNKED_RUN_KIND", "OUTPUT_STEP_GROWTH", "integrate_step_ends", "integrate_to_outputs", "coupled_run",
+           "reach_in_one_step"]
 
 #: ``kind`` of the checkpoints written by :func:`integrate_to_outputs`.
 CHUNKED_RUN_KIND = "coupled-run"
@@ -132,6 +135,55 @@ def integrate_to_outputs(body, times, record, row_size: int, schedule: Checkpoin
                 "settings": settings,
                 "wall_seconds": wall}), i + 1)
     return body, rows, wall
+
+
+def integrate_step_ends(body, end, times=None, progress=None):
+    """Integrate ``body`` to ``end`` in BS's natural steps and keep the state at every step end.
+
+    No output time cuts a step: only the last chunk ends at ``end`` (``exact_finish_time``), so
+    outputs come from the step ends by interpolation (:mod:`spinorbit.coupling.dense_output`).
+    Not resumable from a checkpoint (use :func:`integrate_to_outputs` for that).
+
+    Parameters
+    ----------
+    body : CoupledRigidBody
+        At its start (``body.sim.t`` < ``end``, integrating forwards).
+    end : float
+        Final time (simulation units).
+    times : ndarray, optional
+        Output times, for ``progress`` only.
+    progress : callable, optional
+        Called after each step with the number of ``times`` reached.
+
+    Returns
+    -------
+    node_times : ndarray, shape (n,)
+        The start, every step end, and ``end``.
+    node_states : ndarray, shape (n, 7)
+        ``body.state`` there.
+    wall_seconds : float
+        Wall time spent integrating.
+    """
+    sim = body.sim
+    if not end > sim.t:
+        raise ValueError(f"integrate_step_ends: expected end > sim.t = {sim.t!r} (forwards), got {end!r}.")
+    node_times, node_states = [sim.t], [body.state]
+    wall = 0.0
+    sim.exact_finish_time = 1
+    while True:
+        begin = _time.perf_counter()
+        last = sim.t + sim.dt >= end  # the next step would pass the end: finish there exactly
+        body.integrate(end) if last else body.step()
+        wall += _time.perf_counter() - begin
+        if sim.t == node_times[-1]:
+            continue  # a step BS rejected: t did not move, so there is no new step end
+        node_times.append(sim.t)
+        node_states.append(body.state)
+        if progress is not None and times is not None:
+            progress(int(np.searchsorted(times, sim.t, side="right")))
+        if last:
+            break
+    return np.array(node_times), np.array(node_states), wall
 
 
 def coupled_run(sim, body, moments_per_mass, state, start, times, perturbers, tolerance):

@@ -20,6 +20,11 @@ compiled force), plus the lunar figure's back-reaction (fully coupled). Figure (
   started from DE421's published initial conditions (JDEPOC; ``spinorbit.core.model.lunar_interior``).
 
 Units: au (DE421), TDB days since J2000, masses GM/G ("AU", "day", "Msun"), ω in rad/day.
+
+Past the size rule (docs/architecture.md) as one concept: the three Moon models, each run and
+compared with DE421 by one entry point (:func:`compare_model_with_de421`) that the CLI, the
+examples, the benchmarks and the Moon table share; the route pieces live elsewhere (orbits:
+``coupling.rebound``, outputs: ``long_run`` and ``dense_output``, sampling: ``sampling``).
 """
 
 from __future__ import annotations
@@ -50,7 +55,8 @@ from spinorbit.ephemeris import (
 )
 from spinorbit.lunar_librations import euler313_from_attitudes, physical_librations
 from spinorbit.time import J2000_JD_TDB, tdb_day_and_fraction, time_from_tdb_days
-from spinorbit.coupling.sampling import de421_orbit, sample_from_ephemeris, sample_relative_states
+from spinorbit.coupling.sampling import de421_orbit, remembering, sample_from_ephemeris, sample_relative_states
+from spinorbit.coupling.dense_output import rotation_at
 from spinorbit.coupling.lunar_core import cached_core_state, core_key
 
 __all__ = [
@@ -285,8 +291,13 @@ def _euler313_near(attitudes, reference_angles):
 
 
 def compare_with_de421(moon, span_days: float, step_days: float = 1.0,
-                       progress=None, schedule=None, resume=None, settings=None) -> LibrationComparison:
+                       progress=None, schedule=None, resume=None, settings=None,
+                       cut_steps: bool = False) -> LibrationComparison:
     """Integrate ``moon`` over ``span_days`` and compare its attitude with DE421 every ``step_days``.
+
+    By default BS takes its natural steps (≈ 6 d), the outputs interpolated from the step ends
+    relative to DE421's attitude (:mod:`spinorbit.coupling.dense_output`). With ``cut_steps`` or
+    checkpoints (a resumed run must take the same chunks) each output time ends a chunk instead.
 
     Parameters
     ----------
@@ -300,17 +311,29 @@ def compare_with_de421(moon, span_days: float, step_days: float = 1.0,
     schedule, resume, settings
         Checkpoints (:func:`spinorbit.coupling.long_run.integrate_to_outputs`): each output time
         is a chunk; an interrupted run resumed from its checkpoint ends with the same bits.
+    cut_steps : bool
+        End a chunk at each output time even without checkpoints (the former, slower route).
 
     Returns
     -------
     LibrationComparison
     """
-    from spinorbit.coupling.long_run import integrate_to_outputs
+    from spinorbit.coupling.long_run import integrate_step_ends, integrate_to_outputs
 
     times = _output_times(moon.sim.t, span_days, step_days)
-    _, quaternions, wall = integrate_to_outputs(moon, times, lambda body: body.quaternion, 4, schedule=schedule,
-                                                resume=resume, settings=settings, progress=progress)
-    return _comparison(times, quaternions, wall)
+    if cut_steps or schedule is not None or resume is not None or times.size < 2:
+        _, quaternions, wall = integrate_to_outputs(moon, times, lambda body: body.quaternion, 4, schedule=schedule,
+                                                    resume=resume, settings=settings, progress=progress)
+        return _comparison(times, quaternions, wall)
+    node_times, node_states, wall = integrate_step_ends(moon, times[-1], times=times, progress=progress)
+    quaternions, reference = rotation_at(times, node_times, node_states, _de421_orientation)
+    return _comparison(times, quaternions, wall, reference=reference)
+
+
+def _de421_orientation(times):
+    """DE421's mantle (q, ω) at float TDB days since J2000 (two-float form for jplephem)."""
+    days = np.round(times)
+    return moon_orientation_raw(days, times - days)
 
 
 def _output_times(start, span_days, step_days):
@@ -318,10 +341,11 @@ def _output_times(start, span_days, step_days):
     return start + step_days * np.arange(count)
 
 
-def _comparison(times, quaternions, wall):
-    """The model's attitudes against DE421's at the same times."""
+def _comparison(times, quaternions, wall, reference=None):
+    """The model's attitudes against DE421's at the same times (``reference``: DE421's q, if known)."""
     days = np.round(times)
-    reference, _ = moon_orientation_raw(days, times - days)
+    if reference is None:
+        reference, _ = moon_orientation_raw(days, times - days)
     # δq = conj(q_DE421) ⊗ q_model: the model frame seen from the DE421 frame (mantle axes).
     w = np.einsum("ij,ij->i", reference, quaternions)
     vec = (reference[:, :1] * quaternions[:, 1:] - quaternions[:, :1] * reference[:, 1:]
@@ -400,7 +424,8 @@ def interior_model(start_day, end_day, perturbers=INTERIOR_PERTURBERS,
 
     sources = [sample_relative_states(earth, ("earth",), start, end, sample_tolerance).sources()[0]]
     distant = max(sample_tolerance, DISTANT_SAMPLE_TOLERANCE)
-    sources += [sample_from_ephemeris(de421_orbit("moon"), start, end, (name,), tolerance=distant).sources()[0]
+    moon = remembering(de421_orbit("moon"))  # the distant perturbers' pilots share their times
+    sources += [sample_from_ephemeris(moon, start, end, (name,), tolerance=distant).sources()[0]
                 for name in perturbers[1:]]
     figure = moon_figure(constants.gm["moon"] / gravitational_constant, "rigid", 4)
     body = np.concatenate([figure, pack_perturbers(sources, base=MODEL_PERTURBERS)])
@@ -509,15 +534,15 @@ def compare_interior_with_de421(span_days: float, step_days: float = 1.0, start_
 
 def compare_model_with_de421(model: str, span_days: float, step_days: float = 1.0, coupled: bool = True,
                              progress=None, schedule=None, resume=None, settings=None,
-                             start_day: float = 0.0) -> LibrationComparison:
+                             start_day: float = 0.0, cut_steps: bool = False) -> LibrationComparison:
     """Any of :data:`MOON_MODELS` from ``start_day`` against DE421 (the CLI's and the example's entry point).
 
     The input is checked first (:func:`check_run`). "de421" starts from DE421's mantle at
     ``start_day`` and the core carried there (:func:`core_angular_velocity`); the rigid models from
     DE421's attitude and rates and the orbits at ``start_day``. ``coupled`` applies to the rigid
     models (REBOUND); "de421" is always driven by DE421's orbits. ``schedule``, ``resume`` and
-    ``settings`` (checkpoints, as in :func:`compare_with_de421`) apply to the rigid models only: the
-    "de421" model runs at ≈ 0.1 s per simulated year and has none.
+    ``settings`` (checkpoints, as in :func:`compare_with_de421`) and ``cut_steps`` apply to the rigid
+    models only: the "de421" model runs in a few hundredths of a second per simulated year and has none.
     """
     check_run(model, float(start_day), float(span_days), float(step_days))
     if model == "de421":
@@ -527,7 +552,7 @@ def compare_model_with_de421(model: str, span_days: float, step_days: float = 1.
         return compare_interior_with_de421(span_days, step_days, start_day=start_day, progress=progress)
     moon = moon_at_de421(epoch=time_from_tdb_days(float(start_day)), model=model, coupled=coupled)
     return compare_with_de421(moon, span_days, step_days, progress=progress,
-                              schedule=schedule, resume=resume, settings=settings)
+                              schedule=schedule, resume=resume, settings=settings, cut_steps=cut_steps)
 
 
 #: One line per column of :func:`comparison_table` (also written to ``table.meta['columns']``).

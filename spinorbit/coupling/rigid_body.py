@@ -23,6 +23,7 @@ from spinorbit.coupling.rebound import (
     attach_rotation_hooks,
     body_index,
     integrate_interruptibly,
+    step_interruptibly,
     reinstall_extra_forces,
     simulation_binary,
     simulation_from_binary,
@@ -155,6 +156,17 @@ class CoupledRigidBody:
             Ctrl-C (SIGINT) during the call, also when REBOUND's own handler caught it.
         """
         integrate_interruptibly(self.sim, t)  # a Ctrl-C REBOUND absorbed still stops the run
+        self.hooks.raise_if_failed()
+
+    def step(self) -> None:
+        """Advance orbits and rotation by one step of BS's own choosing (no output time cuts it).
+
+        Raises
+        ------
+        spinorbit.coupling.rebound.rotation_hooks.RotationCallbackError, KeyboardInterrupt
+            As :meth:`integrate`.
+        """
+        step_interruptibly(self.sim)
         self.hooks.raise_if_failed()
 
     # ---------------------------------------------------------------------------------------

@@ -26,7 +26,7 @@ from spinorbit.coupling.rebound.extra_forces import (
     reinstall_extra_forces,
     set_nongravitational,
 )
-from spinorbit.coupling.rebound.interrupts import integrate_interruptibly
+from spinorbit.coupling.rebound.interrupts import integrate_interruptibly, step_interruptibly
 from spinorbit.coupling.rebound.rotation_hooks import (
     MAX_PERTURBERS,
     ROTATION_STATE_SIZE,
@@ -71,6 +71,7 @@ __all__ = [
     "MAX_PERTURBERS",
     "ROTATION_STATE_SIZE",
     "integrate_interruptibly",
+    "step_interruptibly",
     "simulation_binary",
     "simulation_from_binary",
     "SimulationSnapshot",

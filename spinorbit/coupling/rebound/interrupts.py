@@ -14,7 +14,7 @@ import ctypes
 
 import rebound
 
-__all__ = ["integrate_interruptibly"]
+__all__ = ["integrate_interruptibly", "step_interruptibly"]
 
 _REB_SIGINT = ctypes.c_int.in_dll(rebound.clibrebound, "reb_sigint")
 
@@ -44,3 +44,14 @@ def integrate_interruptibly(sim, t) -> None:
         _REB_SIGINT.value = 0  # REBOUND leaves the count set; the next call would stop at once
         raise
     _raise_if_interrupted()  # arrived during the last step, after REBOUND's final check
+
+
+def step_interruptibly(sim) -> None:
+    """One step of ``sim``'s integrator (``sim.steps(1)``: no output time, so BS's step is its own).
+
+    A Ctrl-C that REBOUND's handler absorbed during an earlier ``integrate`` raises
+    ``KeyboardInterrupt`` here, as in :func:`integrate_interruptibly`.
+    """
+    _raise_if_interrupted()
+    sim.steps(1)
+    _raise_if_interrupted()

@@ -55,10 +55,11 @@ MIN_MEAN_ORBITS = 2.0
 MEAN_STEP_SHARE = 0.01
 #: CPU time of one right-hand side of the full route (quaternion equations, the Sun and the degree-8
 #: recoil) and of the mean route (eq. 11 at one torus point): benchmarks/thermal_scene.py measures both
-#: (docs/thermal.md, "The Scene's thermal routes": medians 523 and 2396 ns on 2 shared cores); the
-#: planner compares the routes in these seconds, so only their ratio (≈ 4.6) decides.
+#: (docs/thermal.md, "The Scene's thermal routes": medians 520 and 554 ns on 2 shared cores, the mean
+#: one since its rates take the free motion once per call and the attitude once per torus point); the
+#: planner compares the routes in these seconds, so only their ratio (≈ 1.1) decides.
 FULL_RHS_SECONDS = 5.2e-7
-MEAN_RHS_SECONDS = 2.4e-6
+MEAN_RHS_SECONDS = 5.5e-7
 #: Right-hand sides beyond which the full route is refused: 2e9 is ~17 min at FULL_RHS_SECONDS.
 MAX_FULL_RHS = 2e9
 #: Relative error of the mean theory's secular changes of (S, Z, H) against the full integration:

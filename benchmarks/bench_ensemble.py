@@ -340,8 +340,7 @@ def measure_peer(members):
     # interleaved rounds, every process warm (compiled, the orbit sampled): spinorbit's batch route in this
     # process and on a started pool of 2, its per-member route here; heyoka's threads and processes, 1 and 2
     with concurrent.futures.ProcessPoolExecutor(max_workers=2) as pool:
-        for warming in [pool.submit(_warm_worker, rows[0]) for _ in range(2)]:
-            warming.result()  # both workers imported and compiled, the orbit sampled
+        warm_workers(pool, rows[0])  # both workers imported and compiled, the orbit sampled
         engines = {("batch", 1): lambda: Ensemble(ek.kepler_member, parameters).run(executor="serial"),
                    ("batch", 2): lambda: Ensemble(ek.kepler_member, parameters).run(executor=pool),
                    ("member", 1): lambda: Ensemble(ek.kepler_member, parameters, route="member").run(executor="serial")}
@@ -467,7 +466,7 @@ def machine_efficiency(pool, n=4_000_000):
 
 
 EFFICIENCY_MEMBERS = 24
-EFFICIENCY_REPEATS = 3
+EFFICIENCY_REPEATS = 5
 #: Heavier members for the parallel-efficiency goal (members of ≥ 50 ms): 400 days after the perigee, 0.01 arcsec.
 HEAVY = dict(span=800.0, tolerance_arcsec=0.01)
 
@@ -496,8 +495,7 @@ def measure_efficiency(members=EFFICIENCY_MEMBERS, repeats=EFFICIENCY_REPEATS):
     Ensemble(ek.kepler_member, parameters[:1]).run(executor="serial")  # this process warm, the orbit sampled
     serial, warm, machine = [], [], []
     with concurrent.futures.ProcessPoolExecutor(max_workers=2) as pool:
-        for warming in [pool.submit(_warm_worker, rows[0]) for _ in range(2)]:
-            warming.result()
+        warm_workers(pool, rows[0])
         for _ in range(repeats):
             seconds, table_1 = _timed_ensemble(lambda: Ensemble(ek.kepler_member, parameters).run(executor="serial"))
             serial.append(seconds)
@@ -527,6 +525,10 @@ def markdown_efficiency(e, overhead_pool):
         "| round | serial (s) | pool of 2 (s) | parallel efficiency | the machine's | relative |", "|---|---|---|---|---|---|"]
         + [f"| {k + 1} | {e['serial_all'][k]:.2f} | {e['warm_all'][k]:.2f} | {e['efficiency'][k]:.2f} | "
            f"{e['machine'][k]:.2f} | {relative[k]:.2f} |" for k in range(e["repeats"])] + ["",
+        f"Median (min–max) of the {e['repeats']} rounds: parallel efficiency {statistics.median(e['efficiency']):.2f} "
+        f"({min(e['efficiency']):.2f}–{max(e['efficiency']):.2f}), the machine's {statistics.median(e['machine']):.2f} "
+        f"({min(e['machine']):.2f}–{max(e['machine']):.2f}), relative {statistics.median(relative):.2f} "
+        f"({min(relative):.2f}–{max(relative):.2f}).", "",
         f"c = {c * 1e3:.0f} ms per member (median serial round). The model n c / 2 + (n / chunk) o / 2 predicts "
         f"{model:.2f} s on two free cores against the median {e['warm']:.2f} s. A new pool (its start and each "
         f"worker's imports, compilation cache and sampling included) took {e['fresh']:.2f} s once. The tables are "
@@ -534,6 +536,17 @@ def markdown_efficiency(e, overhead_pool):
         f"{e['load'][0]:.2f} before and {e['load'][1]:.2f} after: the 2 cores are shared with other work, so the "
         "goal (≥ 0.9) can only be judged against the machine's own efficiency of the same round (the 'relative' "
         "column), not on its own."])
+
+
+def warm_workers(pool, row, workers=2, attempts=10):
+    """Warm every worker of ``pool`` (:func:`_warm_worker`), until each of the ``workers`` processes has run one:
+    two warm-ups submitted together may both land on the same worker, leaving the other cold for round 1."""
+    seen = set()
+    for _ in range(attempts):
+        seen.update(f.result() for f in [pool.submit(_warm_worker, row) for _ in range(workers)])
+        if len(seen) >= workers:
+            return seen
+    raise RuntimeError(f"only {len(seen)} of {workers} workers took a warm-up in {attempts} attempts")
 
 
 def _warm_worker(row):
@@ -544,7 +557,8 @@ def _warm_worker(row):
 
     time.sleep(0.2)  # keep this worker busy so that the pool hands the next warm-up to the other
     run_chunk(ek.kepler_member, [(0, row)])
-    return ek.kepler_member(**row).run().error_estimate
+    ek.kepler_member(**row).run()
+    return os.getpid()
 
 
 def stages_text(p):

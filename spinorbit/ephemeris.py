@@ -359,9 +359,15 @@ def _mantle_attitudes(angles, rates, psi):
     n = angles.shape[0]
     attitudes = np.empty((n, 3, 3))
     omega = np.empty((n, 3))
+    # Element by element: a whole-row assignment makes numba 0.68 compile its shape-mismatch message
+    # (string formatting), which tripled this kernel's compile time on a cold cache.
     for i in range(n):
-        attitudes[i] = euler313_to_attitude(angles[i, 0], angles[i, 1], psi[i])
-        omega[i] = euler313_rates_to_omega(angles[i, 0], angles[i, 1], psi[i], rates[i, 0], rates[i, 1], rates[i, 2])
+        attitude = euler313_to_attitude(angles[i, 0], angles[i, 1], psi[i])
+        rate = euler313_rates_to_omega(angles[i, 0], angles[i, 1], psi[i], rates[i, 0], rates[i, 1], rates[i, 2])
+        for j in range(3):
+            omega[i, j] = rate[j]
+            for k in range(3):
+                attitudes[i, j, k] = attitude[j, k]
     return attitudes, omega
 
 

@@ -62,6 +62,7 @@ BENCHMARKS = (
     Benchmark("bench_batch.py", quick=("--quick",)),
     Benchmark("thermal_validation.py", quick=("--no-write",)),
     Benchmark("thermal_scene.py", quick=("--repeat", "1", "--no-write")),
+    Benchmark("damping_validation.py", quick=("--no-write",)),
     Benchmark("stm_accuracy.py", quick=("--no-write",)),
     Benchmark("bench_stm.py", quick=("--repeat", "1", "--no-write")),
     Benchmark("fit_toutatis.py", quick=("--no-write",)),

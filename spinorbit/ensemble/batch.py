@@ -81,7 +81,7 @@ def group_key(scene, at_days):
             tuple(scene.quantities), scene.integrator)
 
 
-def group_sensitivities(states, span_days, principal=None):
+def group_sensitivities(states, span_days):
     """κ of :func:`spinorbit.scene.bounds.attitude_sensitivity` for many states, in one vectorised flow.
 
     The same probe (ω kicked along each user body axis by ``SENSITIVITY_PROBE_RAD / span``, the
@@ -89,8 +89,7 @@ def group_sensitivities(states, span_days, principal=None):
     exact free flow of every member and its three kicked states at once
     (:func:`spinorbit.core.free_motion.members.free_members`). The angle between two attitudes is the
     same in principal and user axes, so it is taken between the principal-axis attitudes; the values
-    agree with the per-state function to rounding. ``principal`` optionally holds each state's
-    ``principal_attitude_and_momentum()`` already computed (the same values, not computed again).
+    agree with the per-state function to rounding.
     """
     from spinorbit.core.free_motion.members import free_members
     from spinorbit.core.math.rotations import attitude_to_quat, rotation_angle_between_many
@@ -99,8 +98,8 @@ def group_sensitivities(states, span_days, principal=None):
     horizons = np.array(SENSITIVITY_HORIZONS) * span_days
     kick = SENSITIVITY_PROBE_RAD / span_days
     quaternions, momenta, moments = [], [], []
-    for k, state in enumerate(states):
-        attitude, momentum = state.principal_attitude_and_momentum() if principal is None else principal[k]
+    for state in states:
+        attitude, momentum = state.principal_attitude_and_momentum()
         p, values, omega = state.body.to_principal, state.body.moment_values, state.angular_velocity.value  # rad/day
         q = attitude_to_quat(np.ascontiguousarray(attitude))
         for axis in range(4):  # the state, then its ω kicked along each user axis (attitude_sensitivity's kicks)
@@ -240,22 +239,20 @@ def _motion_summaries(momenta, moments):
     return [MODE_NAMES[int(c)] for c in modes], ratios, p_psi * hours, p_phi * hours, p_sidereal * hours
 
 
-def _rows(scenes, ends, normals, principal=None):
+def _rows(scenes, ends, normals):
     """The outcome values of every member's end state (principal axes) and its initial state, plain values
-    in the outcome units, as the Scene's one-row table and outcome_row would hold them (``principal``: the
-    members' ``principal_attitude_and_momentum()`` if already computed)."""
+    in the outcome units, as the Scene's one-row table and outcome_row would hold them."""
     from spinorbit import pole as _pole
     from spinorbit.state import InvalidStateError
     from spinorbit.state_table import from_principal, pole_directions, unit_quaternions
 
     directions, end_momenta, start_momenta, start_poles = [], [], [], []
-    for k, (scene, end) in enumerate(zip(scenes, ends)):  # each member's own body (its axes, its moments)
+    for scene, end in zip(scenes, ends):  # each member's own body (its axes, its moments)
         body = scene.state.body
         quaternions, omegas = from_principal(body, end[None, :])
         directions.append(pole_directions(body, unit_quaternions(np.atleast_2d(quaternions)), omegas)[0])
         end_momenta.append(((body.moment_values * omegas) @ body.to_principal.T)[0])  # the table's P (I ω)
-        start_momenta.append((scene.state.principal_attitude_and_momentum() if principal is None
-                              else principal[k])[1])  # the properties' momentum
+        start_momenta.append(scene.state.principal_attitude_and_momentum()[1])  # the properties' momentum
         start_poles.append(scene.state.angular_momentum_direction)
     directions = np.array(directions)
     moments = np.array([s.state.body.principal_moments for s in scenes])
@@ -317,18 +314,17 @@ def run_group(group, shared, at_days, integrators=None):
         return rows, failures, list(group)
     tolerance, span = plan.tolerance_rad, leader.span_days
     # members whose free flow over the span stays in its domain (attitude_sensitivity would refuse the others)
-    fits, principal = [], {}
+    fits = []
     for member in group:
         state = member[1].state
-        principal[member[0]] = state.principal_attitude_and_momentum()  # once per member: κ and the row reuse it
-        momentum = np.linalg.norm(principal[member[0]][1])
+        momentum = np.linalg.norm(state.principal_attitude_and_momentum()[1])
         fits.append(bool(momentum > 0.0 and momentum / state.body.principal_moments[0] * span <= MAX_FLOW_PHASE))
     fallback = [m for m, ok in zip(group, fits) if not ok]
     group = [m for m, ok in zip(group, fits) if ok]
     if not group:
         return rows, failures, fallback
     scenes = [s for _, s, _ in group]
-    kappas = group_sensitivities([s.state for s in scenes], span, [principal[i] for i, _, _ in group])
+    kappas = group_sensitivities([s.state for s in scenes], span)
     bounds = _member_bounds(scenes, survey, kappas)
     batch, used, kept_bounds = [], [], []
     for member, bound in zip(group, bounds):
@@ -367,7 +363,7 @@ def run_group(group, shared, at_days, integrators=None):
     if not ok:
         return rows, failures, fallback
     try:
-        values = _rows([scenes[m] for m in ok], ends[ok], normals, [principal[batch[m][0]] for m in ok])
+        values = _rows([scenes[m] for m in ok], ends[ok], normals)
     except Exception:  # noqa: BLE001 — a member the vectorised outcome refuses: each on its own Scene
         return rows, failures, fallback + [batch[m] for m in ok]
     suffix = "" if at_days is None else "_t0"  # the one named time is the end

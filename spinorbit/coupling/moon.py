@@ -56,7 +56,7 @@ from spinorbit.ephemeris import (
 from spinorbit.lunar_librations import euler313_from_attitudes, physical_librations
 from spinorbit.time import J2000_JD_TDB, tdb_day_and_fraction, time_from_tdb_days
 from spinorbit.coupling.sampling import de421_orbit, remembering, sample_from_ephemeris, sample_relative_states
-from spinorbit.coupling.dense_output import rotation_at
+from spinorbit.coupling.dense_output import quaternion_product, rotation_at
 from spinorbit.coupling.lunar_core import cached_core_state, core_key
 
 __all__ = [
@@ -345,11 +345,10 @@ def _comparison(times, quaternions, wall, reference=None):
     """The model's attitudes against DE421's at the same times (``reference``: DE421's q, if known)."""
     days = np.round(times)
     if reference is None:
-        reference, _ = moon_orientation_raw(days, times - days)
+        reference, _ = _de421_orientation(times)
     # δq = conj(q_DE421) ⊗ q_model: the model frame seen from the DE421 frame (mantle axes).
-    w = np.einsum("ij,ij->i", reference, quaternions)
-    vec = (reference[:, :1] * quaternions[:, 1:] - quaternions[:, :1] * reference[:, 1:]
-           - np.cross(reference[:, 1:], quaternions[:, 1:]))
+    delta = quaternion_product(reference * np.array([1.0, -1.0, -1.0, -1.0]), quaternions)
+    w, vec = delta[:, 0], delta[:, 1:]
     angle = 2.0 * np.arctan2(np.linalg.norm(vec, axis=1), np.abs(w))
     body_vector = 2.0 * vec * np.sign(w)[:, None]
     angles_de421 = moon_libration_angles_raw(days, times - days)[0]

@@ -379,6 +379,7 @@ def measure_stages(ek, rows, repeats=3):
     from spinorbit.core.integrators.batch_quaternion import integrate_quaternion_batch
     from spinorbit.ensemble import batch
     from spinorbit.ensemble.ensemble import build_member
+    from spinorbit.scene.bounds import attitude_sensitivities
     from spinorbit.scene.sampling import SharedSamples
 
     shared = SharedSamples()  # what a worker's chunk holds once the orbit is sampled
@@ -398,7 +399,7 @@ def measure_stages(ek, rows, repeats=3):
             sources, _, _ = batch._kept_sources(scenes[0], plan)
         spent["plan"] += time.process_time() - clock
         clock = time.process_time()
-        kappas = batch.group_sensitivities([s.state for s in scenes], scenes[0].span_days)
+        kappas = attitude_sensitivities([s.state for s in scenes], scenes[0].span_days)
         batch._member_bounds(scenes, survey, kappas)
         spent["bounds"] += time.process_time() - clock
         clock = time.process_time()

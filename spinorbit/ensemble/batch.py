@@ -8,8 +8,8 @@ and dropped, its integrator. Every member of the group then gets, from its own s
 
 - its **bounds**: the worst-attitude bound of every perturber
   (:func:`~spinorbit.scene.bounds.dropped_torque_bound` on the group's shared survey, with the member's
-  |L|/A, moments and attitude sensitivity κ, :func:`group_sensitivities`: the exact free flow of the
-  member and of its three kicked states in one vectorised call). The worst-attitude bound is never
+  |L|/A, moments and attitude sensitivity κ, :func:`~spinorbit.scene.bounds.attitude_sensitivities`: the
+  exact free flow of every member and of its three kicked states in one vectorised call, the planner's κ). The worst-attitude bound is never
   below the free-motion bound a Scene may take, so a drop it allows is a drop the member may take;
 - the group's **drops, if they hold for it**: the bounds of the leader's dropped perturbers must fit
   in :data:`~spinorbit.scene.tolerances.DROP_SHARE` × tolerance for this member, else the member runs
@@ -34,7 +34,7 @@ perturber block), and the outcome row is computed from the core end state direct
 Where the member's own plan would take the group's decisions (the same kept perturbers and
 integrator; always when the group drops nothing, as in the Apophis encounter), its integration is
 the Scene's to the last bit (the batch DOP853 is the scalar one per lane) and so are its outcome
-columns; its error estimate differs from the Scene's by the rounding of κ only. Where the leader's
+columns, and so is its error estimate (the same κ, bounds, run and check). Where the leader's
 plan differs from the member's own (a member that would drop a perturber the leader keeps, or take
 the Taylor method), the row is the group plan's, whose error estimate holds for the member all the
 same: it is made of the member's own bounds and its own a posteriori check. Which members ran where
@@ -53,7 +53,7 @@ from astropy import units as u
 
 from spinorbit.core.integrators.batch_quaternion import integrate_quaternion_batch
 
-__all__ = ["BATCH_INTEGRATORS", "group_key", "group_sensitivities", "run_group"]
+__all__ = ["BATCH_INTEGRATORS", "group_key", "run_group"]
 
 #: The batch integrator of each plan integrator: a function with integrate_quaternion_batch's signature
 #: ``(y0s, t0, t_end, models, rtol, ...) -> (end states (N, 7), stats dict of (N,) arrays)``. A plan
@@ -79,47 +79,6 @@ def group_key(scene, at_days):
     return (id(scene.orbit), tuple(scene.named), tuple(id(p) for p in scene.fixed), tuple(id(p) for p in scene.moving),
             float(scene.epoch_day), float(scene.output_days[-1]), scene.tolerance_rad, scene.sample_tolerance,
             tuple(scene.quantities), scene.integrator)
-
-
-def group_sensitivities(states, span_days):
-    """κ of :func:`spinorbit.scene.bounds.attitude_sensitivity` for many states, in one vectorised flow.
-
-    The same probe (ω kicked along each user body axis by ``SENSITIVITY_PROBE_RAD / span``, the
-    attitude change per unit |δω|·τ at the horizons ``SENSITIVITY_HORIZONS`` × span, at least 1) on the
-    exact free flow of every member and its three kicked states at once
-    (:func:`spinorbit.core.free_motion.members.free_members`). The angle between two attitudes is the
-    same in principal and user axes, so it is taken between the principal-axis attitudes; the values
-    agree with the per-state function to rounding.
-    """
-    from spinorbit.core.free_motion.members import free_members
-    from spinorbit.core.math.rotations import attitude_to_quat, rotation_angle_between_many
-    from spinorbit.scene.bounds import SENSITIVITY_HORIZONS, SENSITIVITY_PROBE_RAD
-
-    horizons = np.array(SENSITIVITY_HORIZONS) * span_days
-    kick = SENSITIVITY_PROBE_RAD / span_days
-    quaternions, momenta, moments = [], [], []
-    for state in states:
-        attitude, momentum = state.principal_attitude_and_momentum()
-        p, values, omega = state.body.to_principal, state.body.moment_values, state.angular_velocity.value  # rad/day
-        q = attitude_to_quat(np.ascontiguousarray(attitude))
-        for axis in range(4):  # the state, then its ω kicked along each user axis (attitude_sensitivity's kicks)
-            kicked = omega.copy()
-            if axis < 3:
-                kicked[axis] += kick
-            quaternions.append(q)
-            momenta.append(momentum if axis == 3 else p @ (values * kicked))
-            moments.append(state.body.principal_moments)
-    n = len(states)
-    elapsed = np.broadcast_to(horizons, (4 * n, horizons.size))
-    *_, flowed, _ = free_members(np.array(quaternions), np.array(momenta), np.array(moments, dtype=float), elapsed)
-    flowed = flowed.reshape(n, 4, horizons.size, 4)
-    kappas = np.ones(n)
-    for m in range(n):
-        base = np.ascontiguousarray(flowed[m, 3])
-        for axis in range(3):
-            angles = rotation_angle_between_many(base, np.ascontiguousarray(flowed[m, axis]))
-            kappas[m] = max(kappas[m], float(np.max(angles / (kick * horizons))))
-    return kappas
 
 
 def _survey(leader, plan):
@@ -288,6 +247,7 @@ def run_group(group, shared, at_days, integrators=None):
     """
     from spinorbit.coupling.one_way import one_way_days
     from spinorbit.core.integrators.dop853 import STATUS_MESSAGES, IntegrationError
+    from spinorbit.scene.bounds import attitude_sensitivities
     from spinorbit.scene.routes import scene_orbit_normals
     from spinorbit.scene.tolerances import DROP_SHARE, first_tolerance, sampling_error_bound
     from spinorbit.state import MAX_FLOW_PHASE
@@ -324,7 +284,7 @@ def run_group(group, shared, at_days, integrators=None):
     if not group:
         return rows, failures, fallback
     scenes = [s for _, s, _ in group]
-    kappas = group_sensitivities([s.state for s in scenes], span)
+    kappas = attitude_sensitivities([s.state for s in scenes], span)
     bounds = _member_bounds(scenes, survey, kappas)
     batch, used, kept_bounds = [], [], []
     for member, bound in zip(group, bounds):

@@ -198,22 +198,58 @@ def _motion_summaries(momenta, moments):
     return [MODE_NAMES[int(c)] for c in modes], ratios, p_psi * hours, p_phi * hours, p_sidereal * hours
 
 
+class _Stacked:
+    """The members' bodies as one body for state_table's row functions: their shared principal axes and each
+    row's own moments (rows (N, 3); those functions take the moments elementwise, row by row)."""
+
+    def __init__(self, to_principal, moment_values):
+        self.to_principal, self.moment_values = to_principal, moment_values
+
+
+def _start_poles(states, momenta):
+    """RotationState.angular_momentum_direction of every state, its user momenta ``momenta`` (N, 3) given:
+    Rᵀ (I ω) / |…| with each row's product and norm the same one-row BLAS calls as the property's."""
+    attitudes = np.array([state.attitude_matrix for state in states])
+    inertial = np.matmul(np.swapaxes(attitudes, 1, 2), momenta[:, :, None])  # (3, 3)ᵀ @ (3,) per row
+    norms = np.sqrt(np.matmul(np.swapaxes(inertial, 1, 2), inertial))  # x·x per row, as np.linalg.norm of a vector
+    return (inertial / norms)[:, :, 0]
+
+
 def _rows(scenes, ends, normals):
     """The outcome values of every member's end state (principal axes) and its initial state, plain values
-    in the outcome units, as the Scene's one-row table and outcome_row would hold them."""
+    in the outcome units, as the Scene's one-row table and outcome_row would hold them.
+
+    Members with the same principal axes (the same P, as in every ensemble of one body's moment ratios)
+    take state_table's functions once for all their rows: each row's numbers are its one-row call's (row-wise
+    kernels and one BLAS call per row). Others are taken member by member.
+    """
     from spinorbit import pole as _pole
     from spinorbit.state import InvalidStateError
     from spinorbit.state_table import from_principal, pole_directions, unit_quaternions
 
-    directions, end_momenta, start_momenta, start_poles = [], [], [], []
-    for scene, end in zip(scenes, ends):  # each member's own body (its axes, its moments)
-        body = scene.state.body
-        quaternions, omegas = from_principal(body, end[None, :])
-        directions.append(pole_directions(body, unit_quaternions(np.atleast_2d(quaternions)), omegas)[0])
-        end_momenta.append(((body.moment_values * omegas) @ body.to_principal.T)[0])  # the table's P (I ω)
-        start_momenta.append(scene.state.principal_attitude_and_momentum()[1])  # the properties' momentum
-        start_poles.append(scene.state.angular_momentum_direction)
-    directions = np.array(directions)
+    states = [scene.state for scene in scenes]
+    p = states[0].body.to_principal
+    if all(state.body.to_principal.tobytes() == p.tobytes() for state in states):
+        values = np.array([state.body.moment_values for state in states])
+        quaternions, omegas = from_principal(states[0].body, ends)
+        directions = pole_directions(_Stacked(p, values), unit_quaternions(quaternions), omegas)
+        end_momenta = np.matmul((values * omegas)[:, None, :], p.T)[:, 0]  # the table's P (I ω), row by row
+        user = values * np.array([state.angular_velocity.value for state in states])  # I ω, rad/day
+        start_momenta = np.matmul(p, user[:, :, None])[:, :, 0]  # the properties' momentum P (I ω)
+        for momentum in start_momenta:
+            if not np.any(momentum):  # what the start pole's property refuses
+                raise InvalidStateError("the body is not rotating (zero spin): it has no spin pole.")
+        start_poles = _start_poles(states, user)
+    else:
+        directions, end_momenta, start_momenta, start_poles = [], [], [], []
+        for state, end in zip(states, ends):  # each member's own body (its axes, its moments)
+            body = state.body
+            quaternions, omegas = from_principal(body, end[None, :])
+            directions.append(pole_directions(body, unit_quaternions(np.atleast_2d(quaternions)), omegas)[0])
+            end_momenta.append(((body.moment_values * omegas) @ body.to_principal.T)[0])  # the table's P (I ω)
+            start_momenta.append(state.principal_attitude_and_momentum()[1])  # the properties' momentum
+            start_poles.append(state.angular_momentum_direction)
+        directions = np.array(directions)
     moments = np.array([s.state.body.principal_moments for s in scenes])
     ra, dec, lon, lat = _pole.pole_angles_deg(directions)  # row by row (no BLAS): a member's bits are its own
     values = {"pole_ra": ra, "pole_dec": dec, "pole_lon": lon, "pole_lat": lat}

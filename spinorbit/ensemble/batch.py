@@ -106,17 +106,21 @@ def _survey(leader, plan):
 
 
 def _member_bounds(scenes, survey, kappas):
-    """{name: worst-attitude bound (rad)} of every member: the planner's dropped_torque_bound on the survey."""
-    from spinorbit.scene.bounds import dropped_torque_bound, max_torque_over_a
+    """{name: worst-attitude bound (rad)} of every member: the planner's dropped_torque_bound on the survey,
+    each perturber's for all members at once (:func:`~spinorbit.scene.bounds.dropped_torque_bounds`: every
+    member's value the bits of its own call)."""
+    from spinorbit.scene.bounds import dropped_torque_bounds, max_torque_over_a
 
-    bounds = []
-    for scene, kappa in zip(scenes, kappas):
-        moments = scene.state.body.principal_moments
-        momentum = np.linalg.norm(scene.state.angular_momentum.value) / moments[0]
-        t_end = scene.output_days[-1]
-        bounds.append({name: dropped_torque_bound(days, max_torque_over_a(moments, gm, r), t_end, kappa, momentum)
-                       for name, days, gm, r in survey})
-    return bounds
+    moments = np.array([scene.state.body.principal_moments for scene in scenes])
+    # |L|/A as the planner takes it: np.linalg.norm of the user-axes momentum I ω, over A
+    momenta = np.array([np.linalg.norm(scene.state.body.moment_values * scene.state.angular_velocity.value)
+                        for scene in scenes]) / moments[:, 0]
+    t_end = scenes[0].output_days[-1]
+    columns = {}
+    for name, days, gm, r in survey:
+        torque = max_torque_over_a(moments.T[:, :, None], gm, r)  # (N, samples): each member's moments
+        columns[name] = dropped_torque_bounds(days, torque, t_end, kappas, momenta)
+    return [{name: float(column[m]) for name, column in columns.items()} for m in range(len(scenes))]
 
 
 def _kept_sources(leader, plan):

@@ -121,6 +121,7 @@ __all__ = [
     "attitude_sensitivity",
     "back_reaction_bound",
     "dropped_torque_bound",
+    "dropped_torque_bounds",
     "free_motion_bounds",
     "free_motion_grid",
     "free_motion_torque_bound",
@@ -254,11 +255,19 @@ def dropped_torque_bound(days, torque_over_a, span_end, kappa, momentum_over_a):
     ``days`` (increasing, TDB days) and ``torque_over_a`` (rad/day²) are survey samples; the integrals
     of the module docstring are taken with the trapezoid rule. ``momentum_over_a`` is |L|/A (rad/day).
     """
+    torque = np.asarray(torque_over_a, dtype=float)
+    return float(dropped_torque_bounds(days, torque[None, :], span_end, kappa, momentum_over_a)[0])
+
+
+def dropped_torque_bounds(days, torque_over_a, span_end, kappa, momentum_over_a):
+    """:func:`dropped_torque_bound` of many bodies on one survey: ``torque_over_a`` (N, n) at ``days`` (n,),
+    ``kappa`` and ``momentum_over_a`` scalars or (N,). Returns (N,) bounds (rad), each row's the bits of its
+    own call (the trapezoid sums run along each row)."""
     days = np.asarray(days, dtype=float)
     n = np.asarray(torque_over_a, dtype=float)
     lever = span_end - days
-    drift = _trapezoid(lever * n, days)
-    tilt = _trapezoid(n, days)
+    drift = _trapezoid_rows(lever * n, days)
+    tilt = _trapezoid_rows(n, days)
     return SAFETY * (kappa * drift + 2.0 * tilt / momentum_over_a)
 
 
@@ -551,3 +560,10 @@ def _trapezoid(values, days):
     if days.size < 2:
         return 0.0
     return float(np.sum(0.5 * (values[1:] + values[:-1]) * np.diff(days)))
+
+
+def _trapezoid_rows(values, days):
+    """:func:`_trapezoid` of each row of ``values`` (N, n) (numpy's pairwise sum along each row, as of one row)."""
+    if days.size < 2:
+        return np.zeros(values.shape[0])
+    return np.sum(0.5 * (values[:, 1:] + values[:, :-1]) * np.diff(days), axis=1)

@@ -408,7 +408,7 @@ def measure_stages(ek, rows, repeats=3):
         n = len(scenes)
         ends, _, _ = batch._integrate(plan.integrator, integrate_quaternion_batch, [s.state.body for s in scenes],
                                       y0s, scenes[0].epoch_day, float(scenes[0].output_days[-1]),
-                                      batch._models(moments + moments, sources), np.full(n, plan.rtol),
+                                      batch._models(moments, sources), np.full(n, plan.rtol),
                                       np.full(n, plan.integration_share_rad))
         spent["integration"] += time.process_time() - clock
         clock = time.process_time()

@@ -133,18 +133,26 @@ def _kept_sources(leader, plan):
 
 
 def _models(moments, sources):
-    """Each member's model array: make_model's figure of its moments in front of the group's perturber block
-    (one array copied per member, its figure written in: the bits of make_model for that member)."""
+    """Each member's model array, twice (run and check lanes: rows m and N + m): make_model's figure of its
+    moments in front of the group's perturber block (one array copied per lane, the member's figure written
+    in once: the bits of make_model for that member)."""
     from spinorbit.core.dynamics.equations import make_model
     from spinorbit.core.model.gravity_field import make_body
 
+    n = len(moments)
     first = make_model(moments[0], sources)
-    models = np.empty((len(moments), first.size))
+    models = np.empty((2 * n, first.size))
     models[:] = first
     for m, member in enumerate(moments):
         figure = make_body(member)
-        models[m, :figure.size] = figure
+        models[m, :figure.size] = models[n + m, :figure.size] = figure
     return models
+
+
+def _same_axes(bodies):
+    """Whether every body has the first one's principal axes (then their rows take one vectorised call)."""
+    p = bodies[0].to_principal.tobytes()
+    return all(body.to_principal.tobytes() == p for body in bodies)
 
 
 def _integrate(integrator, function, bodies, y0s, t0, t_end, models, rtols, shares):
@@ -161,6 +169,7 @@ def _integrate(integrator, function, bodies, y0s, t0, t_end, models, rtols, shar
 
     n = len(bodies)
     lowest = RULES[integrator].lowest
+    same_axes = _same_axes(bodies)
     ends, errors, status = np.full((n, 7), np.nan), np.full(n, np.nan), np.zeros(n, dtype=np.int64)
     tolerances = np.array(rtols, dtype=float)
     pending = np.arange(n)
@@ -170,17 +179,20 @@ def _integrate(integrator, function, bodies, y0s, t0, t_end, models, rtols, shar
         lanes = models if k == n else models[np.concatenate([pending, n + pending])]
         both, stats = function(np.concatenate([y0s[pending]] * 2), t0, t_end, lanes,
                                np.concatenate([tolerances[pending], checks]))
-        retry = []
-        for j, m in enumerate(pending):
-            code = int(stats["status"][j]) or int(stats["status"][k + j])
-            if code:
-                status[m] = code
-                continue
-            ends[m] = both[j]
-            errors[m] = float(np.max(attitude_angles(one_way_quaternions(bodies[m], both[j:j + 1]),
-                                                     one_way_quaternions(bodies[m], both[k + j:k + j + 1]))))
-            if not (errors[m] <= ACCEPTED_SHARE * shares[m] or tolerances[m] <= lowest):
-                retry.append(m)
+        codes = np.where(stats["status"][:k] != 0, stats["status"][:k], stats["status"][k:])
+        status[pending] = codes
+        done = np.flatnonzero(codes == 0)  # lanes j of the pending members whose run and check both finished
+        ends[pending[done]] = both[done]
+        if same_axes and done.size:  # every row's attitude and angle as in its own call (row-wise kernels)
+            quaternions = one_way_quaternions(bodies[0], np.concatenate([both[done], both[k + done]]))
+            errors[pending[done]] = attitude_angles(quaternions[:done.size], quaternions[done.size:])
+        else:
+            for j in done:
+                errors[pending[j]] = float(np.max(attitude_angles(one_way_quaternions(bodies[pending[j]], both[j:j + 1]),
+                                                                  one_way_quaternions(bodies[pending[j]],
+                                                                                      both[k + j:k + j + 1]))))
+        retry = [int(m) for m in pending[done]
+                 if not (errors[m] <= ACCEPTED_SHARE * shares[m] or tolerances[m] <= lowest)]
         if not retry:
             break
         pending = np.array(retry)
@@ -233,7 +245,7 @@ def _rows(scenes, ends, normals):
 
     states = [scene.state for scene in scenes]
     p = states[0].body.to_principal
-    if all(state.body.to_principal.tobytes() == p.tobytes() for state in states):
+    if _same_axes([state.body for state in states]):
         values = np.array([state.body.moment_values for state in states])
         quaternions, omegas = from_principal(states[0].body, ends)
         directions = pole_directions(_Stacked(p, values), unit_quaternions(quaternions), omegas)
@@ -352,7 +364,7 @@ def run_group(group, shared, at_days, integrators=None):
     try:
         ends, errors, status = _integrate(plan.integrator, integrators[plan.integrator],
                                           [s.state.body for s in scenes], y0s, t0, float(t_out[-1]),
-                                          _models(moments + moments, sources), rtols, np.maximum(shares, 0.0))
+                                          _models(moments, sources), rtols, np.maximum(shares, 0.0))
     except (ValueError, RuntimeError):  # the batch refused its input as a whole: each member on its own
         return rows, failures, fallback + batch
     ok = [m for m in range(len(batch)) if not status[m]]

@@ -198,25 +198,28 @@ def attitude_sensitivities(states, span_days):
     """
     from spinorbit.core.math.rotations import rotation_angle_between_many
 
+    states = list(states)
+    n = len(states)
     horizons = np.array(SENSITIVITY_HORIZONS) * span_days
     kick = SENSITIVITY_PROBE_RAD / span_days
-    quaternions, momenta, moments = [], [], []
-    for state in states:
-        q, momentum = _flow_start(state, horizons[-1])
-        p, values, omega = state.body.to_principal, state.body.moment_values, state.angular_velocity.value  # rad/day
-        for axis in range(3):  # ω kicked along each user body axis, then the state itself
-            kicked = omega.copy()
-            kicked[axis] += kick
-            momenta.append(p @ (values * kicked))
-        momenta.append(momentum)
-        quaternions += [q] * 4
-        moments += [state.body.principal_moments] * 4
-    flowed = _free_flows(quaternions, momenta, moments, horizons).reshape(len(states), 4, horizons.size, 4)
-    kappas = np.ones(len(states))
-    for m in range(len(states)):
-        for axis in range(3):
-            angles = rotation_angle_between_many(flowed[m, 3], flowed[m, axis])
-            kappas[m] = max(kappas[m], float(np.max(angles / (kick * horizons))))
+    starts = [_flow_start(state, horizons[-1]) for state in states]
+    p = np.array([state.body.to_principal for state in states])
+    values = np.array([state.body.moment_values for state in states])
+    kicked = np.repeat(np.array([state.angular_velocity.value for state in states])[:, None, :], 3, axis=1)  # rad/day
+    kicked[:, range(3), range(3)] += kick  # ω kicked along each user body axis
+    momenta = np.empty((n, 4, 3))
+    momenta[:, :3] = np.matmul(p[:, None], (values[:, None, :] * kicked)[..., None])[..., 0]  # P (I ω) per row
+    momenta[:, 3] = [momentum for _, momentum in starts]  # then the state itself
+    quaternions = np.repeat(np.array([q for q, _ in starts])[:, None, :], 4, axis=1)
+    moments = np.repeat(np.array([state.body.principal_moments for state in states])[:, None, :], 4, axis=1)
+    flowed = _free_flows(quaternions.reshape(-1, 4), momenta.reshape(-1, 3), moments.reshape(-1, 3),
+                         horizons).reshape(n, 4, horizons.size, 4)
+    base = np.ascontiguousarray(np.broadcast_to(flowed[:, 3:], (n, 3, horizons.size, 4))).reshape(-1, 4)
+    angles = rotation_angle_between_many(base, np.ascontiguousarray(flowed[:, :3]).reshape(-1, 4))
+    largest = np.max(angles.reshape(n, 3, horizons.size) / (kick * horizons), axis=2)  # (n, axis)
+    kappas = np.ones(n)
+    for axis in range(3):  # max(κ, largest) in Python's sense: a NaN axis leaves κ as it was
+        kappas = np.where(largest[:, axis] > kappas, largest[:, axis], kappas)
     return kappas
 
 

@@ -17,6 +17,7 @@ from spinorbit.core.integrators.batch_quaternion import integrate_quaternion_bat
 from spinorbit.core.integrators.dop853 import STATUS_NOT_FINITE
 from spinorbit.ensemble import Ensemble, EnsembleError
 from spinorbit.ensemble.apophis import apophis_parameters
+from spinorbit.ensemble import batch
 from spinorbit.scene.bounds import attitude_sensitivities, attitude_sensitivity
 
 GM_EARTH, GM_SUN = 8.887692462968594e-10, 0.0002959122082855911  # DE421, au³/day²
@@ -70,6 +71,15 @@ def test_the_groups_sensitivity_is_the_planners():
     # a member's κ does not depend on the members computed with it: the planner's own, bit for bit
     assert kappas.tolist() == [attitude_sensitivity(s.state, s.span_days) for s in scenes]
     assert np.all(kappas >= 1.0)
+
+
+def test_the_error_estimates_plain_conversion_is_astropys():
+    # the batch route converts with astropy's scale factors as plain floats: the Quantity's values, bit for bit
+    values = np.random.default_rng(11).random(2000) * 10.0 ** np.random.default_rng(12).integers(-15, 1, 2000)
+    for x in values:
+        in_arcsec = (float(x) * u.rad).to(u.arcsec)
+        assert batch.ARCSEC_PER_RAD * float(x) == in_arcsec.to_value(u.arcsec)
+        assert batch.RAD_PER_ARCSEC * (batch.ARCSEC_PER_RAD * float(x)) == in_arcsec.to_value(u.rad)
 
 
 def test_a_process_pool_gives_the_serial_bits_of_the_batch_route(both):

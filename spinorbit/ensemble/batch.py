@@ -60,6 +60,12 @@ __all__ = ["BATCH_INTEGRATORS", "group_key", "run_group"]
 #: whose integrator has none here runs through the per-member route.
 BATCH_INTEGRATORS = {"quaternion": integrate_quaternion_batch}
 
+#: The scale factors of astropy's conversions of the error estimate (rad → arcsec, and back for the
+#: tolerance check): ``(x * u.rad).to(u.arcsec)`` multiplies x by the first, so the plain products are the
+#: Scene's Quantity values bit for bit (tests/test_ensemble_batch.py), without two Quantities per member.
+ARCSEC_PER_RAD = u.rad.to(u.arcsec)
+RAD_PER_ARCSEC = u.arcsec.to(u.rad)
+
 
 def group_key(scene, at_days):
     """What the members of one group share (a hashable key), or None when the scene cannot be batched.
@@ -385,9 +391,9 @@ def run_group(group, shared, at_days, integrators=None):
         index, scene, _ = batch[m]
         sampling = sampling_error_bound(scene.sample_tolerance, kept_bounds[m]) if sampled else 0.0
         # Scene.run's sum and units: parts in run_one_way's order, the estimate in arcsec, met in rad
-        total = (sum({"dropped": used[m], "integration": float(errors[m]), "sampling": sampling,
-                      "back_reaction": plan.back_reaction_rad}.values()) * u.rad).to(u.arcsec)
+        total = ARCSEC_PER_RAD * sum({"dropped": used[m], "integration": float(errors[m]), "sampling": sampling,
+                                      "back_reaction": plan.back_reaction_rad}.values())
         rows[index] = {**{(f"{k}{suffix}" if k in timed else k): v for k, v in row.items()},
-                       "error_estimate": float(total.to_value(u.arcsec)),
-                       "tolerance_met": bool(total.to_value(u.rad) <= tolerance), "route": plan.route}
+                       "error_estimate": float(total), "tolerance_met": bool(RAD_PER_ARCSEC * total <= tolerance),
+                       "route": plan.route}
     return rows, failures, fallback

@@ -73,6 +73,20 @@ def test_the_groups_sensitivity_is_the_planners():
     assert np.all(kappas >= 1.0)
 
 
+def test_a_members_model_lanes_are_make_models_array_of_its_moments():
+    from spinorbit.core import make_model
+
+    scenes = [ek.kepler_member(**row) for row in members(3)]
+    samples = scenes[0].sample_perturbers("user", ["earth", "sun"], scenes[0].sample_tolerance)
+    moments = [s.state.body.principal_moments for s in scenes]
+    models = batch._models(moments, samples.sources())
+    for m, member in enumerate(moments):
+        alone = make_model(member, samples.sources())
+        assert models[m].tobytes() == alone.tobytes() and models[3 + m].tobytes() == alone.tobytes()
+    with pytest.raises(ValueError, match="A ≤ B ≤ C"):
+        batch._models([(1.0, 0.5, 2.0)], samples.sources())
+
+
 def test_the_error_estimates_plain_conversion_is_astropys():
     # the batch route converts with astropy's scale factors as plain floats: the Quantity's values, bit for bit
     values = np.random.default_rng(11).random(2000) * 10.0 ** np.random.default_rng(12).integers(-15, 1, 2000)

@@ -139,19 +139,20 @@ def _kept_sources(leader, plan):
 
 
 def _models(moments, sources):
-    """Each member's model array, twice (run and check lanes: rows m and N + m): make_model's figure of its
-    moments in front of the group's perturber block (one array copied per lane, the member's figure written
-    in once: the bits of make_model for that member)."""
+    """Each member's model array, twice (run and check lanes: rows m and N + m): make_model's array of the
+    first member with each member's principal moments written into the figure's A, B, C slots (make_body
+    stores them as given, and every other figure entry is the group's: the bits of make_model for that
+    member; tests/test_ensemble_batch.py). ValueError, as make_body's, for moments it would refuse."""
     from spinorbit.core.dynamics.equations import make_model
-    from spinorbit.core.model.gravity_field import make_body
+    from spinorbit.core.model.gravity_field import BODY_A, BODY_C
 
-    n = len(moments)
+    moments = np.array(moments, dtype=float)
+    if not (np.all(np.isfinite(moments)) and np.all(moments > 0.0) and np.all(np.diff(moments, axis=1) >= 0.0)):
+        raise ValueError("moments: expected finite positive principal moments A ≤ B ≤ C for every member.")
     first = make_model(moments[0], sources)
-    models = np.empty((2 * n, first.size))
+    models = np.empty((2 * len(moments), first.size))
     models[:] = first
-    for m, member in enumerate(moments):
-        figure = make_body(member)
-        models[m, :figure.size] = models[n + m, :figure.size] = figure
+    models[:, BODY_A:BODY_C + 1] = np.concatenate([moments, moments])
     return models
 
 

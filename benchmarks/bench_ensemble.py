@@ -400,10 +400,11 @@ def measure_stages(ek, rows, repeats=3):
         spent["plan"] += time.process_time() - clock
         clock = time.process_time()
         kappas = attitude_sensitivities([s.state for s in scenes], scenes[0].span_days)
-        batch._member_bounds(scenes, survey, kappas)
+        moments = np.array([s.state.body.principal_moments for s in scenes])
+        momenta = np.array([s.state.body.moment_values * s.state.angular_velocity.value for s in scenes])
+        batch._member_bounds(survey, scenes[0].output_days[-1], moments, momenta, kappas)
         spent["bounds"] += time.process_time() - clock
         clock = time.process_time()
-        moments = [s.state.body.principal_moments for s in scenes]
         y0s = np.array([s.state.core_state() for s in scenes])
         n = len(scenes)
         ends, _, _ = batch._integrate(plan.integrator, integrate_quaternion_batch, [s.state.body for s in scenes],
@@ -412,7 +413,7 @@ def measure_stages(ek, rows, repeats=3):
                                       np.full(n, plan.integration_share_rad))
         spent["integration"] += time.process_time() - clock
         clock = time.process_time()
-        batch._rows(scenes, ends, None)
+        batch._rows(scenes, ends, None, moments, momenta)
         spent["rows"] += time.process_time() - clock
         return spent
 

@@ -111,22 +111,24 @@ def _survey(leader, plan):
     return rows
 
 
-def _member_bounds(scenes, survey, kappas):
+def _member_bounds(survey, t_end, moments, momenta, kappas):
     """{name: worst-attitude bound (rad)} of every member: the planner's dropped_torque_bound on the survey,
     each perturber's for all members at once (:func:`~spinorbit.scene.bounds.dropped_torque_bounds`: every
-    member's value the bits of its own call)."""
+    member's value the bits of its own call). ``moments`` (N, 3) principal, ``momenta`` (N, 3) I ω in user
+    axes (rad/day), ``kappas`` (N,)."""
     from spinorbit.scene.bounds import dropped_torque_bounds, max_torque_over_a
 
-    moments = np.array([scene.state.body.principal_moments for scene in scenes])
-    # |L|/A as the planner takes it: np.linalg.norm of the user-axes momentum I ω, over A
-    momenta = np.array([np.linalg.norm(scene.state.body.moment_values * scene.state.angular_velocity.value)
-                        for scene in scenes]) / moments[:, 0]
-    t_end = scenes[0].output_days[-1]
+    over_a = _row_norms(momenta) / moments[:, 0]  # |L|/A as the planner takes it
     columns = {}
     for name, days, gm, r in survey:
         torque = max_torque_over_a(moments.T[:, :, None], gm, r)  # (N, samples): each member's moments
-        columns[name] = dropped_torque_bounds(days, torque, t_end, kappas, momenta)
-    return [{name: float(column[m]) for name, column in columns.items()} for m in range(len(scenes))]
+        columns[name] = dropped_torque_bounds(days, torque, t_end, kappas, over_a)
+    return [{name: float(column[m]) for name, column in columns.items()} for m in range(len(moments))]
+
+
+def _row_norms(vectors):
+    """np.linalg.norm of each row (N, 3) as of the row alone: √(x·x) with the one-row dot of each."""
+    return np.sqrt(np.matmul(vectors[:, None, :], vectors[:, :, None]))[:, 0, 0]
 
 
 def _kept_sources(leader, plan):
@@ -233,14 +235,14 @@ def _start_poles(states, momenta):
     """RotationState.angular_momentum_direction of every state, its user momenta ``momenta`` (N, 3) given:
     Rᵀ (I ω) / |…| with each row's product and norm the same one-row BLAS calls as the property's."""
     attitudes = np.array([state.attitude_matrix for state in states])
-    inertial = np.matmul(np.swapaxes(attitudes, 1, 2), momenta[:, :, None])  # (3, 3)ᵀ @ (3,) per row
-    norms = np.sqrt(np.matmul(np.swapaxes(inertial, 1, 2), inertial))  # x·x per row, as np.linalg.norm of a vector
-    return (inertial / norms)[:, :, 0]
+    inertial = np.matmul(np.swapaxes(attitudes, 1, 2), momenta[:, :, None])[:, :, 0]  # (3, 3)ᵀ @ (3,) per row
+    return inertial / _row_norms(inertial)[:, None]
 
 
-def _rows(scenes, ends, normals):
+def _rows(scenes, ends, normals, moments, momenta):
     """The outcome values of every member's end state (principal axes) and its initial state, plain values
-    in the outcome units, as the Scene's one-row table and outcome_row would hold them.
+    in the outcome units, as the Scene's one-row table and outcome_row would hold them. ``moments`` (N, 3)
+    principal, ``momenta`` (N, 3) the initial I ω in user axes (rad/day).
 
     Members with the same principal axes (the same P, as in every ensemble of one body's moment ratios)
     take state_table's functions once for all their rows: each row's numbers are its one-row call's (row-wise
@@ -257,12 +259,11 @@ def _rows(scenes, ends, normals):
         quaternions, omegas = from_principal(states[0].body, ends)
         directions = pole_directions(_Stacked(p, values), unit_quaternions(quaternions), omegas)
         end_momenta = np.matmul((values * omegas)[:, None, :], p.T)[:, 0]  # the table's P (I ω), row by row
-        user = values * np.array([state.angular_velocity.value for state in states])  # I ω, rad/day
-        start_momenta = np.matmul(p, user[:, :, None])[:, :, 0]  # the properties' momentum P (I ω)
+        start_momenta = np.matmul(p, momenta[:, :, None])[:, :, 0]  # the properties' momentum P (I ω)
         for momentum in start_momenta:
             if not np.any(momentum):  # what the start pole's property refuses
                 raise InvalidStateError("the body is not rotating (zero spin): it has no spin pole.")
-        start_poles = _start_poles(states, user)
+        start_poles = _start_poles(states, momenta)
     else:
         directions, end_momenta, start_momenta, start_poles = [], [], [], []
         for state, end in zip(states, ends):  # each member's own body (its axes, its moments)
@@ -273,7 +274,6 @@ def _rows(scenes, ends, normals):
             start_momenta.append(state.principal_attitude_and_momentum()[1])  # the properties' momentum
             start_poles.append(state.angular_momentum_direction)
         directions = np.array(directions)
-    moments = np.array([s.state.body.principal_moments for s in scenes])
     ra, dec, lon, lat = _pole.pole_angles_deg(directions)  # row by row (no BLAS): a member's bits are its own
     values = {"pole_ra": ra, "pole_dec": dec, "pole_lon": lon, "pole_lat": lat}
     if normals is not None:
@@ -342,11 +342,14 @@ def run_group(group, shared, at_days, integrators=None):
     group = [m for m, ok in zip(group, fits) if ok]
     if not group:
         return rows, failures, fallback
-    scenes = [s for _, s, _ in group]
-    kappas = attitude_sensitivities([s.state for s in scenes], span)
-    bounds = _member_bounds(scenes, survey, kappas)
-    batch, used, kept_bounds = [], [], []
-    for member, bound in zip(group, bounds):
+    states = [s.state for _, s, _ in group]
+    # each member's plain values, read from its state once: principal moments, I ω (user axes, rad/day)
+    moments = np.array([state.body.principal_moments for state in states])
+    momenta = np.array([state.body.moment_values for state in states]) * np.array(
+        [state.angular_velocity.value for state in states])
+    bounds = _member_bounds(survey, leader.output_days[-1], moments, momenta, attitude_sensitivities(states, span))
+    batch, picked, used, kept_bounds = [], [], [], []
+    for position, (member, bound) in enumerate(zip(group, bounds)):
         dropped = 0.0
         for name in plan.dropped:  # in the plan's order, as it summed them
             dropped += bound[name]
@@ -359,12 +362,13 @@ def run_group(group, shared, at_days, integrators=None):
         for name in plan.kept:
             kept += bound[name]
         batch.append(member)
+        picked.append(position)
         used.append(dropped)
         kept_bounds.append(kept)
     if not batch:
         return rows, failures, fallback
     scenes = [s for _, s, _ in batch]
-    moments = [s.state.body.principal_moments for s in scenes]
+    moments, momenta = moments[picked], momenta[picked]
     shares = np.array([tolerance - d - 0.0 for d in used])  # run_one_way: tolerance − dropped − back-reaction
     rtols = np.array([first_tolerance(plan.integrator, s) for s in shares])
     y0s = np.array([s.state.core_state() for s in scenes])
@@ -382,7 +386,7 @@ def run_group(group, shared, at_days, integrators=None):
     if not ok:
         return rows, failures, fallback
     try:
-        values = _rows([scenes[m] for m in ok], ends[ok], normals)
+        values = _rows([scenes[m] for m in ok], ends[ok], normals, moments[ok], momenta[ok])
     except Exception:  # noqa: BLE001 — a member the vectorised outcome refuses: each on its own Scene
         return rows, failures, fallback + [batch[m] for m in ok]
     suffix = "" if at_days is None else "_t0"  # the one named time is the end

@@ -8,9 +8,10 @@ and dropped, its integrator. Every member of the group then gets, from its own s
 
 - its **bounds**: the worst-attitude bound of every perturber
   (:func:`~spinorbit.scene.bounds.dropped_torque_bound` on the group's shared survey, with the member's
-  |L|/A, moments and attitude sensitivity κ, :func:`~spinorbit.scene.bounds.attitude_sensitivities`: the
-  exact free flow of every member and of its three kicked states in one vectorised call, the planner's κ). The worst-attitude bound is never
-  below the free-motion bound a Scene may take, so a drop it allows is a drop the member may take;
+  |L|/A, moments and attitude sensitivity κ, :func:`~spinorbit.scene.bounds.attitude_sensitivities`:
+  the planner's κ, from the exact free flow of every member and of its three kicked states in one
+  vectorised call). The worst-attitude bound is never below the free-motion bound a Scene may take,
+  so a drop it allows is a drop the member may take;
 - the group's **drops, if they hold for it**: the bounds of the leader's dropped perturbers must fit
   in :data:`~spinorbit.scene.tolerances.DROP_SHARE` × tolerance for this member, else the member runs
   through its own Scene (the per-member route). So does a member whose perturbers together stay below
@@ -149,8 +150,10 @@ def _models(moments, sources):
     from spinorbit.core.model.gravity_field import BODY_A, BODY_C
 
     moments = np.array(moments, dtype=float)
-    if not (np.all(np.isfinite(moments)) and np.all(moments > 0.0) and np.all(np.diff(moments, axis=1) >= 0.0)):
-        raise ValueError("moments: expected finite positive principal moments A ≤ B ≤ C for every member.")
+    good = np.all(np.isfinite(moments) & (moments > 0.0), axis=1) & np.all(np.diff(moments, axis=1) >= 0.0, axis=1)
+    if not np.all(good):
+        raise ValueError(f"moments: expected finite positive principal moments A ≤ B ≤ C for every member; got "
+                         f"{moments[~good][0].tolist()}. Give each member's moments as RigidBody.principal_moments.")
     first = make_model(moments[0], sources)
     models = np.empty((2 * len(moments), first.size))
     models[:] = first
@@ -197,9 +200,9 @@ def _integrate(integrator, function, bodies, y0s, t0, t_end, models, rtols, shar
             errors[pending[done]] = attitude_angles(quaternions[:done.size], quaternions[done.size:])
         else:
             for j in done:
-                errors[pending[j]] = float(np.max(attitude_angles(one_way_quaternions(bodies[pending[j]], both[j:j + 1]),
-                                                                  one_way_quaternions(bodies[pending[j]],
-                                                                                      both[k + j:k + j + 1]))))
+                body = bodies[pending[j]]
+                errors[pending[j]] = float(np.max(attitude_angles(one_way_quaternions(body, both[j:j + 1]),
+                                                                  one_way_quaternions(body, both[k + j:k + j + 1]))))
         retry = [int(m) for m in pending[done]
                  if not (errors[m] <= ACCEPTED_SHARE * shares[m] or tolerances[m] <= lowest)]
         if not retry:

@@ -379,6 +379,7 @@ def measure_stages(ek, rows, repeats=3):
     from spinorbit.core.integrators.batch_quaternion import integrate_quaternion_batch
     from spinorbit.ensemble import batch
     from spinorbit.ensemble.ensemble import build_member
+    from spinorbit.scene.bounds import attitude_sensitivities
     from spinorbit.scene.sampling import SharedSamples
 
     shared = SharedSamples()  # what a worker's chunk holds once the orbit is sampled
@@ -398,20 +399,21 @@ def measure_stages(ek, rows, repeats=3):
             sources, _, _ = batch._kept_sources(scenes[0], plan)
         spent["plan"] += time.process_time() - clock
         clock = time.process_time()
-        kappas = batch.group_sensitivities([s.state for s in scenes], scenes[0].span_days)
-        batch._member_bounds(scenes, survey, kappas)
+        kappas = attitude_sensitivities([s.state for s in scenes], scenes[0].span_days)
+        moments = np.array([s.state.body.principal_moments for s in scenes])
+        momenta = np.array([s.state.body.moment_values * s.state.angular_velocity.value for s in scenes])
+        batch._member_bounds(survey, scenes[0].output_days[-1], moments, momenta, kappas)
         spent["bounds"] += time.process_time() - clock
         clock = time.process_time()
-        moments = [s.state.body.principal_moments for s in scenes]
         y0s = np.array([s.state.core_state() for s in scenes])
         n = len(scenes)
         ends, _, _ = batch._integrate(plan.integrator, integrate_quaternion_batch, [s.state.body for s in scenes],
                                       y0s, scenes[0].epoch_day, float(scenes[0].output_days[-1]),
-                                      batch._models(moments + moments, sources), np.full(n, plan.rtol),
+                                      batch._models(moments, sources), np.full(n, plan.rtol),
                                       np.full(n, plan.integration_share_rad))
         spent["integration"] += time.process_time() - clock
         clock = time.process_time()
-        batch._rows(scenes, ends, None)
+        batch._rows(scenes, ends, None, moments, momenta)
         spent["rows"] += time.process_time() - clock
         return spent
 

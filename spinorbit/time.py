@@ -148,9 +148,10 @@ def tdb_day_and_fraction(time: Time) -> tuple[np.ndarray | float, np.ndarray | f
     tdb = _convert(_check_time(time), "tdb")
     # astropy keeps jd1 integer-valued (or half-integer) and |jd2| ≤ 0.5 d; jd1 − J2000 is an exact
     # difference of integers. Re-splitting with round() moves only exactly representable values.
-    offset = tdb.jd1 - J2000_JD_TDB
-    day = np.round(offset + tdb.jd2)
-    fraction = (offset - day) + tdb.jd2
+    jd1, jd2 = tdb.jd1, tdb.jd2  # each read of these properties costs ~10 µs (astropy reshapes a view): once
+    offset = jd1 - J2000_JD_TDB
+    day = np.round(offset + jd2)
+    fraction = (offset - day) + jd2
     if np.ndim(day) == 0:
         return float(day), float(fraction)
     return day, fraction

@@ -17,17 +17,14 @@ from spinorbit.core.integrators.batch_quaternion import integrate_quaternion_bat
 from spinorbit.core.integrators.dop853 import STATUS_NOT_FINITE
 from spinorbit.ensemble import Ensemble, EnsembleError
 from spinorbit.ensemble.apophis import apophis_parameters
-from spinorbit.ensemble.batch import group_sensitivities
-from spinorbit.scene.bounds import attitude_sensitivity
+from spinorbit.ensemble import batch
+from spinorbit.scene.bounds import attitude_sensitivities, attitude_sensitivity
 
 GM_EARTH, GM_SUN = 8.887692462968594e-10, 0.0002959122082855911  # DE421, au³/day²
 EARTH_STATE = np.array([2.5e-4, 0.3e-4, -0.2e-4, -0.9e-3, 4.0e-3, 0.3e-3])  # 37 000 km, 7.1 km/s (au, au/day)
 SUN_STATE = np.array([-0.6, -0.75, 0.1, 0.0135, -0.0105, 0.0008])
 FLOAT_COLUMNS = ("energy_ratio", "P_psi", "P_phi", "sidereal_period", "pole_ra", "pole_dec", "pole_lon", "pole_lat",
                  "pole_shift", "P_psi_initial", "P_phi_initial", "sidereal_period_initial", "energy_ratio_initial")
-#: κ of the batch route comes from a vectorised flow: equal to attitude_sensitivity's to rounding (measured
-#: 0 and a few ulps); it enters the error estimate through the sampling part only here.
-KAPPA_RTOL = 1e-12
 
 
 def orbits():
@@ -63,18 +60,40 @@ def test_the_batch_rows_are_the_per_member_rows(both):
     # the last bit (the batch DOP853 is the scalar one per lane), and so is every column computed from it
     for name in FLOAT_COLUMNS + ("mode", "route", "tolerance_met"):
         assert columns(batch, name).tobytes() == columns(member, name).tobytes(), name
-    # the error estimate: the same run and check, the sampling part from the vectorised κ
-    assert np.allclose(columns(batch, "error_estimate"), columns(member, "error_estimate"), rtol=KAPPA_RTOL, atol=0)
+    # the error estimate: the same run and check, the sampling part from the planner's κ
+    assert columns(batch, "error_estimate").tobytes() == columns(member, "error_estimate").tobytes()
     assert np.all(batch["tolerance_met"])
 
 
-def test_the_vectorised_sensitivity_is_the_planners():
+def test_the_groups_sensitivity_is_the_planners():
     scenes = [ek.kepler_member(**row) for row in members(4)]
-    kappas = group_sensitivities([s.state for s in scenes], scenes[0].span_days)
-    alone = [attitude_sensitivity(s.state, s.span_days) for s in scenes]
-    assert np.allclose(kappas, alone, rtol=KAPPA_RTOL, atol=0)
-    # a member's κ does not depend on the members computed with it
-    assert group_sensitivities([scenes[2].state], scenes[0].span_days)[0] == kappas[2]
+    kappas = attitude_sensitivities([s.state for s in scenes], scenes[0].span_days)
+    # a member's κ does not depend on the members computed with it: the planner's own, bit for bit
+    assert kappas.tolist() == [attitude_sensitivity(s.state, s.span_days) for s in scenes]
+    assert np.all(kappas >= 1.0)
+
+
+def test_a_members_model_lanes_are_make_models_array_of_its_moments():
+    from spinorbit.core import make_model
+
+    scenes = [ek.kepler_member(**row) for row in members(3)]
+    samples = scenes[0].sample_perturbers("user", ["earth", "sun"], scenes[0].sample_tolerance)
+    moments = [s.state.body.principal_moments for s in scenes]
+    models = batch._models(moments, samples.sources())
+    for m, member in enumerate(moments):
+        alone = make_model(member, samples.sources())
+        assert models[m].tobytes() == alone.tobytes() and models[3 + m].tobytes() == alone.tobytes()
+    with pytest.raises(ValueError, match="A ≤ B ≤ C"):
+        batch._models([(1.0, 0.5, 2.0)], samples.sources())
+
+
+def test_the_error_estimates_plain_conversion_is_astropys():
+    # the batch route converts with astropy's scale factors as plain floats: the Quantity's values, bit for bit
+    values = np.random.default_rng(11).random(2000) * 10.0 ** np.random.default_rng(12).integers(-15, 1, 2000)
+    for x in values:
+        in_arcsec = (float(x) * u.rad).to(u.arcsec)
+        assert batch.ARCSEC_PER_RAD * float(x) == in_arcsec.to_value(u.arcsec)
+        assert batch.RAD_PER_ARCSEC * (batch.ARCSEC_PER_RAD * float(x)) == in_arcsec.to_value(u.rad)
 
 
 def test_a_process_pool_gives_the_serial_bits_of_the_batch_route(both):

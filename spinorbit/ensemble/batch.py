@@ -8,9 +8,10 @@ and dropped, its integrator. Every member of the group then gets, from its own s
 
 - its **bounds**: the worst-attitude bound of every perturber
   (:func:`~spinorbit.scene.bounds.dropped_torque_bound` on the group's shared survey, with the member's
-  |L|/A, moments and attitude sensitivity κ, :func:`group_sensitivities`: the exact free flow of the
-  member and of its three kicked states in one vectorised call). The worst-attitude bound is never
-  below the free-motion bound a Scene may take, so a drop it allows is a drop the member may take;
+  |L|/A, moments and attitude sensitivity κ, :func:`~spinorbit.scene.bounds.attitude_sensitivities`:
+  the planner's κ, from the exact free flow of every member and of its three kicked states in one
+  vectorised call). The worst-attitude bound is never below the free-motion bound a Scene may take,
+  so a drop it allows is a drop the member may take;
 - the group's **drops, if they hold for it**: the bounds of the leader's dropped perturbers must fit
   in :data:`~spinorbit.scene.tolerances.DROP_SHARE` × tolerance for this member, else the member runs
   through its own Scene (the per-member route). So does a member whose perturbers together stay below
@@ -34,7 +35,7 @@ perturber block), and the outcome row is computed from the core end state direct
 Where the member's own plan would take the group's decisions (the same kept perturbers and
 integrator; always when the group drops nothing, as in the Apophis encounter), its integration is
 the Scene's to the last bit (the batch DOP853 is the scalar one per lane) and so are its outcome
-columns; its error estimate differs from the Scene's by the rounding of κ only. Where the leader's
+columns, and so is its error estimate (the same κ, bounds, run and check). Where the leader's
 plan differs from the member's own (a member that would drop a perturber the leader keeps, or take
 the Taylor method), the row is the group plan's, whose error estimate holds for the member all the
 same: it is made of the member's own bounds and its own a posteriori check. Which members ran where
@@ -53,12 +54,18 @@ from astropy import units as u
 
 from spinorbit.core.integrators.batch_quaternion import integrate_quaternion_batch
 
-__all__ = ["BATCH_INTEGRATORS", "group_key", "group_sensitivities", "run_group"]
+__all__ = ["BATCH_INTEGRATORS", "group_key", "run_group"]
 
 #: The batch integrator of each plan integrator: a function with integrate_quaternion_batch's signature
 #: ``(y0s, t0, t_end, models, rtol, ...) -> (end states (N, 7), stats dict of (N,) arrays)``. A plan
 #: whose integrator has none here runs through the per-member route.
 BATCH_INTEGRATORS = {"quaternion": integrate_quaternion_batch}
+
+#: The scale factors of astropy's conversions of the error estimate (rad → arcsec, and back for the
+#: tolerance check): ``(x * u.rad).to(u.arcsec)`` multiplies x by the first, so the plain products are the
+#: Scene's Quantity values bit for bit (tests/test_ensemble_batch.py), without two Quantities per member.
+ARCSEC_PER_RAD = u.rad.to(u.arcsec)
+RAD_PER_ARCSEC = u.arcsec.to(u.rad)
 
 
 def group_key(scene, at_days):
@@ -79,47 +86,6 @@ def group_key(scene, at_days):
     return (id(scene.orbit), tuple(scene.named), tuple(id(p) for p in scene.fixed), tuple(id(p) for p in scene.moving),
             float(scene.epoch_day), float(scene.output_days[-1]), scene.tolerance_rad, scene.sample_tolerance,
             tuple(scene.quantities), scene.integrator)
-
-
-def group_sensitivities(states, span_days):
-    """κ of :func:`spinorbit.scene.bounds.attitude_sensitivity` for many states, in one vectorised flow.
-
-    The same probe (ω kicked along each user body axis by ``SENSITIVITY_PROBE_RAD / span``, the
-    attitude change per unit |δω|·τ at the horizons ``SENSITIVITY_HORIZONS`` × span, at least 1) on the
-    exact free flow of every member and its three kicked states at once
-    (:func:`spinorbit.core.free_motion.members.free_members`). The angle between two attitudes is the
-    same in principal and user axes, so it is taken between the principal-axis attitudes; the values
-    agree with the per-state function to rounding.
-    """
-    from spinorbit.core.free_motion.members import free_members
-    from spinorbit.core.math.rotations import attitude_to_quat, rotation_angle_between_many
-    from spinorbit.scene.bounds import SENSITIVITY_HORIZONS, SENSITIVITY_PROBE_RAD
-
-    horizons = np.array(SENSITIVITY_HORIZONS) * span_days
-    kick = SENSITIVITY_PROBE_RAD / span_days
-    quaternions, momenta, moments = [], [], []
-    for state in states:
-        attitude, momentum = state.principal_attitude_and_momentum()
-        p, values, omega = state.body.to_principal, state.body.moment_values, state.angular_velocity.value  # rad/day
-        q = attitude_to_quat(np.ascontiguousarray(attitude))
-        for axis in range(4):  # the state, then its ω kicked along each user axis (attitude_sensitivity's kicks)
-            kicked = omega.copy()
-            if axis < 3:
-                kicked[axis] += kick
-            quaternions.append(q)
-            momenta.append(momentum if axis == 3 else p @ (values * kicked))
-            moments.append(state.body.principal_moments)
-    n = len(states)
-    elapsed = np.broadcast_to(horizons, (4 * n, horizons.size))
-    *_, flowed, _ = free_members(np.array(quaternions), np.array(momenta), np.array(moments, dtype=float), elapsed)
-    flowed = flowed.reshape(n, 4, horizons.size, 4)
-    kappas = np.ones(n)
-    for m in range(n):
-        base = np.ascontiguousarray(flowed[m, 3])
-        for axis in range(3):
-            angles = rotation_angle_between_many(base, np.ascontiguousarray(flowed[m, axis]))
-            kappas[m] = max(kappas[m], float(np.max(angles / (kick * horizons))))
-    return kappas
 
 
 def _survey(leader, plan):
@@ -146,18 +112,24 @@ def _survey(leader, plan):
     return rows
 
 
-def _member_bounds(scenes, survey, kappas):
-    """{name: worst-attitude bound (rad)} of every member: the planner's dropped_torque_bound on the survey."""
-    from spinorbit.scene.bounds import dropped_torque_bound, max_torque_over_a
+def _member_bounds(survey, t_end, moments, momenta, kappas):
+    """{name: worst-attitude bound (rad)} of every member: the planner's dropped_torque_bound on the survey,
+    each perturber's for all members at once (:func:`~spinorbit.scene.bounds.dropped_torque_bounds`: every
+    member's value the bits of its own call). ``moments`` (N, 3) principal, ``momenta`` (N, 3) I ω in user
+    axes (rad/day), ``kappas`` (N,)."""
+    from spinorbit.scene.bounds import dropped_torque_bounds, max_torque_over_a
 
-    bounds = []
-    for scene, kappa in zip(scenes, kappas):
-        moments = scene.state.body.principal_moments
-        momentum = np.linalg.norm(scene.state.angular_momentum.value) / moments[0]
-        t_end = scene.output_days[-1]
-        bounds.append({name: dropped_torque_bound(days, max_torque_over_a(moments, gm, r), t_end, kappa, momentum)
-                       for name, days, gm, r in survey})
-    return bounds
+    over_a = _row_norms(momenta) / moments[:, 0]  # |L|/A as the planner takes it
+    columns = {}
+    for name, days, gm, r in survey:
+        torque = max_torque_over_a(moments.T[:, :, None], gm, r)  # (N, samples): each member's moments
+        columns[name] = dropped_torque_bounds(days, torque, t_end, kappas, over_a)
+    return [{name: float(column[m]) for name, column in columns.items()} for m in range(len(moments))]
+
+
+def _row_norms(vectors):
+    """np.linalg.norm of each row (N, 3) as of the row alone: √(x·x) with the one-row dot of each."""
+    return np.sqrt(np.matmul(vectors[:, None, :], vectors[:, :, None]))[:, 0, 0]
 
 
 def _kept_sources(leader, plan):
@@ -170,18 +142,29 @@ def _kept_sources(leader, plan):
 
 
 def _models(moments, sources):
-    """Each member's model array: make_model's figure of its moments in front of the group's perturber block
-    (one array copied per member, its figure written in: the bits of make_model for that member)."""
+    """Each member's model array, twice (run and check lanes: rows m and N + m): make_model's array of the
+    first member with each member's principal moments written into the figure's A, B, C slots (make_body
+    stores them as given, and every other figure entry is the group's: the bits of make_model for that
+    member; tests/test_ensemble_batch.py). ValueError, as make_body's, for moments it would refuse."""
     from spinorbit.core.dynamics.equations import make_model
-    from spinorbit.core.model.gravity_field import make_body
+    from spinorbit.core.model.gravity_field import BODY_A, BODY_C
 
+    moments = np.array(moments, dtype=float)
+    good = np.all(np.isfinite(moments) & (moments > 0.0), axis=1) & np.all(np.diff(moments, axis=1) >= 0.0, axis=1)
+    if not np.all(good):
+        raise ValueError(f"moments: expected finite positive principal moments A ≤ B ≤ C for every member; got "
+                         f"{moments[~good][0].tolist()}. Give each member's moments as RigidBody.principal_moments.")
     first = make_model(moments[0], sources)
-    models = np.empty((len(moments), first.size))
+    models = np.empty((2 * len(moments), first.size))
     models[:] = first
-    for m, member in enumerate(moments):
-        figure = make_body(member)
-        models[m, :figure.size] = figure
+    models[:, BODY_A:BODY_C + 1] = np.concatenate([moments, moments])
     return models
+
+
+def _same_axes(bodies):
+    """Whether every body has the first one's principal axes (then their rows take one vectorised call)."""
+    p = bodies[0].to_principal.tobytes()
+    return all(body.to_principal.tobytes() == p for body in bodies)
 
 
 def _integrate(integrator, function, bodies, y0s, t0, t_end, models, rtols, shares):
@@ -198,6 +181,7 @@ def _integrate(integrator, function, bodies, y0s, t0, t_end, models, rtols, shar
 
     n = len(bodies)
     lowest = RULES[integrator].lowest
+    same_axes = _same_axes(bodies)
     ends, errors, status = np.full((n, 7), np.nan), np.full(n, np.nan), np.zeros(n, dtype=np.int64)
     tolerances = np.array(rtols, dtype=float)
     pending = np.arange(n)
@@ -207,17 +191,20 @@ def _integrate(integrator, function, bodies, y0s, t0, t_end, models, rtols, shar
         lanes = models if k == n else models[np.concatenate([pending, n + pending])]
         both, stats = function(np.concatenate([y0s[pending]] * 2), t0, t_end, lanes,
                                np.concatenate([tolerances[pending], checks]))
-        retry = []
-        for j, m in enumerate(pending):
-            code = int(stats["status"][j]) or int(stats["status"][k + j])
-            if code:
-                status[m] = code
-                continue
-            ends[m] = both[j]
-            errors[m] = float(np.max(attitude_angles(one_way_quaternions(bodies[m], both[j:j + 1]),
-                                                     one_way_quaternions(bodies[m], both[k + j:k + j + 1]))))
-            if not (errors[m] <= ACCEPTED_SHARE * shares[m] or tolerances[m] <= lowest):
-                retry.append(m)
+        codes = np.where(stats["status"][:k] != 0, stats["status"][:k], stats["status"][k:])
+        status[pending] = codes
+        done = np.flatnonzero(codes == 0)  # lanes j of the pending members whose run and check both finished
+        ends[pending[done]] = both[done]
+        if same_axes and done.size:  # every row's attitude and angle as in its own call (row-wise kernels)
+            quaternions = one_way_quaternions(bodies[0], np.concatenate([both[done], both[k + done]]))
+            errors[pending[done]] = attitude_angles(quaternions[:done.size], quaternions[done.size:])
+        else:
+            for j in done:
+                body = bodies[pending[j]]
+                errors[pending[j]] = float(np.max(attitude_angles(one_way_quaternions(body, both[j:j + 1]),
+                                                                  one_way_quaternions(body, both[k + j:k + j + 1]))))
+        retry = [int(m) for m in pending[done]
+                 if not (errors[m] <= ACCEPTED_SHARE * shares[m] or tolerances[m] <= lowest)]
         if not retry:
             break
         pending = np.array(retry)
@@ -239,23 +226,57 @@ def _motion_summaries(momenta, moments):
     return [MODE_NAMES[int(c)] for c in modes], ratios, p_psi * hours, p_phi * hours, p_sidereal * hours
 
 
-def _rows(scenes, ends, normals):
+class _Stacked:
+    """The members' bodies as one body for state_table's row functions: their shared principal axes and each
+    row's own moments (rows (N, 3); those functions take the moments elementwise, row by row)."""
+
+    def __init__(self, to_principal, moment_values):
+        self.to_principal, self.moment_values = to_principal, moment_values
+
+
+def _start_poles(states, momenta):
+    """RotationState.angular_momentum_direction of every state, its user momenta ``momenta`` (N, 3) given:
+    Rᵀ (I ω) / |…| with each row's product and norm the same one-row BLAS calls as the property's."""
+    attitudes = np.array([state.attitude_matrix for state in states])
+    inertial = np.matmul(np.swapaxes(attitudes, 1, 2), momenta[:, :, None])[:, :, 0]  # (3, 3)ᵀ @ (3,) per row
+    return inertial / _row_norms(inertial)[:, None]
+
+
+def _rows(scenes, ends, normals, moments, momenta):
     """The outcome values of every member's end state (principal axes) and its initial state, plain values
-    in the outcome units, as the Scene's one-row table and outcome_row would hold them."""
+    in the outcome units, as the Scene's one-row table and outcome_row would hold them. ``moments`` (N, 3)
+    principal, ``momenta`` (N, 3) the initial I ω in user axes (rad/day).
+
+    Members with the same principal axes (the same P, as in every ensemble of one body's moment ratios)
+    take state_table's functions once for all their rows: each row's numbers are its one-row call's (row-wise
+    kernels and one BLAS call per row). Others are taken member by member.
+    """
     from spinorbit import pole as _pole
     from spinorbit.state import InvalidStateError
     from spinorbit.state_table import from_principal, pole_directions, unit_quaternions
 
-    directions, end_momenta, start_momenta, start_poles = [], [], [], []
-    for scene, end in zip(scenes, ends):  # each member's own body (its axes, its moments)
-        body = scene.state.body
-        quaternions, omegas = from_principal(body, end[None, :])
-        directions.append(pole_directions(body, unit_quaternions(np.atleast_2d(quaternions)), omegas)[0])
-        end_momenta.append(((body.moment_values * omegas) @ body.to_principal.T)[0])  # the table's P (I ω)
-        start_momenta.append(scene.state.principal_attitude_and_momentum()[1])  # the properties' momentum
-        start_poles.append(scene.state.angular_momentum_direction)
-    directions = np.array(directions)
-    moments = np.array([s.state.body.principal_moments for s in scenes])
+    states = [scene.state for scene in scenes]
+    p = states[0].body.to_principal
+    if _same_axes([state.body for state in states]):
+        values = np.array([state.body.moment_values for state in states])
+        quaternions, omegas = from_principal(states[0].body, ends)
+        directions = pole_directions(_Stacked(p, values), unit_quaternions(quaternions), omegas)
+        end_momenta = np.matmul((values * omegas)[:, None, :], p.T)[:, 0]  # the table's P (I ω), row by row
+        start_momenta = np.matmul(p, momenta[:, :, None])[:, :, 0]  # the properties' momentum P (I ω)
+        for momentum in start_momenta:
+            if not np.any(momentum):  # what the start pole's property refuses
+                raise InvalidStateError("the body is not rotating (zero spin): it has no spin pole.")
+        start_poles = _start_poles(states, momenta)
+    else:
+        directions, end_momenta, start_momenta, start_poles = [], [], [], []
+        for state, end in zip(states, ends):  # each member's own body (its axes, its moments)
+            body = state.body
+            quaternions, omegas = from_principal(body, end[None, :])
+            directions.append(pole_directions(body, unit_quaternions(np.atleast_2d(quaternions)), omegas)[0])
+            end_momenta.append(((body.moment_values * omegas) @ body.to_principal.T)[0])  # the table's P (I ω)
+            start_momenta.append(state.principal_attitude_and_momentum()[1])  # the properties' momentum
+            start_poles.append(state.angular_momentum_direction)
+        directions = np.array(directions)
     ra, dec, lon, lat = _pole.pole_angles_deg(directions)  # row by row (no BLAS): a member's bits are its own
     values = {"pole_ra": ra, "pole_dec": dec, "pole_lon": lon, "pole_lat": lat}
     if normals is not None:
@@ -288,6 +309,7 @@ def run_group(group, shared, at_days, integrators=None):
     """
     from spinorbit.coupling.one_way import one_way_days
     from spinorbit.core.integrators.dop853 import STATUS_MESSAGES, IntegrationError
+    from spinorbit.scene.bounds import attitude_sensitivities
     from spinorbit.scene.routes import scene_orbit_normals
     from spinorbit.scene.tolerances import DROP_SHARE, first_tolerance, sampling_error_bound
     from spinorbit.state import MAX_FLOW_PHASE
@@ -323,11 +345,14 @@ def run_group(group, shared, at_days, integrators=None):
     group = [m for m, ok in zip(group, fits) if ok]
     if not group:
         return rows, failures, fallback
-    scenes = [s for _, s, _ in group]
-    kappas = group_sensitivities([s.state for s in scenes], span)
-    bounds = _member_bounds(scenes, survey, kappas)
-    batch, used, kept_bounds = [], [], []
-    for member, bound in zip(group, bounds):
+    states = [s.state for _, s, _ in group]
+    # each member's plain values, read from its state once: principal moments, I ω (user axes, rad/day)
+    moments = np.array([state.body.principal_moments for state in states])
+    momenta = np.array([state.body.moment_values for state in states]) * np.array(
+        [state.angular_velocity.value for state in states])
+    bounds = _member_bounds(survey, leader.output_days[-1], moments, momenta, attitude_sensitivities(states, span))
+    batch, picked, used, kept_bounds = [], [], [], []
+    for position, (member, bound) in enumerate(zip(group, bounds)):
         dropped = 0.0
         for name in plan.dropped:  # in the plan's order, as it summed them
             dropped += bound[name]
@@ -340,19 +365,20 @@ def run_group(group, shared, at_days, integrators=None):
         for name in plan.kept:
             kept += bound[name]
         batch.append(member)
+        picked.append(position)
         used.append(dropped)
         kept_bounds.append(kept)
     if not batch:
         return rows, failures, fallback
     scenes = [s for _, s, _ in batch]
-    moments = [s.state.body.principal_moments for s in scenes]
+    moments, momenta = moments[picked], momenta[picked]
     shares = np.array([tolerance - d - 0.0 for d in used])  # run_one_way: tolerance − dropped − back-reaction
     rtols = np.array([first_tolerance(plan.integrator, s) for s in shares])
     y0s = np.array([s.state.core_state() for s in scenes])
     try:
         ends, errors, status = _integrate(plan.integrator, integrators[plan.integrator],
                                           [s.state.body for s in scenes], y0s, t0, float(t_out[-1]),
-                                          _models(moments + moments, sources), rtols, np.maximum(shares, 0.0))
+                                          _models(moments, sources), rtols, np.maximum(shares, 0.0))
     except (ValueError, RuntimeError):  # the batch refused its input as a whole: each member on its own
         return rows, failures, fallback + batch
     ok = [m for m in range(len(batch)) if not status[m]]
@@ -363,7 +389,7 @@ def run_group(group, shared, at_days, integrators=None):
     if not ok:
         return rows, failures, fallback
     try:
-        values = _rows([scenes[m] for m in ok], ends[ok], normals)
+        values = _rows([scenes[m] for m in ok], ends[ok], normals, moments[ok], momenta[ok])
     except Exception:  # noqa: BLE001 — a member the vectorised outcome refuses: each on its own Scene
         return rows, failures, fallback + [batch[m] for m in ok]
     suffix = "" if at_days is None else "_t0"  # the one named time is the end
@@ -373,9 +399,9 @@ def run_group(group, shared, at_days, integrators=None):
         index, scene, _ = batch[m]
         sampling = sampling_error_bound(scene.sample_tolerance, kept_bounds[m]) if sampled else 0.0
         # Scene.run's sum and units: parts in run_one_way's order, the estimate in arcsec, met in rad
-        total = (sum({"dropped": used[m], "integration": float(errors[m]), "sampling": sampling,
-                      "back_reaction": plan.back_reaction_rad}.values()) * u.rad).to(u.arcsec)
+        total = ARCSEC_PER_RAD * sum({"dropped": used[m], "integration": float(errors[m]), "sampling": sampling,
+                                      "back_reaction": plan.back_reaction_rad}.values())
         rows[index] = {**{(f"{k}{suffix}" if k in timed else k): v for k, v in row.items()},
-                       "error_estimate": float(total.to_value(u.arcsec)),
-                       "tolerance_met": bool(total.to_value(u.rad) <= tolerance), "route": plan.route}
+                       "error_estimate": float(total), "tolerance_met": bool(RAD_PER_ARCSEC * total <= tolerance),
+                       "route": plan.route}
     return rows, failures, fallback

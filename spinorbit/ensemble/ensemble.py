@@ -27,7 +27,7 @@ import time as _time
 
 import numpy as np
 from astropy import units as u
-from astropy.table import MaskedColumn, QTable
+from astropy.table import Column, MaskedColumn, QTable
 from astropy.utils.masked import Masked
 
 from spinorbit.ensemble.errors import EnsembleError, EnsembleInterrupted
@@ -321,6 +321,23 @@ class Ensemble:
         row = self.parameters[index]
         return {name: _plain_value(row[name]) for name in self.parameters.colnames if name not in SEED_COLUMNS}
 
+    def _plain_columns(self):
+        """{name: every member's value as :meth:`member_parameters` gives it}, of every column (seeds too),
+        taken column by column once (a table row per member costs more than its member's plan share)."""
+        columns = {}
+        for name in self.parameters.colnames:
+            column = self.parameters[name]
+            if type(column) is Column and column.ndim == 1 and column.dtype.kind in "biufU":
+                columns[name] = column.tolist()  # numpy's item() of each element, as _plain_value takes it
+            else:
+                columns[name] = [_plain_value(column[i]) for i in range(len(column))]
+        return columns
+
+    def _members_of(self, indices, columns):
+        """[(index, make_scene's keyword arguments)] of ``indices`` from :meth:`_plain_columns`."""
+        names = [name for name in columns if name not in SEED_COLUMNS]
+        return [(i, {name: columns[name][i] for name in names}) for i in indices]
+
     @property
     def fingerprint(self):
         """SHA-256 of what fixes the results: make_scene's name, every parameter's bits, chunk size, times."""
@@ -333,10 +350,10 @@ class Ensemble:
             digest.update(f"route={self.route}|{names}|".encode())
         if self.at_days is not None:
             digest.update(self.at_days.tobytes())
+        columns = self._plain_columns()
         for index in range(self.n_members):
-            row = self.parameters[index]
-            digest.update("|".join(f"{name}={_fingerprint_text(_plain_value(row[name]))}"
-                                   for name in self.parameters.colnames).encode())
+            digest.update("|".join(f"{name}={_fingerprint_text(values[index])}"
+                                   for name, values in columns.items()).encode())
         return digest.hexdigest()
 
     @property
@@ -359,7 +376,7 @@ class Ensemble:
         return restored
 
     def _split(self, members):
-        """(in-process rows, in-process failures, members to run, their Scenes) of a list of member indices.
+        """(in-process rows, in-process failures, members to run, their Scenes) of [(index, parameters)].
 
         Every member is built here; the torque-free ones are evaluated at once (one vectorised call),
         the others are returned as (index, parameters) with their Scenes ``{index: Scene}`` (used when
@@ -367,8 +384,7 @@ class Ensemble:
         """
         rows, failures, shipped, scenes = {}, {}, [], {}
         free = []
-        for index in members:
-            parameters = self.member_parameters(index)
+        for index, parameters in members:
             try:
                 scene = build_member(self.make_scene, parameters)
             except Exception as error:  # noqa: BLE001 — recorded like a worker's failure
@@ -444,12 +460,13 @@ class Ensemble:
             classify_here = pool is None or (bool(pending) and not keep_tables
                                              and self._first_is_torque_free(pending[0]))
             partial, futures = {}, {}
+            columns = self._plain_columns() if pending else {}
             for chunk in pending:
                 members = self.chunk_members(chunk)
                 if keep_tables or not classify_here:
-                    rows, failures, ship, scenes = {}, {}, [(i, self.member_parameters(i)) for i in members], {}
+                    rows, failures, ship, scenes = {}, {}, self._members_of(members, columns), {}
                 else:
-                    rows, failures, ship, scenes = self._split(members)
+                    rows, failures, ship, scenes = self._split(self._members_of(members, columns))
                 stats["members_in_process"] += len(members) - len(ship)
                 stats["members_run"] += len(members)
                 if not ship:
@@ -502,7 +519,7 @@ class Ensemble:
         results = []
         with open_executor(executor) as (pool, description):
             for index in indices:  # each alone, by the same path as in run(): torque-free ones in this process
-                rows, failures, ship, scenes = self._split([index])
+                rows, failures, ship, scenes = self._split([(index, self.member_parameters(index))])
                 if ship:
                     job = (pool.submit(run_chunk, self.make_scene, ship, self.at_days, False, None, self.route,
                                        self.batch_integrators) if pool is not None else None)

@@ -117,9 +117,11 @@ __all__ = [
     "FreeMotion",
     "action_changes",
     "action_sensitivities",
+    "attitude_sensitivities",
     "attitude_sensitivity",
     "back_reaction_bound",
     "dropped_torque_bound",
+    "dropped_torque_bounds",
     "free_motion_bounds",
     "free_motion_grid",
     "free_motion_torque_bound",
@@ -180,23 +182,74 @@ def attitude_sensitivity(state, span_days):
     Three exact propagations of ``state`` with ω kicked by δ along each body axis, compared with the
     unkicked one at the horizons τ = :data:`SENSITIVITY_HORIZONS` × ``span_days``. δ is chosen so
     that δ·span ≈ :data:`SENSITIVITY_PROBE_RAD`. Returns at least 1 (a uniform rotation's κ).
+    :func:`attitude_sensitivities` of the one state.
+    """
+    return float(attitude_sensitivities([state], span_days)[0])
+
+
+def attitude_sensitivities(states, span_days):
+    """κ of :func:`attitude_sensitivity` for many states: every state and its three kicked states in one
+    vectorised exact flow (:func:`spinorbit.core.free_motion.members.free_flow_each`).
+
+    The angle between two attitudes is the same in principal and user axes, so it is taken between the
+    principal-axis attitudes. A state's κ depends on its own flows only: the same bits alone and among
+    any others (the ensemble's batch route takes a group's κ from one call). InvalidStateError for a
+    state whose flow over the span would leave the free flow's domain.
     """
     from spinorbit.core.math.rotations import rotation_angle_between_many
-    from spinorbit.state import RotationState
 
+    states = list(states)
+    n = len(states)
     horizons = np.array(SENSITIVITY_HORIZONS) * span_days
-    omega = state.angular_velocity.to_value("rad/day")
     kick = SENSITIVITY_PROBE_RAD / span_days
-    base = np.ascontiguousarray(state.propagate_torque_free(horizons)[0])
-    kappa = 1.0
-    for axis in range(3):
-        kicked_omega = omega.copy()
-        kicked_omega[axis] += kick
-        kicked = RotationState(state.body, state.quaternion, kicked_omega)
-        other = np.ascontiguousarray(kicked.propagate_torque_free(horizons)[0])
-        angles = rotation_angle_between_many(base, other)
-        kappa = max(kappa, float(np.max(angles / (kick * horizons))))
-    return kappa
+    starts = [_flow_start(state, horizons[-1]) for state in states]
+    p = np.array([state.body.to_principal for state in states])
+    values = np.array([state.body.moment_values for state in states])
+    kicked = np.repeat(np.array([state.angular_velocity.value for state in states])[:, None, :], 3, axis=1)  # rad/day
+    kicked[:, range(3), range(3)] += kick  # ω kicked along each user body axis
+    momenta = np.empty((n, 4, 3))
+    momenta[:, :3] = np.matmul(p[:, None], (values[:, None, :] * kicked)[..., None])[..., 0]  # P (I ω) per row
+    momenta[:, 3] = [momentum for _, momentum in starts]  # then the state itself
+    quaternions = np.repeat(np.array([q for q, _ in starts])[:, None, :], 4, axis=1)
+    moments = np.repeat(np.array([state.body.principal_moments for state in states])[:, None, :], 4, axis=1)
+    flowed = _free_flows(quaternions.reshape(-1, 4), momenta.reshape(-1, 3), moments.reshape(-1, 3),
+                         horizons).reshape(n, 4, horizons.size, 4)
+    base = np.ascontiguousarray(np.broadcast_to(flowed[:, 3:], (n, 3, horizons.size, 4))).reshape(-1, 4)
+    angles = rotation_angle_between_many(base, np.ascontiguousarray(flowed[:, :3]).reshape(-1, 4))
+    largest = np.max(angles.reshape(n, 3, horizons.size) / (kick * horizons), axis=2)  # (n, axis)
+    kappas = np.ones(n)
+    for axis in range(3):  # max(κ, largest) in Python's sense: a NaN axis leaves κ as it was
+        kappas = np.where(largest[:, axis] > kappas, largest[:, axis], kappas)
+    return kappas
+
+
+def _flow_start(state, horizon):
+    """(principal quaternion, principal momentum) of ``state``, InvalidStateError when its exact flow to
+    ``horizon`` days would leave the flow's domain (RotationState.propagate_torque_free's check)."""
+    from spinorbit.core.math.rotations import attitude_to_quat
+    from spinorbit.state import MAX_FLOW_PHASE, InvalidStateError
+
+    attitude, momentum = state.principal_attitude_and_momentum()
+    phase = float(np.linalg.norm(momentum)) / state.body.principal_moments[0] * horizon
+    if not phase <= MAX_FLOW_PHASE:
+        raise InvalidStateError(
+            f"dt up to {horizon!r} d is beyond the free flow's domain: the fastest angle of this motion turns by "
+            f"{phase:.3g} rad > {MAX_FLOW_PHASE:g} rad, where one ulp of dt already moves the attitude by more "
+            "than 0.1 rad. Propagate from a later state, or shorten dt.")
+    return attitude_to_quat(np.ascontiguousarray(attitude)), momentum
+
+
+def _free_flows(quaternions, momenta, moments, horizons):
+    """Principal-axis attitudes (N, K, 4) of N states (principal quaternions, momenta and moments) flowed
+    exactly to the K ``horizons``: one compiled loop, each state on its own."""
+    from spinorbit.core.free_motion.members import free_flow_each
+
+    n = len(quaternions)
+    q_out, m_out = np.empty((n, horizons.size, 4)), np.empty((n, horizons.size, 3))
+    free_flow_each(np.array(quaternions, dtype=float), np.array(momenta, dtype=float),
+                   np.array(moments, dtype=float), np.ascontiguousarray(np.broadcast_to(horizons, (n, horizons.size))),
+                   q_out, m_out)
+    return q_out
 
 
 def dropped_torque_bound(days, torque_over_a, span_end, kappa, momentum_over_a):
@@ -205,11 +258,19 @@ def dropped_torque_bound(days, torque_over_a, span_end, kappa, momentum_over_a):
     ``days`` (increasing, TDB days) and ``torque_over_a`` (rad/day²) are survey samples; the integrals
     of the module docstring are taken with the trapezoid rule. ``momentum_over_a`` is |L|/A (rad/day).
     """
+    torque = np.asarray(torque_over_a, dtype=float)
+    return float(dropped_torque_bounds(days, torque[None, :], span_end, kappa, momentum_over_a)[0])
+
+
+def dropped_torque_bounds(days, torque_over_a, span_end, kappa, momentum_over_a):
+    """:func:`dropped_torque_bound` of many bodies on one survey: ``torque_over_a`` (N, n) at ``days`` (n,),
+    ``kappa`` and ``momentum_over_a`` scalars or (N,). Returns (N,) bounds (rad), each row's the bits of its
+    own call (the trapezoid sums run along each row)."""
     days = np.asarray(days, dtype=float)
     n = np.asarray(torque_over_a, dtype=float)
     lever = span_end - days
-    drift = _trapezoid(lever * n, days)
-    tilt = _trapezoid(n, days)
+    drift = _trapezoid_rows(lever * n, days)
+    tilt = _trapezoid_rows(n, days)
     return SAFETY * (kappa * drift + 2.0 * tilt / momentum_over_a)
 
 
@@ -315,24 +376,14 @@ def action_sensitivities(state, span_days):
     second order, is measured too). Horizons τ and probe size as in :func:`attitude_sensitivity`.
     """
     from spinorbit.core.math.rotations import rotation_angle_between_many
-    from spinorbit.state import RotationState
 
     horizons = np.array(SENSITIVITY_HORIZONS) * span_days
-    base = np.ascontiguousarray(state.propagate_torque_free(horizons)[0])
-    _, momentum = state.principal_attitude_and_momentum()
+    q, momentum = _flow_start(state, horizons[-1])
     moments = np.array(state.body.principal_moments, dtype=float)
-    p = state.body.to_principal
     size = float(np.linalg.norm(momentum))
     omega = momentum / moments
     energy = 0.5 * float(momentum @ omega)
-
-    def response(kicked_momentum):
-        kicked = RotationState(state.body, state.quaternion, p.T @ (kicked_momentum / moments))
-        other = np.ascontiguousarray(kicked.propagate_torque_free(horizons)[0])
-        return rotation_angle_between_many(base, other) / horizons
-
     eps = SENSITIVITY_PROBE_RAD / (span_days * float(np.linalg.norm(omega)))
-    kappa_l = float(np.max(response(momentum * (1.0 + eps)) / (eps * size / moments[0])))
     across = omega - (omega @ momentum) / size**2 * momentum
     across_size = float(np.linalg.norm(across))
     if across_size < 1e-9 * np.linalg.norm(omega):  # ω along L: E changes at second order, any direction across
@@ -342,7 +393,11 @@ def action_sensitivities(state, span_days):
     angle = min(SENSITIVITY_PROBE_RAD / (span_days * max(across_size, 1e-300)), 1e-3)
     turned = math.cos(angle) * momentum + math.sin(angle) * size * across
     change = abs(0.5 * float(turned @ (turned / moments)) - energy)
-    kappa_e = float(np.max(response(turned) / (change / size))) if change > 0.0 else 1.0
+    # the state, ω scaled and L turned: one vectorised exact flow
+    base, scaled, other = _free_flows([q] * 3, [momentum, momentum * (1.0 + eps), turned], [moments] * 3, horizons)
+    kappa_l = float(np.max(rotation_angle_between_many(base, scaled) / horizons / (eps * size / moments[0])))
+    kappa_e = (float(np.max(rotation_angle_between_many(base, other) / horizons / (change / size))) if change > 0.0
+               else 1.0)
     return kappa_l, kappa_e
 
 
@@ -508,3 +563,10 @@ def _trapezoid(values, days):
     if days.size < 2:
         return 0.0
     return float(np.sum(0.5 * (values[1:] + values[:-1]) * np.diff(days)))
+
+
+def _trapezoid_rows(values, days):
+    """:func:`_trapezoid` of each row of ``values`` (N, n) (numpy's pairwise sum along each row, as of one row)."""
+    if days.size < 2:
+        return np.zeros(values.shape[0])
+    return np.sum(0.5 * (values[:, 1:] + values[:, :-1]) * np.diff(days), axis=1)

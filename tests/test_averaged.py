@@ -533,3 +533,31 @@ def test_coarse_first_iteration_of_the_inverse_map():
         if scale == 10.0:
             coarse = element_differences(two_iterations(el, model, frame, ic, (8, 8)), full, ic)[0]
             assert np.abs(coarse[3:]).max() > 1e-9
+
+
+@pytest.mark.parametrize("make_scene", [scene_apophis, scene_toutatis])
+@pytest.mark.parametrize("swap", [False, True])
+def test_averaging_frame_axis_rule(make_scene, swap):
+    """The compiled averaging_frame: a rotation whose z axis is the first perturber's orbit normal n
+    when the spin is > 45° from n, else n × spin (normalised), so sin I ≥ ~0.7 either way; the
+    inertial spin is rotated independently (scipy)."""
+    from scipy.spatial.transform import Rotation
+
+    scene = make_scene()
+    y0 = scene.y0.copy()
+    if swap:
+        y0[4:] = y0[4:][::-1]  # another spin direction, the other branch of the rule for some scene
+    frame = averaging_frame(y0, scene.model)
+    assert np.abs(frame @ frame.T - np.eye(3)).max() < 1e-14 and np.linalg.det(frame) > 0
+    xv = perturber_state(0.0, scene.model, MODEL_PERTURBERS + 1)
+    normal = np.cross(xv[:3], xv[3:])
+    normal /= np.linalg.norm(normal)
+    q = y0[:4] / np.linalg.norm(y0[:4])
+    spin = Rotation.from_quat([q[1], q[2], q[3], q[0]]).apply(moments_of(scene.model) * y0[4:])
+    spin /= np.linalg.norm(spin)
+    if abs(spin @ normal) < math.sqrt(0.5):
+        assert np.abs(frame[2] - normal).max() < 1e-14
+    else:
+        expected = np.cross(normal, spin)
+        assert np.abs(frame[2] - expected / np.linalg.norm(expected)).max() < 1e-14
+    assert np.hypot(*(frame @ spin)[:2]) > 0.7 - 1e-12  # sin I of the spin in the frame

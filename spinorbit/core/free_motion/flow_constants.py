@@ -34,7 +34,10 @@ from spinorbit.core.math.ddouble import (
     dd_remainder_dd,
     dd_scale,
     dd_sqrt,
+    fma,
+    quick_two_sum,
     two_prod,
+    two_sum,
 )
 from spinorbit.core.math.elliptic_integrals import (
     METHOD_LARGE_NEGATIVE,
@@ -62,6 +65,10 @@ from spinorbit.core.math.rotations import quat_to_matrix
 # The double-double AGM for K and Π stops when both the AGM gap and the last term of the Π series
 # are below this fraction of the result: the double-double unit roundoff is 2^-106 ≈ 1.2e-32.
 AGM_TOLERANCE = 1e-33
+# ... and once the AGM gap (a − g)/a is below this: K = π/(a + g) then differs from π/(2 M) by
+# (a − g)²/(16 a²) < 1e-33 relative. The compensated gap is only known to ≈ ε² (first-order
+# corrections), so the stop cannot ask for the AGM_TOLERANCE itself.
+AGM_GAP = 1e-16
 # f = −n up to 1e30 needs ≈ 50 halvings of p_k before the quadratic phase; 200 is never reached.
 AGM_MAX_STEPS = 200
 
@@ -135,41 +142,83 @@ def complete_k_pi_dd(f_hi, f_lo, mc_hi, mc_lo):
     T = 1 − Σ_{k≥1} Q_k = Σ_{k≥1} 2^{-k} D_k, D_k = 1 − Π_{i<k} ε_i, the result is
     Π = K/2 · (2 + f T)/(1 + f), and D_{k+1} = D_k + δ_k (1 − D_k) with δ_k = 1 − ε_k = 2 a_k g_k /
     (p_k² + a_k g_k) sums positive terms only (ε_k ≥ 0 for n ≤ 0). Once ε_k = 0 all later D are 1,
-    so the tail of T is the last weight 2^{-k}. Checked against mpmath (50 digits) for p_c from 1e-20
-    to 1 and f from 0 to 1e30: relative error ≤ 3e-31 (``tests/test_torque_free.py``).
+    so the tail of T is the last weight 2^{-k}.
+
+    Arithmetic: compensated, not double-double. Each quantity is a double x plus a double x' that
+    carries its error to first order: the double AGM runs unchanged on the x's, and x' collects the
+    exact rounding error of every operation (``two_prod`` by FMA, ``two_sum``, the residual of
+    every quotient and root) plus the propagated x' of the operands, never renormalised. The
+    neglected terms are products of two errors, ≈ ε² ≈ 5e-32 relative per step. The quotients'
+    and roots' corrections multiply by a reciprocal instead of dividing again, and the x chain
+    never waits for the x' chain, so one step costs about four roundings' worth of division and
+    root instead of the double-double's eight (≈ 280 ns → see ``benchmarks/bench_elliptic.py``).
+    Checked against mpmath (50 digits) for p_c from 1e-16 to 1 and f from 0 to 1e30
+    (``tests/test_torque_free.py``, AGM_TOLERANCE there).
     """
-    ah, al = 1.0, 0.0
-    gh, gl = dd_sqrt(mc_hi, mc_lo)
-    oneh, onel = dd_add(1.0, 0.0, f_hi, f_lo)
-    ph, pl = dd_sqrt(oneh, onel)
-    prod_h, prod_l = 1.0, 0.0  # Π_{i<k} ε_i = 1 − D_k, kept as a product (no cancellation)
-    dh, dl = 0.0, 0.0  # D_k
-    th, tl = 0.0, 0.0  # partial sum of T
+    a, al = 1.0, 0.0
+    g = math.sqrt(mc_hi)
+    gl = (fma(-g, g, mc_hi) + mc_lo) * (0.5 / g)
+    one_h, one_l = two_sum(1.0, f_hi)
+    one_l += f_lo
+    p = math.sqrt(one_h)
+    pl = (fma(-p, p, one_h) + one_l) * (0.5 / p)
+    prod, prodl = 1.0, 0.0  # Π_{i<k} ε_i = 1 − D_k, kept as a product (no cancellation)
+    d, dl = 0.0, 0.0  # D_k
+    t, tl = 0.0, 0.0  # partial sum of T
     weight = 1.0
     for _ in range(AGM_MAX_STEPS):
-        agh, agl = dd_mul(ah, al, gh, gl)
-        p2h, p2l = dd_mul(ph, pl, ph, pl)
-        denh, denl = dd_add(p2h, p2l, agh, agl)
-        nh, nl = dd_add(p2h, p2l, -agh, -agl)
-        eh, el = dd_div(nh, nl, denh, denl)
-        delh, dell = dd_div(2.0 * agh, 2.0 * agl, denh, denl)
-        xh, xl = dd_mul(delh, dell, prod_h, prod_l)
-        dh, dl = dd_add(dh, dl, xh, xl)
-        prod_h, prod_l = dd_mul(prod_h, prod_l, eh, el)
+        ag = a * g
+        agl = fma(a, g, -ag) + (a * gl + al * g)
+        p2 = p * p
+        p2l = fma(p, p, -p2) + 2.0 * p * pl
+        den, e1 = two_sum(p2, ag)
+        denl = e1 + (p2l + agl)
+        num, e2 = two_sum(p2, -ag)
+        numl = e2 + (p2l - agl)
+        inv = 1.0 / den
+        eps_k = num * inv
+        eps_l = (fma(-eps_k, den, num) + (numl - eps_k * denl)) * inv
+        ag2 = 2.0 * ag
+        dlt = ag2 * inv
+        dlt_l = (fma(-dlt, den, ag2) + (2.0 * agl - dlt * denl)) * inv
+        x = dlt * prod
+        xl = fma(dlt, prod, -x) + (dlt * prodl + dlt_l * prod)
+        d, e3 = two_sum(d, x)
+        dl += e3 + xl
+        new_prod = prod * eps_k
+        prodl = fma(prod, eps_k, -new_prod) + (prod * eps_l + prodl * eps_k)
+        prod = new_prod
         weight *= 0.5
-        th, tl = dd_add(th, tl, weight * dh, weight * dl)
-        ph, pl = dd_div(denh, denl, 2.0 * ph, 2.0 * pl)
-        sh, sl = dd_add(ah, al, gh, gl)
-        ah, al = 0.5 * sh, 0.5 * sl
-        gh, gl = dd_sqrt(agh, agl)
-        if abs(prod_h) * weight <= AGM_TOLERANCE * abs(th) and abs(ah - gh) <= AGM_TOLERANCE * ah:
+        t, e4 = two_sum(t, weight * d)
+        tl += e4 + weight * dl
+        half_p = 0.5 / p
+        new_p = den * half_p
+        pl = (fma(-new_p, 2.0 * p, den) + (denl - new_p * 2.0 * pl)) * half_p
+        p = new_p
+        s, e5 = two_sum(a, g)
+        a, al = 0.5 * s, 0.5 * (e5 + (al + gl))
+        g = math.sqrt(ag)
+        gl = (fma(-g, g, ag) + agl) * (0.5 / g)
+        # the gap with its correction (the double chain alone may stay an ulp apart forever)
+        if abs(prod) * weight <= AGM_TOLERANCE * abs(t) and abs((a - g) + (al - gl)) <= AGM_GAP * a:
             break
-    th, tl = dd_add(th, tl, weight, 0.0)
-    kh, kl = dd_div(PI_HI, PI_LO, 2.0 * ah, 2.0 * al)
-    fth, ftl = dd_mul(f_hi, f_lo, th, tl)
-    numh, numl = dd_add(2.0, 0.0, fth, ftl)
-    rh, rl = dd_div(numh, numl, oneh, onel)
-    pih, pil = dd_mul(kh, kl, 0.5 * rh, 0.5 * rl)
+    t, e6 = two_sum(t, weight)
+    tl += e6
+    s, e7 = two_sum(a, g)
+    sl = e7 + (al + gl)
+    # K = π / (a + g), Π = K (2 + f T) / (2 (1 + f)), with the same first-order corrections
+    k = PI_HI / s
+    kl = (fma(-k, s, PI_HI) + (PI_LO - k * sl)) / s
+    ft = f_hi * t
+    ftl = fma(f_hi, t, -ft) + (f_hi * tl + f_lo * t)
+    top, e8 = two_sum(2.0, ft)
+    topl = e8 + ftl
+    ratio = top / one_h
+    ratio_l = (fma(-ratio, one_h, top) + (topl - ratio * one_l)) / one_h
+    pi_k = 0.5 * k * ratio
+    pi_l = fma(0.5 * k, ratio, -pi_k) + 0.5 * (k * ratio_l + kl * ratio)
+    kh, kl = quick_two_sum(k, kl)
+    pih, pil = quick_two_sum(pi_k, pi_l)
     return kh, kl, pih, pil
 
 

@@ -95,6 +95,7 @@ from spinorbit.core.free_motion.flow_constants import (
     FL_RATE_LO,
     FLOW_SIZE,
     flow_constants,
+    flow_constants_into,
     flow_kappa_pn,
     half_angles,
 )
@@ -232,6 +233,7 @@ def propagate_many_into(quaternions, momenta, moments, times, q_out, m_out, clos
     two equal moments take the regular precession (:mod:`.regular_precession`, trig only) instead
     of the elliptic flow at parameter 0; False forces the elliptic flow (tests, benchmarks).
     """
+    flow = np.empty(FLOW_SIZE)  # one buffer for every state's constants (an allocation each cost ≈ 25 ns)
     for i in range(quaternions.shape[0]):
         if momenta[i, 0] == 0.0 and momenta[i, 1] == 0.0 and momenta[i, 2] == 0.0:
             for k in range(times.shape[0]):  # no rotation at all
@@ -244,8 +246,8 @@ def propagate_many_into(quaternions, momenta, moments, times, q_out, m_out, clos
             for k in range(times.shape[0]):
                 evaluate_precession(times[k], pc, q_out[i, k], m_out[i, k])
             continue
-        flow, mo, mk, pk = flow_constants(
-            quaternions[i], momenta[i], moments[i, 0], moments[i, 1], moments[i, 2]
+        mo, mk, pk = flow_constants_into(
+            flow, quaternions[i], momenta[i], moments[i, 0], moments[i, 1], moments[i, 2]
         )
         for k in range(times.shape[0]):  # element stores: views q_out[i, k] cost ~10% of an evaluation
             (q_out[i, k, 0], q_out[i, k, 1], q_out[i, k, 2], q_out[i, k, 3],

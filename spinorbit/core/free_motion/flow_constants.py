@@ -18,14 +18,13 @@ from spinorbit.core.elements.canonical import (
     MODE_SAM,
     MODE_UNIFORM,
     amplitude_from_momentum,
-    body_from_argument,
     elliptic_constants,
     flip_signs,
     inertia_constants,
     motion_from_momentum,
-    node_angles_of,
 )
 from spinorbit.core.jit import jit
+from spinorbit.core.math.carlson import rf
 from spinorbit.core.math.ddouble import (
     dd_add,
     dd_difference_ratio,
@@ -59,8 +58,11 @@ from spinorbit.core.math.elliptic_periods import (
     parameter_constants_with_k,
 )
 from spinorbit.core.math.jacobi import sncndn_reduced
-from spinorbit.core.math.pn_fourier import FOURIER_MAX_TERMS, pn_fourier_coefficients, sine_series
-from spinorbit.core.math.rotations import quat_to_matrix
+from spinorbit.core.math.pn_fourier import (
+    FOURIER_MAX_TERMS,
+    pn_fourier_coefficients,
+    sine_series,
+)
 
 # The double-double AGM for K and Π stops when both the AGM gap and the last term of the Π series
 # are below this fraction of the result: the double-double unit roundoff is 2^-106 ≈ 1.2e-32.
@@ -312,16 +314,16 @@ def half_angles(sin_x, cos_x):
 
 
 @jit
-def node_quaternion(cos_i, sin_i, h):
+def node_quaternion(cos_i, sin_i, sin_h, cos_h):
     """Quaternion (w, x, y, z) of the node frame (R1(I) R3(h))ᵀ = R3(h)ᵀ R1(I)ᵀ, body → inertial.
 
-    q_z(h) ⊗ q_x(I) from the half angles, as four floats: the matrix of
+    q_z(h) ⊗ q_x(I) from the half angles (:func:`half_angles`, no trigonometric call), as four floats: the matrix of
     :func:`.andoyer.node_frame` and Shepperd's conversion of it allocated two arrays and cost
     ≈ 80 ns of the set-up. The sign is the one :func:`.rotations.matrix_to_quat` picks (largest
     component positive), so the output quaternions keep their sign convention.
     """
     ci, si = half_angles(sin_i, cos_i)  # I ∈ [0, π]
-    ch, sh = math.cos(0.5 * h), math.sin(0.5 * h)
+    ch, sh = half_angles(sin_h, cos_h)
     w, x, y, z = ch * ci, ch * si, sh * si, sh * ci
     big = w
     if abs(x) > abs(big):
@@ -356,10 +358,22 @@ def flow_constants(quaternion, momentum, big_a, big_b, big_c):
         Motion constants (:func:`.canonical.motion_constants`), parameter and pn constants of the
         elliptic kernels.
     """
+    flow = np.empty(FLOW_SIZE)
+    mo, mk, pk = flow_constants_into(flow, quaternion, momentum, big_a, big_b, big_c)
+    return flow, mo, mk, pk
+
+
+@jit
+def flow_constants_into(flow, quaternion, momentum, big_a, big_b, big_c):
+    """:func:`flow_constants` into a caller's (FLOW_SIZE,) array; returns (mo, mk, pk).
+
+    For loops over many states (:func:`.flow.propagate_many_into`): one buffer for all of them
+    instead of an allocation per state. Every slot the evaluation reads is written.
+    """
     ic = inertia_constants(big_a, big_b, big_c)
     m0x, m0y, m0z = momentum[0], momentum[1], momentum[2]
     mo, flip = motion_from_momentum(m0x, m0y, m0z, ic)
-    flow = np.zeros(FLOW_SIZE)
+    flow[:] = 0.0
     mode = int(mo[MO_MODE])
     flow[FL_MODE] = mode
     flow[FL_FLIP] = flip
@@ -384,7 +398,7 @@ def flow_constants(quaternion, momentum, big_a, big_b, big_c):
         flow[FL_QN_W], flow[FL_QN_X] = quaternion[0], quaternion[1]
         flow[FL_QN_Y], flow[FL_QN_Z] = quaternion[2], quaternion[3]
         mk, pk = elliptic_constants(mo)  # unused by a uniform rotation; returned for one signature
-        return flow, mo, mk, pk
+        return mo, mk, pk
     mx, my, mz = fx * m0x, fy * m0y, fz * m0z
     (nuh, nul, perh, perl, cgh, cgl, wh, wl, kah, kal, param, param_c, char_n, ok, complete_pi) = (
         phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c)
@@ -399,16 +413,12 @@ def flow_constants(quaternion, momentum, big_a, big_b, big_c):
     else:  # the separatrix: the kernels' closed forms, from the motion constants
         mk, pk = elliptic_constants(mo)
         periodic = False
-    # the working attitude diag(flip) · M(q)ᵀ as a view of M(q) with its columns signed (one array,
-    # not three: per-state allocations were a third of the set-up)
-    matrix = quat_to_matrix(quaternion)
-    matrix[:, 0] *= fx
-    matrix[:, 1] *= fy
-    matrix[:, 2] *= fz
-    arg0 = ellipf_k(amplitude_from_momentum(mx, my, mz, mo, ic), mk)
-    _, _, _, sin_l, cos_l = body_from_argument(arg0, mo, mk)
-    _, cos_i, sin_i, h, g0 = node_angles_of(matrix.T, mx, my, mz, sin_l, cos_l)
-    flow[FL_QN_W], flow[FL_QN_X], flow[FL_QN_Y], flow[FL_QN_Z] = node_quaternion(cos_i, sin_i, h)
+    if periodic:
+        arg0 = _argument_of_momentum(mx, my, mz, mode, ic, mk)
+    else:  # m_c = 0: F = atanh(sin am) in Carlson's form, ±inf past ±π/2 (ellipf_k's cases)
+        arg0 = ellipf_k(amplitude_from_momentum(mx, my, mz, mo, ic), mk)
+    g0, qn = _node_of_state(quaternion, m0x, m0y, m0z, fx, fy, fz, mx, my, mo)
+    flow[FL_QN_W], flow[FL_QN_X], flow[FL_QN_Y], flow[FL_QN_Z] = qn
     flow[FL_ARG0] = arg0
     flow[FL_PERIODIC] = 1.0 if periodic else 0.0
     flow[FL_RATE_HI], flow[FL_RATE_LO] = nuh, nul
@@ -432,7 +442,77 @@ def flow_constants(quaternion, momentum, big_a, big_b, big_c):
         ph, pl = dd_mul(kah, kal, pn_k(arg0, mk, pk), 0.0)
     ch, cl = dd_add(g0, 0.0, -ph, -pl)
     flow[FL_G_CONST_HI], flow[FL_G_CONST_LO] = ch, cl
-    return flow, mo, mk, pk
+    return mo, mk, pk
+
+
+@jit
+def _argument_of_momentum(mx, my, mz, mode, ic, mk):
+    """The elliptic argument F(am | p) at the working-frame momentum (u in SAM, v in LAM), 0 ≤ p < 1.
+
+    :func:`.canonical.amplitude_from_momentum` followed by :func:`.elliptic_integrals.ellipf_k`,
+    without the atan2 and the sin, cos of its result: sin and cos of the amplitude are the
+    momentum's own ratios, and the whole turns of π (|am| ≤ π, so j ∈ {−1, 0, 1}) follow from
+    their signs. F = 2jK + sin r · R_F(cos² r, cos² r + p_c sin² r, 1) (note §6.3).
+    """
+    _a, _b, _c, a_b, b_c, a_c = ic
+    if mode == MODE_SAM:
+        ys, xs = math.sqrt(b_c) * my, math.sqrt(a_c) * mx
+    else:
+        ys, xs = math.sqrt(a_b) * my, math.sqrt(a_c) * mz
+    norm = math.hypot(ys, xs)
+    if not norm > 0.0:
+        return 0.0  # atan2(0, 0) = 0 (spin exactly about C in SAM)
+    s, c = ys / norm, xs / norm
+    j = 0.0
+    if c < 0.0:  # am beyond ±π/2: r = am − jπ, sin r = −s, cos r = −c
+        j = math.copysign(1.0, s)
+        s, c = -s, -c
+    f_r = s * rf(c * c, c * c + mk[MK_MC] * (s * s), 1.0)
+    return 2.0 * j * mk[MK_K_HI] + (2.0 * j * mk[MK_K_LO] + f_r)
+
+
+@jit
+def _rotate(w, x, y, z, vx, vy, vz):
+    """M(q) v for a unit quaternion q = (w, x, y, z): the body vector v in the inertial frame."""
+    tx = 2.0 * (y * vz - z * vy)
+    ty = 2.0 * (z * vx - x * vz)
+    tz = 2.0 * (x * vy - y * vx)
+    return (vx + w * tx + (y * tz - z * ty), vy + w * ty + (z * tx - x * tz),
+            vz + w * tz + (x * ty - y * tx))
+
+
+@jit
+def _node_of_state(quaternion, m0x, m0y, m0z, fx, fy, fz, mx, my, mo):
+    """(g0, node quaternion) of a state: :func:`.canonical.node_angles_of` from the quaternion.
+
+    l is the body-frame longitude of the momentum, (sin l, cos l) = (M_x, M_y)/|M_⊥| (working frame;
+    at J = 0 the elements' convention l = π/2 of :func:`.canonical.body_from_sncndn`). The inertial
+    momentum is M(q) M0 (the flip is its own inverse), the node's h enters only through
+    (sin h, cos h) = (i_0, −i_1)/|i_⊥|, and the first row of R3(g) = Wᵀ R Nᵀ needs the inertial
+    image of W's first column (cos l, −sin l, 0) in the working frame. No matrix, no atan2 for h,
+    no sn, cn, dn at arg0 (≈ 150 ns of the set-up).
+    """
+    perp = math.hypot(mx, my)
+    if perp > 0.0:
+        sin_l, cos_l = mx / perp, my / perp
+    elif mo[MO_MODE] == MODE_SAM:
+        sin_l, cos_l = 1.0, 0.0
+    else:
+        sin_l, cos_l = 0.0, 1.0
+    w, x, y, z = quaternion[0], quaternion[1], quaternion[2], quaternion[3]
+    i0, i1, big_h = _rotate(w, x, y, z, m0x, m0y, m0z)
+    r0, r1, r2 = _rotate(w, x, y, z, fx * cos_l, -fy * sin_l, 0.0)
+    big_g = math.sqrt(m0x * m0x + m0y * m0y + m0z * m0z)
+    across = math.hypot(i0, i1)
+    sin_i, cos_i = across / big_g, big_h / big_g
+    if across > 0.0:
+        sh, ch = i0 / across, -i1 / across
+    else:  # I = 0: h = atan2(i0, −i1) of the signed zeros, as node_angles_of takes it
+        h = math.atan2(i0, -i1)
+        sh, ch = math.sin(h), math.cos(h)
+    r3g_00 = r0 * ch + r1 * sh
+    r3g_01 = cos_i * (r1 * ch - r0 * sh) + sin_i * r2
+    return math.atan2(r3g_01, r3g_00), node_quaternion(cos_i, sin_i, sh, ch)
 
 
 

@@ -417,7 +417,7 @@ def flow_constants_into(flow, quaternion, momentum, big_a, big_b, big_c):
         arg0 = _argument_of_momentum(mx, my, mz, mode, ic, mk)
     else:  # m_c = 0: F = atanh(sin am) in Carlson's form, ±inf past ±π/2 (ellipf_k's cases)
         arg0 = ellipf_k(amplitude_from_momentum(mx, my, mz, mo, ic), mk)
-    g0, qn = _node_of_state(quaternion, m0x, m0y, m0z, fx, fy, fz, mx, my, mo)
+    g0, qn = _node_of_state(quaternion, m0x, m0y, m0z, fx, fy, fz, mx, my)
     flow[FL_QN_W], flow[FL_QN_X], flow[FL_QN_Y], flow[FL_QN_Z] = qn
     flow[FL_ARG0] = arg0
     flow[FL_PERIODIC] = 1.0 if periodic else 0.0
@@ -459,10 +459,11 @@ def _argument_of_momentum(mx, my, mz, mode, ic, mk):
         ys, xs = math.sqrt(b_c) * my, math.sqrt(a_c) * mx
     else:
         ys, xs = math.sqrt(a_b) * my, math.sqrt(a_c) * mz
-    norm = math.hypot(ys, xs)
-    if not norm > 0.0:
+    norm2 = ys * ys + xs * xs  # not hypot (≈ 15 ns): momenta below 1e150 cannot overflow it
+    if not norm2 > 0.0:
         return 0.0  # atan2(0, 0) = 0 (spin exactly about C in SAM)
-    s, c = ys / norm, xs / norm
+    inv = 1.0 / math.sqrt(norm2)
+    s, c = ys * inv, xs * inv
     j = 0.0
     if c < 0.0:  # am beyond ±π/2: r = am − jπ, sin r = −s, cos r = −c
         j = math.copysign(1.0, s)
@@ -482,7 +483,7 @@ def _rotate(w, x, y, z, vx, vy, vz):
 
 
 @jit
-def _node_of_state(quaternion, m0x, m0y, m0z, fx, fy, fz, mx, my, mo):
+def _node_of_state(quaternion, m0x, m0y, m0z, fx, fy, fz, mx, my):
     """(g0, node quaternion) of a state: :func:`.canonical.node_angles_of` from the quaternion.
 
     l is the body-frame longitude of the momentum, (sin l, cos l) = (M_x, M_y)/|M_⊥| (working frame;
@@ -492,21 +493,22 @@ def _node_of_state(quaternion, m0x, m0y, m0z, fx, fy, fz, mx, my, mo):
     image of W's first column (cos l, −sin l, 0) in the working frame. No matrix, no atan2 for h,
     no sn, cn, dn at arg0 (≈ 150 ns of the set-up).
     """
-    perp = math.hypot(mx, my)
-    if perp > 0.0:
-        sin_l, cos_l = mx / perp, my / perp
-    elif mo[MO_MODE] == MODE_SAM:
+    # sums of squares, not hypot (≈ 15 ns each): momenta below 1e150 cannot overflow them
+    perp2 = mx * mx + my * my
+    if perp2 > 0.0:
+        inv = 1.0 / math.sqrt(perp2)
+        sin_l, cos_l = mx * inv, my * inv
+    else:  # J = 0 (SAM with M_x = M_y = 0)
         sin_l, cos_l = 1.0, 0.0
-    else:
-        sin_l, cos_l = 0.0, 1.0
     w, x, y, z = quaternion[0], quaternion[1], quaternion[2], quaternion[3]
     i0, i1, big_h = _rotate(w, x, y, z, m0x, m0y, m0z)
     r0, r1, r2 = _rotate(w, x, y, z, fx * cos_l, -fy * sin_l, 0.0)
-    big_g = math.sqrt(m0x * m0x + m0y * m0y + m0z * m0z)
-    across = math.hypot(i0, i1)
-    sin_i, cos_i = across / big_g, big_h / big_g
+    inv_g = 1.0 / math.sqrt(m0x * m0x + m0y * m0y + m0z * m0z)
+    across = math.sqrt(i0 * i0 + i1 * i1)
+    sin_i, cos_i = across * inv_g, big_h * inv_g
     if across > 0.0:
-        sh, ch = i0 / across, -i1 / across
+        inv = 1.0 / across
+        sh, ch = i0 * inv, -i1 * inv
     else:  # I = 0: h = atan2(i0, −i1) of the signed zeros, as node_angles_of takes it
         h = math.atan2(i0, -i1)
         sh, ch = math.sin(h), math.cos(h)

@@ -197,7 +197,7 @@ def flow_state(t, flow, mo, mk, pk):
     cl, sl = half_angles(sin_l, cos_l)
     # half angles of J (cos J = M_z/G), from whichever of G ± M_z does not cancel
     big_g = mo[MO_G]
-    perp = math.hypot(mx, my)
+    perp = math.sqrt(mx * mx + my * my)  # not hypot (≈ 15 ns): |M| < 1e150 cannot overflow
     if mz >= 0.0:
         cj = math.sqrt(0.5 * (big_g + mz) / big_g)
         sj = perp / (2.0 * big_g * cj)

@@ -25,7 +25,7 @@ double inputs (A, B, C, M):
 
 * ν, c G, κ from error-free products of the inputs (:mod:`.ddouble`);
 * the half period 2K(p) of the argument and the complete Π(n | p) (n = ``MO_PN_N`` ≤ 0, p < 1 the
-  parameter actually used by the kernels: m in SAM, μ = 1/m in LAM) from one double-double AGM
+  parameter actually used by the kernels: m in SAM, μ = 1/m in LAM) from one compensated AGM
   (DLMF 19.8.5 and 19.8.6–8), with the parameter and the characteristic themselves formed in
   double-double, so K and Π belong to the exact inputs and not to their rounded ratios;
 * arg(t) = j · 2K + r with j = rint(arg/2K) and |r| ≤ K, both from the double-double arg; pn advances

@@ -64,12 +64,12 @@ from spinorbit.core.math.pn_fourier import (
     sine_series,
 )
 
-# The double-double AGM for K and Π stops when both the AGM gap and the last term of the Π series
-# are below this fraction of the result: the double-double unit roundoff is 2^-106 ≈ 1.2e-32.
+# The compensated AGM for K and Π stops when the last term of the Π series is below this fraction of
+# the result (the double-double unit roundoff is 2^-106 ≈ 1.2e-32) ...
 AGM_TOLERANCE = 1e-33
-# ... and once the AGM gap (a − g)/a is below this: K = π/(a + g) then differs from π/(2 M) by
+# ... and the AGM gap (a − g)/a is below this: K = π/(a + g) then differs from π/(2 M) by
 # (a − g)²/(16 a²) < 1e-33 relative. The compensated gap is only known to ≈ ε² (first-order
-# corrections), so the stop cannot ask for the AGM_TOLERANCE itself.
+# corrections), so the stop cannot ask for AGM_TOLERANCE there.
 AGM_GAP = 1e-16
 # f = −n up to 1e30 needs ≈ 50 halvings of p_k before the quadratic phase; 200 is never reached.
 AGM_MAX_STEPS = 200
@@ -153,7 +153,7 @@ def complete_k_pi_dd(f_hi, f_lo, mc_hi, mc_lo):
     neglected terms are products of two errors, ≈ ε² ≈ 5e-32 relative per step. The quotients'
     and roots' corrections multiply by a reciprocal instead of dividing again, and the x chain
     never waits for the x' chain, so one step costs about four roundings' worth of division and
-    root instead of the double-double's eight (≈ 280 ns → see ``benchmarks/bench_elliptic.py``).
+    root instead of the double-double's eight (``benchmarks/bench_elliptic.py`` times both AGMs).
     Checked against mpmath (50 digits) for p_c from 1e-16 to 1 and f from 0 to 1e30
     (``tests/test_torque_free.py``, AGM_TOLERANCE there).
     """
@@ -406,7 +406,7 @@ def flow_constants_into(flow, quaternion, momentum, big_a, big_b, big_c):
     if ok > 0.0 and mo[MO_PARAM_C] > 0.0:
         # kernel constants from the once-rounded double-double p, p_c, n (not from ratios of rounded
         # differences: near the separatrix those lose ε/p_c in p_c), with K and Π from the
-        # double-double AGM above instead of a second AGM and a Carlson R_J per state
+        # compensated AGM above instead of a second AGM and a Carlson R_J per state
         mk = parameter_constants_with_k(param, param_c, 0.5 * perh, 0.5 * perl)
         pk = characteristic_constants_with_complete(char_n, param, complete_pi)
         periodic = True

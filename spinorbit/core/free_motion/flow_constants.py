@@ -233,7 +233,18 @@ def _dd_lin(ah, al, xh, xl, bh, bl, yh, yl):
 
 
 @jit
-def phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c):
+def moment_constants(big_a, big_b, big_c):
+    """The per-body part of the set-up: (:func:`.canonical.inertia_constants`, double-double
+    (a − b, b − c, a − c, c) as an 8-tuple), formed once for states that share their moments."""
+    abh, abl = dd_difference_ratio(big_a, big_b)
+    bch, bcl = dd_difference_ratio(big_b, big_c)
+    ach, acl = dd_difference_ratio(big_a, big_c)
+    ch, cl = dd_div(1.0, 0.0, big_c, 0.0)
+    return inertia_constants(big_a, big_b, big_c), (abh, abl, bch, bcl, ach, acl, ch, cl)
+
+
+@jit
+def phase_constants_dd(mode, mx, my, mz, inertia_dd):
     """Secular constants of a SAM/LAM motion as double-doubles from the exact double inputs.
 
     Parameters
@@ -242,8 +253,8 @@ def phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c):
         MODE_SAM or MODE_LAM (from :func:`.canonical.motion_from_momentum`).
     mx, my, mz : float
         Body angular momentum (any flip: only squares enter).
-    big_a, big_b, big_c : float
-        Principal moments A ≤ B ≤ C.
+    inertia_dd : tuple
+        The double-double (a − b, b − c, a − c, c) of :func:`moment_constants`.
 
     Returns
     -------
@@ -264,9 +275,7 @@ def phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c):
     LAM ν² = Q (a−b), p = P_a (b−c) / ((a−b) Q), p_c = −(a−c) R / ((a−b) Q), n = −P_a / Q;
     κ = (a−c) G / ν in both modes.
     """
-    abh, abl = dd_difference_ratio(big_a, big_b)
-    bch, bcl = dd_difference_ratio(big_b, big_c)
-    ach, acl = dd_difference_ratio(big_a, big_c)
+    abh, abl, bch, bcl, ach, acl, ch, cl = inertia_dd
     x2h, x2l = two_prod(mx, mx)
     y2h, y2l = two_prod(my, my)
     z2h, z2l = two_prod(mz, mz)
@@ -291,7 +300,6 @@ def phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c):
     pch, pcl = dd_div(ah_, al_, denh, denl)
     param = dd_div(numh, numl, denh, denl)[0]
     nuh, nul = dd_sqrt(nu2h, nu2l)
-    ch, cl = dd_div(1.0, 0.0, big_c, 0.0)
     cgh, cgl = dd_mul(ch, cl, gh, gl)
     # κ = (a−c) G / ν
     kah, kal = dd_mul(ach, acl, gh, gl)
@@ -370,7 +378,16 @@ def flow_constants_into(flow, quaternion, momentum, big_a, big_b, big_c):
     For loops over many states (:func:`.flow.propagate_many_into`): one buffer for all of them
     instead of an allocation per state. Every slot the evaluation reads is written.
     """
-    ic = inertia_constants(big_a, big_b, big_c)
+    ic, inertia_dd = moment_constants(big_a, big_b, big_c)
+    return flow_constants_shared(flow, quaternion, momentum, big_a, big_b, big_c, ic, inertia_dd)
+
+
+@jit
+def flow_constants_shared(flow, quaternion, momentum, big_a, big_b, big_c, ic, inertia_dd):
+    """:func:`flow_constants_into` with the body's :func:`moment_constants` (ic, inertia_dd) given.
+
+    States of one body share them; they were ≈ 12 divisions of every state's set-up.
+    """
     m0x, m0y, m0z = momentum[0], momentum[1], momentum[2]
     mo, flip = motion_from_momentum(m0x, m0y, m0z, ic)
     flow[:] = 0.0
@@ -401,7 +418,7 @@ def flow_constants_into(flow, quaternion, momentum, big_a, big_b, big_c):
         return mo, mk, pk
     mx, my, mz = fx * m0x, fy * m0y, fz * m0z
     (nuh, nul, perh, perl, cgh, cgl, wh, wl, kah, kal, param, param_c, char_n, ok, complete_pi) = (
-        phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c)
+        phase_constants_dd(mode, mx, my, mz, inertia_dd)
     )
     if ok > 0.0 and mo[MO_PARAM_C] > 0.0:
         # kernel constants from the once-rounded double-double p, p_c, n (not from ratios of rounded

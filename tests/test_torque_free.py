@@ -271,6 +271,13 @@ def test_arrays_of_states_equal_one_by_one():
     qi, mi = torque_free_states(quaternions[5], momenta[5], *moments[3], times)
     np.testing.assert_array_equal(shared_q[5], qi)
     np.testing.assert_array_equal(shared_m[5], mi)
+    # runs of equal moments share their per-body constants (propagate_many_into): A A B B A …
+    mixed = moments[np.arange(n) // 2 % 3 + 3]
+    mixed_q, mixed_m = torque_free_states_many(quaternions, momenta, mixed, times)
+    for i in range(n):
+        qi, mi = torque_free_states(quaternions[i], momenta[i], *mixed[i], times)
+        np.testing.assert_array_equal(mixed_q[i], qi)
+        np.testing.assert_array_equal(mixed_m[i], mi)
 
 
 def test_attitude_matrix_form_matches_quaternions():

@@ -23,7 +23,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _report import Timing, interleaved_timings, machine_line, write_section  # noqa: E402
 
 from spinorbit import special  # noqa: E402
+from spinorbit.core.free_motion.flow_constants import complete_k_pi_dd  # noqa: E402
 from spinorbit.core.math import elliptic as E  # noqa: E402
+from spinorbit.core.math.elliptic_integrals import complete_k_pi  # noqa: E402
 
 N = 200_000
 REPEATS = 7
@@ -68,6 +70,24 @@ def loop_ellipk(m, mc):
     total = 0.0
     for i in range(m.size):
         total += E.ellipk(m[i], mc[i])
+    return total
+
+
+@numba.njit
+def loop_complete_dd(f, mc):
+    total = 0.0
+    for i in range(mc.size):
+        k_hi, _, pi_hi, _ = complete_k_pi_dd(f, 0.0, mc[i], 0.0)
+        total += k_hi + pi_hi
+    return total
+
+
+@numba.njit
+def loop_complete(f, mc):
+    total = 0.0
+    for i in range(mc.size):
+        k, pi = complete_k_pi(f, mc[i])
+        total += k + pi
     return total
 
 
@@ -180,6 +200,9 @@ def main():
     rows.append(("am", ns_per_element(loop_am, u, mk), "ellipj (ph)",
                  ns_per_element(loop_scipy_ellipj, u, M), None))
     rows.append(("K (own AGM, double-double)", ns_per_element(loop_ellipk, m_arr, 1.0 - m_arr), "", None, None))
+    rows.append(("K and Π(−f|m) together, compensated AGM (~1e-30; flow set-up)",
+                 ns_per_element(loop_complete_dd, F, 1.0 - m_arr), "", None, None))
+    rows.append(("K and Π(−f|m) together, double AGM", ns_per_element(loop_complete, F, 1.0 - m_arr), "", None, None))
     rows.append(("F(φ|m)", ns_per_element(loop_ellipf, phi, mk), "ellipkinc",
                  ns_per_element(loop_scipy_ellipkinc, phi, M), None))
     rows.append(("Π(φ, −f|m)", ns_per_element(loop_ellippi, phi, mk, nk), "", None, None))

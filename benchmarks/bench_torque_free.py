@@ -154,7 +154,7 @@ def main():
     rows = []
 
     # exact solution: one state → many times, many states → many times (small random rotations of
-    # the HLW state), many states at one time each (setup-dominated: the double-double AGM per
+    # the HLW state), many states at one time each (setup-dominated: the compensated AGM per
     # state); the four timed in turn, EXACT_REPEATS rounds, so the machine's load moves all alike
     q, m = torque_free_states(IDENTITY, MOMENTUM, *MOMENTS, times)
     error = rotation_angle(q_ref, q).max()
@@ -241,7 +241,7 @@ def main():
         "",
         f"Goal: ≥ {GOAL_STATES_PER_SECOND:.0e} states/s on one core for the exact solution (many times "
         f"per state): **{verdict}** ({exact_rate:.3g} states/s). With one time per state the per-state "
-        f"setup dominates (one double-double AGM for K and Π, forward map to the elements, node frame, "
+        f"setup dominates (one compensated AGM for K and Π, forward map to the elements, node frame, "
         f"coefficients of pn's nome series; "
         f"≈ {1e6 / one_time_rate:.1f} µs per state; goal ≥ {GOAL_ONE_TIME_STATES_PER_SECOND:.0e}): "
         f"**{one_time_verdict}** for that workload ({one_time_rate:.3g} states/s). The integrators cannot reach the exact "

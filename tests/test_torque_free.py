@@ -68,6 +68,8 @@ NEAR_SEPARATRIX_MP_TOLERANCE = 2e-14  # rad
 # Invariants: |M| and T = ½ Σ M_i²/I_i at every output time, relative to their initial values.
 INVARIANT_TOLERANCE = 8 * np.finfo(float).eps
 # Double-double complete integrals against 50-digit mpmath.
+# measured ≤ 5e-30 on 300 random (p_c ∈ [1e-16, 1], f ∈ [1e-10, 1e30]) for the compensated AGM: its
+# first-order corrections drop ≈ 2ε² per step, and f = 1e30 takes ≈ 50 steps before converging.
 AGM_TOLERANCE = 1e-29
 
 HLW_MOMENTS = (2.0 / 3.0, 1.0, 2.0)  # Hairer–Lubich–Wanner I = (2, 1, 2/3), principal order A ≤ B ≤ C
@@ -269,6 +271,13 @@ def test_arrays_of_states_equal_one_by_one():
     qi, mi = torque_free_states(quaternions[5], momenta[5], *moments[3], times)
     np.testing.assert_array_equal(shared_q[5], qi)
     np.testing.assert_array_equal(shared_m[5], mi)
+    # runs of equal moments share their per-body constants (propagate_many_into): A A B B A …
+    mixed = moments[np.arange(n) // 2 % 3 + 3]
+    mixed_q, mixed_m = torque_free_states_many(quaternions, momenta, mixed, times)
+    for i in range(n):
+        qi, mi = torque_free_states(quaternions[i], momenta[i], *mixed[i], times)
+        np.testing.assert_array_equal(mixed_q[i], qi)
+        np.testing.assert_array_equal(mixed_m[i], mi)
 
 
 def test_attitude_matrix_form_matches_quaternions():
@@ -417,3 +426,78 @@ def test_typical_and_nearly_symmetric_states_take_the_series():
     assert _series_ratio([0.3, 0.4, 0.8], SYMMETRIC_PROLATE)[1] > 0
     assert _series_ratio([0.3, 0.4, 0.8], SYMMETRIC_OBLATE)[1] == 0
     assert _series_ratio(APOPHIS_MOMENTUM, APOPHIS_MOMENTS)[1] == 0
+
+
+# --------------------------------------------------------------------------------------------------
+# The set-up's shortcuts against the kernels they replace
+# --------------------------------------------------------------------------------------------------
+
+# The shortcut paths of the set-up (the argument from the momentum's own sin/cos of the amplitude,
+# the node from quaternion rotations) round differently from the atan2/sin/cos and matrix route of
+# :mod:`.canonical` they replace; both are a few ulp from the exact value, so they agree to this.
+SHORTCUT_TOLERANCE = 16 * np.finfo(float).eps
+
+
+def _working_momenta():
+    """Seeded momenta of the Apophis-like body in every quadrant of the amplitude, both modes,
+    plus spin exactly about C (J = 0) and about A, and the flips they need."""
+    from spinorbit.core.elements.canonical import flip_signs, inertia_constants, motion_from_momentum
+
+    rng = np.random.default_rng(18)
+    ic = inertia_constants(*APOPHIS_MOMENTS)
+    rows = [rng.normal(size=3) for _ in range(200)] + [np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])]
+    for m0 in rows:
+        mo, flip = motion_from_momentum(m0[0], m0[1], m0[2], ic)
+        if mo[0] == MODE_UNIFORM:
+            continue
+        fx, fy, fz = flip_signs(flip)
+        yield m0, ic, mo, (fx, fy, fz)
+
+
+def test_argument_from_momentum_equals_carlson_of_the_amplitude():
+    """_argument_of_momentum = ellipf_k(amplitude_from_momentum(…)) in SAM and LAM, |am| ≤ π."""
+    from spinorbit.core.elements.canonical import amplitude_from_momentum, elliptic_constants
+    from spinorbit.core.free_motion.flow_constants import _argument_of_momentum
+    from spinorbit.core.math.elliptic_integrals import ellipf_k
+
+    modes, beyond = set(), 0
+    for m0, ic, mo, (fx, fy, fz) in _working_momenta():
+        mx, my, mz = fx * m0[0], fy * m0[1], fz * m0[2]
+        mk, _ = elliptic_constants(mo)
+        if not mk[1] > 0.0:
+            continue
+        amplitude = amplitude_from_momentum(mx, my, mz, mo, ic)
+        reference = ellipf_k(amplitude, mk)
+        value = _argument_of_momentum(mx, my, mz, int(mo[0]), ic, mk)
+        assert abs(value - reference) <= SHORTCUT_TOLERANCE * max(abs(reference), 1.0), (m0, value, reference)
+        modes.add(int(mo[0]))
+        beyond += abs(amplitude) > 0.5 * math.pi
+    assert modes == {MODE_SAM, MODE_LAM} and beyond > 20
+
+
+def test_node_from_quaternion_equals_the_matrix_route():
+    """_node_of_state = node_angles_of on the flipped attitude matrix with l from sn, cn, dn at arg0."""
+    from spinorbit.core.elements.canonical import (
+        amplitude_from_momentum,
+        body_from_argument,
+        elliptic_constants,
+        node_angles_of,
+    )
+    from spinorbit.core.free_motion.flow_constants import _node_of_state, node_quaternion
+    from spinorbit.core.math.elliptic_integrals import ellipf_k
+    from spinorbit.core.math.rotations import quat_to_matrix
+
+    rng = np.random.default_rng(19)
+    for m0, ic, mo, (fx, fy, fz) in _working_momenta():
+        mx, my, mz = fx * m0[0], fy * m0[1], fz * m0[2]
+        mk, _ = elliptic_constants(mo)
+        q = rng.normal(size=4)
+        q /= np.linalg.norm(q)
+        matrix = quat_to_matrix(q) * np.array([fx, fy, fz])
+        arg0 = ellipf_k(amplitude_from_momentum(mx, my, mz, mo, ic), mk)
+        _, _, _, sin_l, cos_l = body_from_argument(arg0, mo, mk)
+        _, cos_i, sin_i, h, g0 = node_angles_of(matrix.T, mx, my, mz, sin_l, cos_l)
+        reference = np.array(node_quaternion(cos_i, sin_i, math.sin(h), math.cos(h)))
+        value_g0, value_q = _node_of_state(q, m0[0], m0[1], m0[2], fx, fy, fz, mx, my)
+        assert abs(math.remainder(value_g0 - g0, 2.0 * math.pi)) <= SHORTCUT_TOLERANCE * 4.0, (m0, value_g0, g0)
+        assert np.max(np.abs(np.array(value_q) - reference)) <= SHORTCUT_TOLERANCE, (m0, value_q, reference)

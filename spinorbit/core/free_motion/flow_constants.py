@@ -18,14 +18,13 @@ from spinorbit.core.elements.canonical import (
     MODE_SAM,
     MODE_UNIFORM,
     amplitude_from_momentum,
-    body_from_argument,
     elliptic_constants,
     flip_signs,
     inertia_constants,
     motion_from_momentum,
-    node_angles_of,
 )
 from spinorbit.core.jit import jit
+from spinorbit.core.math.carlson import rf
 from spinorbit.core.math.ddouble import (
     dd_add,
     dd_difference_ratio,
@@ -34,7 +33,10 @@ from spinorbit.core.math.ddouble import (
     dd_remainder_dd,
     dd_scale,
     dd_sqrt,
+    fma,
+    quick_two_sum,
     two_prod,
+    two_sum,
 )
 from spinorbit.core.math.elliptic_integrals import (
     METHOD_LARGE_NEGATIVE,
@@ -56,12 +58,19 @@ from spinorbit.core.math.elliptic_periods import (
     parameter_constants_with_k,
 )
 from spinorbit.core.math.jacobi import sncndn_reduced
-from spinorbit.core.math.pn_fourier import FOURIER_MAX_TERMS, pn_fourier_coefficients, sine_series
-from spinorbit.core.math.rotations import quat_to_matrix
+from spinorbit.core.math.pn_fourier import (
+    FOURIER_MAX_TERMS,
+    pn_fourier_coefficients,
+    sine_series,
+)
 
-# The double-double AGM for K and Π stops when both the AGM gap and the last term of the Π series
-# are below this fraction of the result: the double-double unit roundoff is 2^-106 ≈ 1.2e-32.
+# The compensated AGM for K and Π stops when the last term of the Π series is below this fraction of
+# the result (the double-double unit roundoff is 2^-106 ≈ 1.2e-32) ...
 AGM_TOLERANCE = 1e-33
+# ... and the AGM gap (a − g)/a is below this: K = π/(a + g) then differs from π/(2 M) by
+# (a − g)²/(16 a²) < 1e-33 relative. The compensated gap is only known to ≈ ε² (first-order
+# corrections), so the stop cannot ask for AGM_TOLERANCE there.
+AGM_GAP = 1e-16
 # f = −n up to 1e30 needs ≈ 50 halvings of p_k before the quadratic phase; 200 is never reached.
 AGM_MAX_STEPS = 200
 
@@ -135,41 +144,83 @@ def complete_k_pi_dd(f_hi, f_lo, mc_hi, mc_lo):
     T = 1 − Σ_{k≥1} Q_k = Σ_{k≥1} 2^{-k} D_k, D_k = 1 − Π_{i<k} ε_i, the result is
     Π = K/2 · (2 + f T)/(1 + f), and D_{k+1} = D_k + δ_k (1 − D_k) with δ_k = 1 − ε_k = 2 a_k g_k /
     (p_k² + a_k g_k) sums positive terms only (ε_k ≥ 0 for n ≤ 0). Once ε_k = 0 all later D are 1,
-    so the tail of T is the last weight 2^{-k}. Checked against mpmath (50 digits) for p_c from 1e-20
-    to 1 and f from 0 to 1e30: relative error ≤ 3e-31 (``tests/test_torque_free.py``).
+    so the tail of T is the last weight 2^{-k}.
+
+    Arithmetic: compensated, not double-double. Each quantity is a double x plus a double x' that
+    carries its error to first order: the double AGM runs unchanged on the x's, and x' collects the
+    exact rounding error of every operation (``two_prod`` by FMA, ``two_sum``, the residual of
+    every quotient and root) plus the propagated x' of the operands, never renormalised. The
+    neglected terms are products of two errors, ≈ ε² ≈ 5e-32 relative per step. The quotients'
+    and roots' corrections multiply by a reciprocal instead of dividing again, and the x chain
+    never waits for the x' chain, so one step costs about four roundings' worth of division and
+    root instead of the double-double's eight (``benchmarks/bench_elliptic.py`` times both AGMs).
+    Checked against mpmath (50 digits) for p_c from 1e-16 to 1 and f from 0 to 1e30
+    (``tests/test_torque_free.py``, AGM_TOLERANCE there).
     """
-    ah, al = 1.0, 0.0
-    gh, gl = dd_sqrt(mc_hi, mc_lo)
-    oneh, onel = dd_add(1.0, 0.0, f_hi, f_lo)
-    ph, pl = dd_sqrt(oneh, onel)
-    prod_h, prod_l = 1.0, 0.0  # Π_{i<k} ε_i = 1 − D_k, kept as a product (no cancellation)
-    dh, dl = 0.0, 0.0  # D_k
-    th, tl = 0.0, 0.0  # partial sum of T
+    a, al = 1.0, 0.0
+    g = math.sqrt(mc_hi)
+    gl = (fma(-g, g, mc_hi) + mc_lo) * (0.5 / g)
+    one_h, one_l = two_sum(1.0, f_hi)
+    one_l += f_lo
+    p = math.sqrt(one_h)
+    pl = (fma(-p, p, one_h) + one_l) * (0.5 / p)
+    prod, prodl = 1.0, 0.0  # Π_{i<k} ε_i = 1 − D_k, kept as a product (no cancellation)
+    d, dl = 0.0, 0.0  # D_k
+    t, tl = 0.0, 0.0  # partial sum of T
     weight = 1.0
     for _ in range(AGM_MAX_STEPS):
-        agh, agl = dd_mul(ah, al, gh, gl)
-        p2h, p2l = dd_mul(ph, pl, ph, pl)
-        denh, denl = dd_add(p2h, p2l, agh, agl)
-        nh, nl = dd_add(p2h, p2l, -agh, -agl)
-        eh, el = dd_div(nh, nl, denh, denl)
-        delh, dell = dd_div(2.0 * agh, 2.0 * agl, denh, denl)
-        xh, xl = dd_mul(delh, dell, prod_h, prod_l)
-        dh, dl = dd_add(dh, dl, xh, xl)
-        prod_h, prod_l = dd_mul(prod_h, prod_l, eh, el)
+        ag = a * g
+        agl = fma(a, g, -ag) + (a * gl + al * g)
+        p2 = p * p
+        p2l = fma(p, p, -p2) + 2.0 * p * pl
+        den, e1 = two_sum(p2, ag)
+        denl = e1 + (p2l + agl)
+        num, e2 = two_sum(p2, -ag)
+        numl = e2 + (p2l - agl)
+        inv = 1.0 / den
+        eps_k = num * inv
+        eps_l = (fma(-eps_k, den, num) + (numl - eps_k * denl)) * inv
+        ag2 = 2.0 * ag
+        dlt = ag2 * inv
+        dlt_l = (fma(-dlt, den, ag2) + (2.0 * agl - dlt * denl)) * inv
+        x = dlt * prod
+        xl = fma(dlt, prod, -x) + (dlt * prodl + dlt_l * prod)
+        d, e3 = two_sum(d, x)
+        dl += e3 + xl
+        new_prod = prod * eps_k
+        prodl = fma(prod, eps_k, -new_prod) + (prod * eps_l + prodl * eps_k)
+        prod = new_prod
         weight *= 0.5
-        th, tl = dd_add(th, tl, weight * dh, weight * dl)
-        ph, pl = dd_div(denh, denl, 2.0 * ph, 2.0 * pl)
-        sh, sl = dd_add(ah, al, gh, gl)
-        ah, al = 0.5 * sh, 0.5 * sl
-        gh, gl = dd_sqrt(agh, agl)
-        if abs(prod_h) * weight <= AGM_TOLERANCE * abs(th) and abs(ah - gh) <= AGM_TOLERANCE * ah:
+        t, e4 = two_sum(t, weight * d)
+        tl += e4 + weight * dl
+        half_p = 0.5 / p
+        new_p = den * half_p
+        pl = (fma(-new_p, 2.0 * p, den) + (denl - new_p * 2.0 * pl)) * half_p
+        p = new_p
+        s, e5 = two_sum(a, g)
+        a, al = 0.5 * s, 0.5 * (e5 + (al + gl))
+        g = math.sqrt(ag)
+        gl = (fma(-g, g, ag) + agl) * (0.5 / g)
+        # the gap with its correction (the double chain alone may stay an ulp apart forever)
+        if abs(prod) * weight <= AGM_TOLERANCE * abs(t) and abs((a - g) + (al - gl)) <= AGM_GAP * a:
             break
-    th, tl = dd_add(th, tl, weight, 0.0)
-    kh, kl = dd_div(PI_HI, PI_LO, 2.0 * ah, 2.0 * al)
-    fth, ftl = dd_mul(f_hi, f_lo, th, tl)
-    numh, numl = dd_add(2.0, 0.0, fth, ftl)
-    rh, rl = dd_div(numh, numl, oneh, onel)
-    pih, pil = dd_mul(kh, kl, 0.5 * rh, 0.5 * rl)
+    t, e6 = two_sum(t, weight)
+    tl += e6
+    s, e7 = two_sum(a, g)
+    sl = e7 + (al + gl)
+    # K = π / (a + g), Π = K (2 + f T) / (2 (1 + f)), with the same first-order corrections
+    k = PI_HI / s
+    kl = (fma(-k, s, PI_HI) + (PI_LO - k * sl)) / s
+    ft = f_hi * t
+    ftl = fma(f_hi, t, -ft) + (f_hi * tl + f_lo * t)
+    top, e8 = two_sum(2.0, ft)
+    topl = e8 + ftl
+    ratio = top / one_h
+    ratio_l = (fma(-ratio, one_h, top) + (topl - ratio * one_l)) / one_h
+    pi_k = 0.5 * k * ratio
+    pi_l = fma(0.5 * k, ratio, -pi_k) + 0.5 * (k * ratio_l + kl * ratio)
+    kh, kl = quick_two_sum(k, kl)
+    pih, pil = quick_two_sum(pi_k, pi_l)
     return kh, kl, pih, pil
 
 
@@ -182,7 +233,18 @@ def _dd_lin(ah, al, xh, xl, bh, bl, yh, yl):
 
 
 @jit
-def phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c):
+def moment_constants(big_a, big_b, big_c):
+    """The per-body part of the set-up: (:func:`.canonical.inertia_constants`, double-double
+    (a − b, b − c, a − c, c) as an 8-tuple), formed once for states that share their moments."""
+    abh, abl = dd_difference_ratio(big_a, big_b)
+    bch, bcl = dd_difference_ratio(big_b, big_c)
+    ach, acl = dd_difference_ratio(big_a, big_c)
+    ch, cl = dd_div(1.0, 0.0, big_c, 0.0)
+    return inertia_constants(big_a, big_b, big_c), (abh, abl, bch, bcl, ach, acl, ch, cl)
+
+
+@jit
+def phase_constants_dd(mode, mx, my, mz, inertia_dd):
     """Secular constants of a SAM/LAM motion as double-doubles from the exact double inputs.
 
     Parameters
@@ -191,8 +253,8 @@ def phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c):
         MODE_SAM or MODE_LAM (from :func:`.canonical.motion_from_momentum`).
     mx, my, mz : float
         Body angular momentum (any flip: only squares enter).
-    big_a, big_b, big_c : float
-        Principal moments A ≤ B ≤ C.
+    inertia_dd : tuple
+        The double-double (a − b, b − c, a − c, c) of :func:`moment_constants`.
 
     Returns
     -------
@@ -213,9 +275,7 @@ def phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c):
     LAM ν² = Q (a−b), p = P_a (b−c) / ((a−b) Q), p_c = −(a−c) R / ((a−b) Q), n = −P_a / Q;
     κ = (a−c) G / ν in both modes.
     """
-    abh, abl = dd_difference_ratio(big_a, big_b)
-    bch, bcl = dd_difference_ratio(big_b, big_c)
-    ach, acl = dd_difference_ratio(big_a, big_c)
+    abh, abl, bch, bcl, ach, acl, ch, cl = inertia_dd
     x2h, x2l = two_prod(mx, mx)
     y2h, y2l = two_prod(my, my)
     z2h, z2l = two_prod(mz, mz)
@@ -240,7 +300,6 @@ def phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c):
     pch, pcl = dd_div(ah_, al_, denh, denl)
     param = dd_div(numh, numl, denh, denl)[0]
     nuh, nul = dd_sqrt(nu2h, nu2l)
-    ch, cl = dd_div(1.0, 0.0, big_c, 0.0)
     cgh, cgl = dd_mul(ch, cl, gh, gl)
     # κ = (a−c) G / ν
     kah, kal = dd_mul(ach, acl, gh, gl)
@@ -263,16 +322,16 @@ def half_angles(sin_x, cos_x):
 
 
 @jit
-def node_quaternion(cos_i, sin_i, h):
+def node_quaternion(cos_i, sin_i, sin_h, cos_h):
     """Quaternion (w, x, y, z) of the node frame (R1(I) R3(h))ᵀ = R3(h)ᵀ R1(I)ᵀ, body → inertial.
 
-    q_z(h) ⊗ q_x(I) from the half angles, as four floats: the matrix of
+    q_z(h) ⊗ q_x(I) from the half angles (:func:`half_angles`, no trigonometric call), as four floats: the matrix of
     :func:`.andoyer.node_frame` and Shepperd's conversion of it allocated two arrays and cost
     ≈ 80 ns of the set-up. The sign is the one :func:`.rotations.matrix_to_quat` picks (largest
     component positive), so the output quaternions keep their sign convention.
     """
     ci, si = half_angles(sin_i, cos_i)  # I ∈ [0, π]
-    ch, sh = math.cos(0.5 * h), math.sin(0.5 * h)
+    ch, sh = half_angles(sin_h, cos_h)
     w, x, y, z = ch * ci, ch * si, sh * si, sh * ci
     big = w
     if abs(x) > abs(big):
@@ -307,10 +366,31 @@ def flow_constants(quaternion, momentum, big_a, big_b, big_c):
         Motion constants (:func:`.canonical.motion_constants`), parameter and pn constants of the
         elliptic kernels.
     """
-    ic = inertia_constants(big_a, big_b, big_c)
+    flow = np.empty(FLOW_SIZE)
+    mo, mk, pk = flow_constants_into(flow, quaternion, momentum, big_a, big_b, big_c)
+    return flow, mo, mk, pk
+
+
+@jit
+def flow_constants_into(flow, quaternion, momentum, big_a, big_b, big_c):
+    """:func:`flow_constants` into a caller's (FLOW_SIZE,) array; returns (mo, mk, pk).
+
+    For loops over many states (:func:`.flow.propagate_many_into`): one buffer for all of them
+    instead of an allocation per state. Every slot the evaluation reads is written.
+    """
+    ic, inertia_dd = moment_constants(big_a, big_b, big_c)
+    return flow_constants_shared(flow, quaternion, momentum, big_a, big_b, big_c, ic, inertia_dd)
+
+
+@jit
+def flow_constants_shared(flow, quaternion, momentum, big_a, big_b, big_c, ic, inertia_dd):
+    """:func:`flow_constants_into` with the body's :func:`moment_constants` (ic, inertia_dd) given.
+
+    States of one body share them; they were ≈ 12 divisions of every state's set-up.
+    """
     m0x, m0y, m0z = momentum[0], momentum[1], momentum[2]
     mo, flip = motion_from_momentum(m0x, m0y, m0z, ic)
-    flow = np.zeros(FLOW_SIZE)
+    flow[:] = 0.0
     mode = int(mo[MO_MODE])
     flow[FL_MODE] = mode
     flow[FL_FLIP] = flip
@@ -335,31 +415,27 @@ def flow_constants(quaternion, momentum, big_a, big_b, big_c):
         flow[FL_QN_W], flow[FL_QN_X] = quaternion[0], quaternion[1]
         flow[FL_QN_Y], flow[FL_QN_Z] = quaternion[2], quaternion[3]
         mk, pk = elliptic_constants(mo)  # unused by a uniform rotation; returned for one signature
-        return flow, mo, mk, pk
+        return mo, mk, pk
     mx, my, mz = fx * m0x, fy * m0y, fz * m0z
     (nuh, nul, perh, perl, cgh, cgl, wh, wl, kah, kal, param, param_c, char_n, ok, complete_pi) = (
-        phase_constants_dd(mode, mx, my, mz, big_a, big_b, big_c)
+        phase_constants_dd(mode, mx, my, mz, inertia_dd)
     )
     if ok > 0.0 and mo[MO_PARAM_C] > 0.0:
         # kernel constants from the once-rounded double-double p, p_c, n (not from ratios of rounded
         # differences: near the separatrix those lose ε/p_c in p_c), with K and Π from the
-        # double-double AGM above instead of a second AGM and a Carlson R_J per state
+        # compensated AGM above instead of a second AGM and a Carlson R_J per state
         mk = parameter_constants_with_k(param, param_c, 0.5 * perh, 0.5 * perl)
         pk = characteristic_constants_with_complete(char_n, param, complete_pi)
         periodic = True
     else:  # the separatrix: the kernels' closed forms, from the motion constants
         mk, pk = elliptic_constants(mo)
         periodic = False
-    # the working attitude diag(flip) · M(q)ᵀ as a view of M(q) with its columns signed (one array,
-    # not three: per-state allocations were a third of the set-up)
-    matrix = quat_to_matrix(quaternion)
-    matrix[:, 0] *= fx
-    matrix[:, 1] *= fy
-    matrix[:, 2] *= fz
-    arg0 = ellipf_k(amplitude_from_momentum(mx, my, mz, mo, ic), mk)
-    _, _, _, sin_l, cos_l = body_from_argument(arg0, mo, mk)
-    _, cos_i, sin_i, h, g0 = node_angles_of(matrix.T, mx, my, mz, sin_l, cos_l)
-    flow[FL_QN_W], flow[FL_QN_X], flow[FL_QN_Y], flow[FL_QN_Z] = node_quaternion(cos_i, sin_i, h)
+    if periodic:
+        arg0 = _argument_of_momentum(mx, my, mz, mode, ic, mk)
+    else:  # m_c = 0: F = atanh(sin am) in Carlson's form, ±inf past ±π/2 (ellipf_k's cases)
+        arg0 = ellipf_k(amplitude_from_momentum(mx, my, mz, mo, ic), mk)
+    g0, qn = _node_of_state(quaternion, m0x, m0y, m0z, fx, fy, fz, mx, my)
+    flow[FL_QN_W], flow[FL_QN_X], flow[FL_QN_Y], flow[FL_QN_Z] = qn
     flow[FL_ARG0] = arg0
     flow[FL_PERIODIC] = 1.0 if periodic else 0.0
     flow[FL_RATE_HI], flow[FL_RATE_LO] = nuh, nul
@@ -383,7 +459,79 @@ def flow_constants(quaternion, momentum, big_a, big_b, big_c):
         ph, pl = dd_mul(kah, kal, pn_k(arg0, mk, pk), 0.0)
     ch, cl = dd_add(g0, 0.0, -ph, -pl)
     flow[FL_G_CONST_HI], flow[FL_G_CONST_LO] = ch, cl
-    return flow, mo, mk, pk
+    return mo, mk, pk
+
+
+@jit
+def _argument_of_momentum(mx, my, mz, mode, ic, mk):
+    """The elliptic argument F(am | p) at the working-frame momentum (u in SAM, v in LAM), 0 ≤ p < 1.
+
+    :func:`.canonical.amplitude_from_momentum` followed by :func:`.elliptic_integrals.ellipf_k`,
+    without the atan2 and the sin, cos of its result: sin and cos of the amplitude are the
+    momentum's own ratios, and the whole turns of π (|am| ≤ π, so j ∈ {−1, 0, 1}) follow from
+    their signs. F = 2jK + sin r · R_F(cos² r, cos² r + p_c sin² r, 1) (note §6.3).
+    """
+    _a, _b, _c, a_b, b_c, a_c = ic
+    if mode == MODE_SAM:
+        ys, xs = math.sqrt(b_c) * my, math.sqrt(a_c) * mx
+    else:
+        ys, xs = math.sqrt(a_b) * my, math.sqrt(a_c) * mz
+    norm2 = ys * ys + xs * xs  # not hypot (≈ 15 ns): momenta below 1e150 cannot overflow it
+    if not norm2 > 0.0:
+        return 0.0  # atan2(0, 0) = 0 (spin exactly about C in SAM)
+    inv = 1.0 / math.sqrt(norm2)
+    s, c = ys * inv, xs * inv
+    j = 0.0
+    if c < 0.0:  # am beyond ±π/2: r = am − jπ, sin r = −s, cos r = −c
+        j = math.copysign(1.0, s)
+        s, c = -s, -c
+    f_r = s * rf(c * c, c * c + mk[MK_MC] * (s * s), 1.0)
+    return 2.0 * j * mk[MK_K_HI] + (2.0 * j * mk[MK_K_LO] + f_r)
+
+
+@jit
+def _rotate(w, x, y, z, vx, vy, vz):
+    """M(q) v for a unit quaternion q = (w, x, y, z): the body vector v in the inertial frame."""
+    tx = 2.0 * (y * vz - z * vy)
+    ty = 2.0 * (z * vx - x * vz)
+    tz = 2.0 * (x * vy - y * vx)
+    return (vx + w * tx + (y * tz - z * ty), vy + w * ty + (z * tx - x * tz),
+            vz + w * tz + (x * ty - y * tx))
+
+
+@jit
+def _node_of_state(quaternion, m0x, m0y, m0z, fx, fy, fz, mx, my):
+    """(g0, node quaternion) of a state: :func:`.canonical.node_angles_of` from the quaternion.
+
+    l is the body-frame longitude of the momentum, (sin l, cos l) = (M_x, M_y)/|M_⊥| (working frame;
+    at J = 0 the elements' convention l = π/2 of :func:`.canonical.body_from_sncndn`). The inertial
+    momentum is M(q) M0 (the flip is its own inverse), the node's h enters only through
+    (sin h, cos h) = (i_0, −i_1)/|i_⊥|, and the first row of R3(g) = Wᵀ R Nᵀ needs the inertial
+    image of W's first column (cos l, −sin l, 0) in the working frame. No matrix, no atan2 for h,
+    no sn, cn, dn at arg0 (≈ 150 ns of the set-up).
+    """
+    # sums of squares, not hypot (≈ 15 ns each): momenta below 1e150 cannot overflow them
+    perp2 = mx * mx + my * my
+    if perp2 > 0.0:
+        inv = 1.0 / math.sqrt(perp2)
+        sin_l, cos_l = mx * inv, my * inv
+    else:  # J = 0 (SAM with M_x = M_y = 0)
+        sin_l, cos_l = 1.0, 0.0
+    w, x, y, z = quaternion[0], quaternion[1], quaternion[2], quaternion[3]
+    i0, i1, big_h = _rotate(w, x, y, z, m0x, m0y, m0z)
+    r0, r1, r2 = _rotate(w, x, y, z, fx * cos_l, -fy * sin_l, 0.0)
+    inv_g = 1.0 / math.sqrt(m0x * m0x + m0y * m0y + m0z * m0z)
+    across = math.sqrt(i0 * i0 + i1 * i1)
+    sin_i, cos_i = across * inv_g, big_h * inv_g
+    if across > 0.0:
+        inv = 1.0 / across
+        sh, ch = i0 * inv, -i1 * inv
+    else:  # I = 0: h = atan2(i0, −i1) of the signed zeros, as node_angles_of takes it
+        h = math.atan2(i0, -i1)
+        sh, ch = math.sin(h), math.cos(h)
+    r3g_00 = r0 * ch + r1 * sh
+    r3g_01 = cos_i * (r1 * ch - r0 * sh) + sin_i * r2
+    return math.atan2(r3g_01, r3g_00), node_quaternion(cos_i, sin_i, sh, ch)
 
 
 

@@ -91,7 +91,7 @@ def _characteristic_method(n, m):
 def characteristic_constants_with_complete(n, m, complete):
     """:func:`characteristic_constants` for 0 ≤ m < 1 with Π(n|m) already known.
 
-    For callers that hold Π from their own double-double AGM (the flow set-up,
+    For callers that hold Π from their own (compensated) AGM (the flow set-up,
     :func:`spinorbit.core.free_motion.flow_constants.complete_k_pi_dd`), so the complete integral is
     not formed a second time in Carlson's form.
     """

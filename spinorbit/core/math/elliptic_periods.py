@@ -108,7 +108,7 @@ def parameter_constants(m, mc):
 def parameter_constants_with_k(m, mc, k_hi, k_lo):
     """:func:`parameter_constants` for 0 ≤ m < 1 with K(m) already known as a double-double.
 
-    For callers that hold K from their own double-double AGM (the flow set-up forms K from the
+    For callers that hold K from their own (compensated) AGM (the flow set-up forms K from the
     exact inputs, :func:`spinorbit.core.free_motion.flow_constants.complete_k_pi_dd`), so the AGM
     is not run twice per state.
     """

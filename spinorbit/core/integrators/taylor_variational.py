@@ -17,9 +17,9 @@ J(t) that are polynomials in the series of ω and T, so with the state's series 
 
     Φ^[k+1] = (1/(k+1)) Σ_{j≤k} J^[j] Φ^[k−j],   Ψ^[k+1] = (1/(k+1)) (Σ_{j≤k} J^[j] Ψ^[k−j] + F^[k]).
 
-T's series is built from the rows the state's recurrence already fills: the body-frame positions and
-|r|⁻⁵ of each perturber (its pair products, weighted by |r|⁻⁵, with the same truncation of a Keplerian
-orbit series above its order m).
+T's series is built from the rows the state's recurrence already fills: each perturber's body-frame
+ρ = |r|⁻⁵ᐟ² r_body, whose pair products are |r|⁻⁵ r rᵀ (the |r|⁻⁵ᐟ² comes from the truncated orbit
+series, as in the state's torque).
 
 The driver is the Taylor integrator's rule (order and step of heyoka, Biscani & Izzo 2021), with one
 addition: the radius of convergence is also estimated from the last two orders of (Φ, Ψ), each relative
@@ -65,9 +65,8 @@ from spinorbit.core.integrators.taylor import (
     taylor_order,
 )
 from spinorbit.core.integrators.taylor_recurrences import (
-    BODY_POSITION_OFFSET,
-    INVERSE_R5_OFFSET,
     PERTURBER_BLOCK_ROWS,
+    SCALED_BODY_POSITION_OFFSET,
     SERIES_HEAD_ROWS,
     horner,
     orbit_radius,
@@ -96,34 +95,24 @@ _W0 = 4  # ω's first row in the state's series
 
 
 @jit
-def tidal_series_into(model, s, n_pert, order, orbit_orders, pairs, tidal):
+def tidal_series_into(model, s, n_pert, order, tidal):
     """Orders 0..order−1 of T = Σ 3μ |r|⁻⁵ r rᵀ (body frame) from the filled state series ``s``.
 
-    ``pairs`` (6 × order) is work space; ``tidal`` (6 × ≥ order) receives the rows T_XX … T_XY. A
-    perturber's |r|⁻⁵ is zero above its orbit order m (as in the state's recurrence).
+    ``tidal`` (6 × ≥ order) receives the rows T_XX … T_XY, as Σ 3μ ρ ρᵀ of each perturber's body-frame
+    ρ = |r|⁻⁵ᐟ² r_body, which the state's recurrence fills (its torque is made of the same products).
     """
     for c in range(6):
         for k in range(order):
             tidal[c, k] = 0.0
     for p in range(n_pert):
         three_mu = 3.0 * model[MODEL_PERTURBERS + 1 + p * PERTURBER_ROW + 1]
-        base = SERIES_HEAD_ROWS + p * PERTURBER_BLOCK_ROWS
-        rb = base + BODY_POSITION_OFFSET
-        s5 = base + INVERSE_R5_OFFSET
-        m = orbit_orders[p]
+        rb = SERIES_HEAD_ROWS + p * PERTURBER_BLOCK_ROWS + SCALED_BODY_POSITION_OFFSET
         for c in range(6):
             a, b = TIDAL_PAIRS[c]
             for k in range(order):
                 acc = 0.0
                 for j in range(k + 1):
                     acc += s[rb + a, j] * s[rb + b, k - j]
-                pairs[c, k] = acc
-        for k in range(order):
-            lo = max(0, k - m)
-            for c in range(6):
-                acc = 0.0
-                for j in range(lo, k + 1):
-                    acc += s[s5, k - j] * pairs[c, j]
                 tidal[c, k] += three_mu * acc
 
 
@@ -220,7 +209,6 @@ def integrate_taylor_variational_kernel(y0, t0, t_out, model, tol, max_steps):
     s = series_array(n_pert, order)
     v = np.zeros((VARIATIONAL_SIZE, order + 1))
     tidal = np.zeros((6, order + 1))
-    pairs = np.zeros((6, order + 1))
     y = y0.copy()
     normalize_quaternion_part(y)
     var = np.zeros(VARIATIONAL_SIZE)
@@ -253,7 +241,7 @@ def integrate_taylor_variational_kernel(y0, t0, t_out, model, tol, max_steps):
         w_scale = max(math.sqrt(y[4] * y[4] + y[5] * y[5] + y[6] * y[6]), 1e-300)
         h_cap = STEP_GROWTH * h_prev
         taylor_coefficients_into(t, model, s, n_pert, order, h_cap, orbit_tol, orbit_orders)
-        tidal_series_into(model, s, n_pert, order, orbit_orders, pairs, tidal)
+        tidal_series_into(model, s, n_pert, order, tidal)
         variational_series_into(model, s, tidal, v, order)
         rho = np.inf
         for k in (order - 1, order):

@@ -66,7 +66,7 @@ def test_kepler_orbit_puts_the_sun_where_the_elements_say(small):
     constants = de421_constants()
     position, velocity = elements_to_state(a_km / constants.au_km, e, inc, raan, argp, mean_anomaly,
                                            constants.gm["sun"], "ecliptic")
-    sun = perturber_state(orbit.kepler[-1], model, MODEL_PERTURBERS + 1)
+    sun = perturber_state(orbit.kepler_elements[-1], model, MODEL_PERTURBERS + 1)
     assert np.allclose(sun[:3], -position, rtol=0, atol=KEPLER_RTOL * np.linalg.norm(position))
     assert np.allclose(sun[3:], -velocity, rtol=0, atol=KEPLER_RTOL * np.linalg.norm(velocity))
     normal = np.cross(position, velocity)
@@ -82,7 +82,7 @@ def test_full_route_is_the_core_integration(small):
     # Built here from the shape, not through the Scene: the block, the Sun, the model, the integration.
     block = thermal_block(shape, shape_mass_properties(shape, density=DENSITY))
     model = make_model(body.principal_moments, [orbit.kepler_sun()], thermal=block, thermal_sun=0)
-    t0 = orbit.kepler[-1]
+    t0 = orbit.kepler_elements[-1]
     ys = integrate_quaternion(state.core_state(), t0, t0 + np.linspace(5, 60, 12), model,
                               rtol=result.table.meta["rtol"])
     q = np.stack([result.table[c] for c in ("q_w", "q_x", "q_y", "q_z")], axis=1)
@@ -103,7 +103,7 @@ def test_mean_route_is_propagate_mean_thermal(small):
     model = make_model(body.principal_moments, [orbit.kepler_sun()],
                        thermal=thermal_block(thermal.shape, thermal.properties), thermal_sun=0)
     frame = orbit.kepler_frame()
-    t0 = orbit.kepler[-1]
+    t0 = orbit.kepler_elements[-1]
     el0 = elements_of_state(state.core_state(), model, frame)
     direct, _ = propagate_mean_thermal(el0, t0, t0 + days, model, frame, result.table.meta["mean_step_days"])
     got = _elements(result.table)
@@ -143,7 +143,7 @@ def test_forced_routes(small):
 
 def test_mean_route_agrees_with_the_full_route_within_its_estimate(small):
     _, _, thermal, state, orbit = small
-    period = 2 * math.pi / math.sqrt(de421_constants().gm["sun"] / orbit.kepler[0] ** 3)
+    period = 2 * math.pi / math.sqrt(de421_constants().gm["sun"] / orbit.kepler_elements[0] ** 3)
     # Whole orbits (the orbit's short-period terms return) and half orbits (they do not).
     days = period * np.array([1.0, 1.5, 2.5, 4.0])
     results = {route: Scene(state, EPOCH, EPOCH + days * u.day, orbit=orbit, thermal=thermal,
@@ -242,3 +242,13 @@ def test_bad_thermal_input(small):
         about_b = _tumbler(body, (1e-6, 1.0, 1e-6))  # at the separatrix: no torus to average over
         Scene(about_b, EPOCH, EPOCH + 100 * u.yr, orbit=orbit, thermal=thermal, tolerance=0.1 * u.rad,
               thermal_route="mean").plan()
+
+
+def test_only_a_kepler_orbit_carries_elements():
+    """The elements field must not share its name with the ``Orbit.kepler`` constructor: a dataclass
+    then takes the bound classmethod as every other orbit's default (a truthy non-tuple)."""
+    assert Orbit.circular(2.0 * u.au).kepler_elements is None
+    assert Orbit.de421("moon").kepler_elements is None
+    elements = Orbit.kepler(*ELEMENTS, EPOCH).kepler_elements
+    assert isinstance(elements, tuple) and len(elements) == 7
+    assert all(isinstance(value, float) for value in elements)

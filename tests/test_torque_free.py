@@ -28,7 +28,6 @@ from spinorbit.core.math.elliptic_integrals import NK_N, complete_k_pi
 from spinorbit.core.math.elliptic_periods import MK_K_HI, MK_M
 from spinorbit.core.math.elliptic_periods import ellipk
 from spinorbit.core.math.pn_fourier import (
-    FOURIER_MAX_TERMS,
     FOURIER_RHO_MAX,
     FOURIER_TAIL,
     NOME_LAMBDA_MAX,

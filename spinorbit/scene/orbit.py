@@ -91,7 +91,7 @@ class Orbit:
     #: Built here among DE421's planets: runs stay inside DE421's span (:meth:`check_span`).
     de421_planets: bool = False
     #: Of kind "kepler": the heliocentric ellipse as ICRF elements (a au, e, i, Ω, ω, M rad, epoch TDB day).
-    kepler: tuple | None = None
+    kepler_elements: tuple | None = None
 
     @classmethod
     def de421(cls, name):
@@ -167,7 +167,7 @@ class Orbit:
         description = (f"heliocentric Kepler ellipse a = {a:.6g}, e = {e:.6g}, i = {math.degrees(inc):.6g} deg "
                        f"({frame}) at {epoch.tdb.iso} TDB, the Sun alone, no planets")
         return cls("kepler", str(name), description=description,
-                   kepler=(a_km / au_km, e, inc_icrf, node % (2 * math.pi), argp_icrf, mean_anomaly, epoch_day))
+                   kepler_elements=(a_km / au_km, e, inc_icrf, node % (2 * math.pi), argp_icrf, mean_anomaly, epoch_day))
 
     def kepler_sun(self):
         """The core Kepler source of the Sun relative to the body (au, day; :func:`~spinorbit.core.model.perturbers.kepler_source`)."""
@@ -176,13 +176,13 @@ class Orbit:
 
         if self.kind != "kepler":
             raise SceneError(f"kepler_sun needs an Orbit.kepler; this orbit is of kind {self.kind!r}.")
-        a, e, inc, node, argp, mean_anomaly, epoch_day = self.kepler
+        a, e, inc, node, argp, mean_anomaly, epoch_day = self.kepler_elements
         return kepler_source(de421_constants().gm["sun"], a, e, inc, node, argp, mean_anomaly, epoch=epoch_day,
                              sign=-1.0)
 
     def kepler_frame(self):
         """Inertial (ICRF) → orbit frame (P, Q, W) of an Orbit.kepler: W, the orbit normal, is its z."""
-        _, _, inc, node, argp, _, _ = self.kepler
+        _, _, inc, node, argp, _, _ = self.kepler_elements
         cos_o, sin_o, cos_i, sin_i, cos_w, sin_w = (math.cos(node), math.sin(node), math.cos(inc), math.sin(inc),
                                                     math.cos(argp), math.sin(argp))
         p = [cos_o * cos_w - sin_o * sin_w * cos_i, sin_o * cos_w + cos_o * sin_w * cos_i, sin_w * sin_i]

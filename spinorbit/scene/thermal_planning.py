@@ -99,7 +99,7 @@ class ThermalSetup:
         self.frame = orbit.kepler_frame()  # inertial → (P, Q, W): H/Z is the cosine of the obliquity
         self.y0 = scene.state.core_state()
         self.t0 = scene.epoch_day
-        a, e = orbit.kepler[0], orbit.kepler[1]
+        a, e = orbit.kepler_elements[0], orbit.kepler_elements[1]
         from spinorbit.ephemeris import de421_constants
 
         self.gm_sun = de421_constants().gm["sun"]

@@ -22,7 +22,6 @@ from spinorbit.core.elements.canonical import (
     MO_ARG_PER_S,
     MO_G,
     MO_MODE,
-    MO_PARAM,
     MO_PARAM_C,
     MO_PN_COEFF,
     MO_PN_N,

@@ -94,9 +94,12 @@ import astropy.units, astropy.time
 mark("astropy (units, time)")
 import numba
 mark("numba import")
+# numba.np.arraymath imports this at target set-up to find BLAS: timed apart, it is part of the floor.
+import scipy.linalg.cython_blas
+mark("scipy.linalg (numba's BLAS check at target set-up)")
 from spinorbit.core.math.rotations import euler313_to_attitude
 euler313_to_attitude(0.1, 0.2, 0.3)
-mark("numba's CPU target set-up + first cached kernel")
+mark("numba's CPU target set-up (rest) + first cached kernel")
 import spinorbit.commands.moon
 from spinorbit.coupling.moon import compare_model_with_de421
 mark("spinorbit's moon modules")

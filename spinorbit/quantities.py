@@ -22,6 +22,12 @@ from astropy import units as u
 
 __all__ = ["QuantityInputError", "finite_values", "parse_quantity", "parse_unit", "value_in"]
 
+# The physical types value_in compares with, looked up once: comparing with a string parses the name
+# on every call (~4 µs each, several per member of an ensemble); comparing PhysicalTypes is the same test.
+_ANGULAR_VELOCITY = u.get_physical_type("angular velocity")
+_FREQUENCY = u.get_physical_type("frequency")
+_DIMENSIONLESS = u.get_physical_type("dimensionless")
+
 
 class QuantityInputError(u.UnitTypeError):
     """A Quantity argument of the wrong physical type, a frequency given for a rotation rate, or unreadable text.
@@ -93,7 +99,8 @@ def value_in(name: str, value, unit, example: str, *, plain_unit=None, finite: b
     """
     unit = u.Unit(unit)
     if isinstance(value, u.Quantity):
-        if unit.physical_type == "angular velocity" and value.unit.physical_type == "frequency":
+        expected_type, value_type = unit.physical_type, value.unit.physical_type  # each read costs ~1 µs: once
+        if expected_type == _ANGULAR_VELOCITY and value_type == _FREQUENCY:
             raise QuantityInputError(_frequency_advice(name, value, unit))
         try:
             values = value.to_value(unit, equivalencies=u.dimensionless_angles())
@@ -102,7 +109,7 @@ def value_in(name: str, value, unit, example: str, *, plain_unit=None, finite: b
                 f"{name}: expected a Quantity in {_expected(unit)} such as {example}; got "
                 f"{_arrived(value)}."
             ) from None
-        if unit.physical_type != "dimensionless" and value.unit.physical_type != unit.physical_type:
+        if expected_type != _DIMENSIONLESS and value_type != expected_type:
             # dimensionless_angles lets rad/day pass as 1/day; only the right physical type may pass
             raise QuantityInputError(
                 f"{name}: expected a Quantity in {_expected(unit)} such as {example}; got "

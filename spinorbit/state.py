@@ -222,6 +222,12 @@ class RotationState:
         return self._omega * RAD_PER_DAY
 
     @property
+    def angular_velocity_rad_per_day(self) -> np.ndarray:
+        """:attr:`angular_velocity`'s values in rad/day as plain floats (a copy): the same numbers without
+        building a Quantity (~5 µs), for code that reads many states (the ensemble's batch route)."""
+        return self._omega.copy()
+
+    @property
     def angular_momentum(self) -> u.Quantity:
         """Body angular momentum I ω in the user's body axes (moment unit × rad/day)."""
         return self._body.moment_values * self._omega * (self._body.moment_unit * RAD_PER_DAY)

@@ -148,7 +148,12 @@ def tdb_day_and_fraction(time: Time) -> tuple[np.ndarray | float, np.ndarray | f
     tdb = _convert(_check_time(time), "tdb")
     # astropy keeps jd1 integer-valued (or half-integer) and |jd2| ≤ 0.5 d; jd1 − J2000 is an exact
     # difference of integers. Re-splitting with round() moves only exactly representable values.
-    jd1, jd2 = tdb.jd1, tdb.jd2  # each read of these properties costs ~10 µs (astropy reshapes a view): once
+    if tdb.masked:
+        jd1, jd2 = tdb.jd1, tdb.jd2  # masked arrays, as astropy's properties give them
+    else:
+        # the stored doubles themselves: astropy's jd1/jd2 properties cost ~8 µs each (they rebuild the
+        # input's shape and unbox a scalar), the same numbers; read on every call, never cached (a Time is mutable)
+        jd1, jd2 = tdb._time.jd1, tdb._time.jd2
     offset = jd1 - J2000_JD_TDB
     day = np.round(offset + jd2)
     fraction = (offset - day) + jd2

@@ -39,6 +39,23 @@ def test_body_orders_axes_with_a_proper_rotation():
     assert np.allclose(np.abs(p @ np.diag([3.0836, 3.235, 1.0]) @ p.T), np.diag(body.principal_moments))
 
 
+@pytest.mark.parametrize("moments", [[1.0, 2.0, 3.0], [1.0, 3.0, 2.0], [2.0, 1.0, 3.0], [2.0, 3.0, 1.0],
+                                     [3.0, 1.0, 2.0], [3.0, 2.0, 1.0], [2.0, 1.0, 1.0], [1.0, 1.0, 1.0]])
+def test_every_axis_order_gives_a_proper_rotation_sorting_the_moments(moments):
+    # the permutation's parity is counted (no determinant): each of the 6 orders, and ties, must give det +1
+    p = RigidBody(moments).to_principal
+    assert np.linalg.det(p) == 1.0 and np.all(np.abs(p).sum(axis=1) == 1.0)
+    assert tuple(np.abs(p) @ np.array(moments)) == RigidBody(moments).principal_moments
+
+
+def test_plain_angular_velocity_is_the_quantitys_values_and_a_copy():
+    state = RotationState(RigidBody([1.0, 2.0, 3.0]), [1.0, 0.0, 0.0, 0.0], [0.1, -0.2, 0.3] * u.rad / u.s)
+    plain = state.angular_velocity_rad_per_day
+    assert plain.tobytes() == state.angular_velocity.to_value(u.rad / u.day).tobytes()
+    plain[0] = 99.0
+    assert state.angular_velocity_rad_per_day[0] != 99.0
+
+
 @pytest.mark.parametrize("unit", [1.0, u.kg * u.m**2])
 def test_body_owns_its_moments(unit):
     # The body keeps its own read-only copy: the caller's array stays writable, and changing it

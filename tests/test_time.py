@@ -110,3 +110,20 @@ def test_unknown_output_scale_is_refused():
 def test_quantity_days_are_refused():
     with pytest.raises(TypeError, match="strip units"):
         time_from_tdb_days(3.0 * u.day)
+
+
+@pytest.mark.parametrize("value", [2462240.407, [2451545.0, 2462240.407, 2488069.5], [[2451545.25], [2415020.75]]])
+def test_day_and_fraction_read_the_same_doubles_as_astropys_jd1_jd2(value):
+    # tdb_day_and_fraction reads the stored jd1/jd2 (not astropy's reshaping properties): the same bits,
+    # scalar and array, and it sees a Time changed in place
+    time = Time(value, format="jd", scale="tdb")
+    offset = time.jd1 - 2451545.0
+    day = np.round(offset + time.jd2)
+    expected = (day, (offset - day) + time.jd2)
+    got = tdb_day_and_fraction(time)
+    assert all(np.asarray(g).tobytes() == np.asarray(e).tobytes() and np.shape(g) == np.shape(e)
+               for g, e in zip(got, expected))
+    if time.isscalar:
+        assert isinstance(got[0], float)
+        time[()] = Time(2451546.0, format="jd", scale="tdb")
+        assert tdb_day_and_fraction(time) == (1.0, 0.0)

@@ -349,7 +349,7 @@ def run_group(group, shared, at_days, integrators=None):
     # each member's plain values, read from its state once: principal moments, I ω (user axes, rad/day)
     moments = np.array([state.body.principal_moments for state in states])
     momenta = np.array([state.body.moment_values for state in states]) * np.array(
-        [state.angular_velocity.value for state in states])
+        [state.angular_velocity_rad_per_day for state in states])
     bounds = _member_bounds(survey, leader.output_days[-1], moments, momenta, attitude_sensitivities(states, span))
     batch, picked, used, kept_bounds = [], [], [], []
     for position, (member, bound) in enumerate(zip(group, bounds)):

@@ -205,7 +205,7 @@ def attitude_sensitivities(states, span_days):
     starts = [_flow_start(state, horizons[-1]) for state in states]
     p = np.array([state.body.to_principal for state in states])
     values = np.array([state.body.moment_values for state in states])
-    kicked = np.repeat(np.array([state.angular_velocity.value for state in states])[:, None, :], 3, axis=1)  # rad/day
+    kicked = np.repeat(np.array([state.angular_velocity_rad_per_day for state in states])[:, None, :], 3, axis=1)  # rad/day
     kicked[:, range(3), range(3)] += kick  # ω kicked along each user body axis
     momenta = np.empty((n, 4, 3))
     momenta[:, :3] = np.matmul(p[:, None], (values[:, None, :] * kicked)[..., None])[..., 0]  # P (I ω) per row

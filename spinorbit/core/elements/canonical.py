@@ -155,7 +155,16 @@ def motion_constants(mode, big_g, d_c, a_d, b_d, a, b, c, a_b, b_c, a_c):
     Parameters are G and the energy differences of :func:`energy_differences` (for the flipped
     frame, which has the same differences) and the inertia constants.
     """
-    mo = np.zeros(MO_SIZE)
+    mo = np.empty(MO_SIZE)
+    motion_constants_into(mo, mode, big_g, d_c, a_d, b_d, a, b, c, a_b, b_c, a_c)
+    return mo
+
+
+@jit
+def motion_constants_into(mo, mode, big_g, d_c, a_d, b_d, a, b, c, a_b, b_c, a_c):
+    """:func:`motion_constants` into a caller's (MO_SIZE,) array (loops over many states reuse one
+    buffer: the allocation cost ≈ 20 ns of the torque-free set-up)."""
+    mo[:] = 0.0
     mo[MO_MODE] = mode
     mo[MO_G] = big_g
     if mode == MODE_UNIFORM:
@@ -195,10 +204,19 @@ def motion_constants(mode, big_g, d_c, a_d, b_d, a, b, c, a_b, b_c, a_c):
 @jit
 def motion_from_momentum(mx, my, mz, ic):
     """(motion constants, flip) of the torque-free motion through body momentum (M_x, M_y, M_z)."""
+    mo = np.empty(MO_SIZE)
+    flip = motion_from_momentum_into(mo, mx, my, mz, ic)
+    return mo, flip
+
+
+@jit
+def motion_from_momentum_into(mo, mx, my, mz, ic):
+    """:func:`motion_from_momentum` into a caller's (MO_SIZE,) array; returns the flip."""
     a, b, c, a_b, b_c, a_c = ic
     g2, d_c, a_d, b_d = energy_differences(mx, my, mz, a_b, b_c, a_c)
     mode, flip = choose_flip(mx, mz, b_d, a_b, b_c)
-    return motion_constants(mode, math.sqrt(g2), d_c, a_d, b_d, a, b, c, a_b, b_c, a_c), flip
+    motion_constants_into(mo, mode, math.sqrt(g2), d_c, a_d, b_d, a, b, c, a_b, b_c, a_c)
+    return flip
 
 
 @jit
@@ -317,8 +335,9 @@ def body_from_sncndn(sn, cn, dn, mo):
     mz = mo[MO_Z_AMP] * third
     ws = mo[MO_SIN_L_W] * first
     wc = mo[MO_COS_L_W] * sn
-    norm = math.hypot(ws, wc)
-    return mx, my, mz, ws / norm, wc / norm
+    # not hypot (≈ 15 ns per evaluation): amplitudes below 1e150 cannot overflow the squares
+    inv = 1.0 / math.sqrt(ws * ws + wc * wc)
+    return mx, my, mz, ws * inv, wc * inv
 
 
 @jit

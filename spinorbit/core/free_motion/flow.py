@@ -60,6 +60,7 @@ from spinorbit.core.elements.canonical import (
     FLIP_B,
     FLIP_C,
     MO_G,
+    MO_SIZE,
     MODE_UNIFORM,
     body_from_sncndn,
 )
@@ -95,7 +96,7 @@ from spinorbit.core.free_motion.flow_constants import (
     FL_RATE_LO,
     FLOW_SIZE,
     flow_constants,
-    flow_constants_shared,
+    flow_constants_buffers,
     flow_kappa_pn,
     half_angles,
     moment_constants,
@@ -235,6 +236,7 @@ def propagate_many_into(quaternions, momenta, moments, times, q_out, m_out, clos
     of the elliptic flow at parameter 0; False forces the elliptic flow (tests, benchmarks).
     """
     flow = np.empty(FLOW_SIZE)  # one buffer for every state's constants (an allocation each cost ≈ 25 ns)
+    mo = np.empty(MO_SIZE)
     ic, inertia_dd = moment_constants(moments[0, 0], moments[0, 1], moments[0, 2])
     body = 0  # the row ic, inertia_dd belong to: recomputed only when the moments change
     for i in range(quaternions.shape[0]):
@@ -252,8 +254,8 @@ def propagate_many_into(quaternions, momenta, moments, times, q_out, m_out, clos
         if moments[i, 0] != moments[body, 0] or moments[i, 1] != moments[body, 1] or moments[i, 2] != moments[body, 2]:
             ic, inertia_dd = moment_constants(moments[i, 0], moments[i, 1], moments[i, 2])
             body = i
-        mo, mk, pk = flow_constants_shared(
-            flow, quaternions[i], momenta[i], moments[i, 0], moments[i, 1], moments[i, 2], ic, inertia_dd
+        mk, pk = flow_constants_buffers(
+            flow, mo, quaternions[i], momenta[i], moments[i, 0], moments[i, 1], moments[i, 2], ic, inertia_dd
         )
         for k in range(times.shape[0]):  # element stores: views q_out[i, k] cost ~10% of an evaluation
             (q_out[i, k, 0], q_out[i, k, 1], q_out[i, k, 2], q_out[i, k, 3],

@@ -15,13 +15,14 @@ import numpy as np
 from spinorbit.core.elements.canonical import (
     MO_MODE,
     MO_PARAM_C,
+    MO_SIZE,
     MODE_SAM,
     MODE_UNIFORM,
     amplitude_from_momentum,
     elliptic_constants,
     flip_signs,
     inertia_constants,
-    motion_from_momentum,
+    motion_from_momentum_into,
 )
 from spinorbit.core.jit import jit
 from spinorbit.core.math.carlson import rf
@@ -388,8 +389,18 @@ def flow_constants_shared(flow, quaternion, momentum, big_a, big_b, big_c, ic, i
 
     States of one body share them; they were ≈ 12 divisions of every state's set-up.
     """
+    mo = np.empty(MO_SIZE)
+    mk, pk = flow_constants_buffers(flow, mo, quaternion, momentum, big_a, big_b, big_c, ic, inertia_dd)
+    return mo, mk, pk
+
+
+@jit
+def flow_constants_buffers(flow, mo, quaternion, momentum, big_a, big_b, big_c, ic, inertia_dd):
+    """:func:`flow_constants_shared` into a caller's (MO_SIZE,) motion-constants array too; returns
+    (mk, pk). One buffer for a loop's states: the allocation cost ≈ 20 ns of each set-up.
+    """
     m0x, m0y, m0z = momentum[0], momentum[1], momentum[2]
-    mo, flip = motion_from_momentum(m0x, m0y, m0z, ic)
+    flip = motion_from_momentum_into(mo, m0x, m0y, m0z, ic)
     flow[:] = 0.0
     mode = int(mo[MO_MODE])
     flow[FL_MODE] = mode
@@ -415,7 +426,7 @@ def flow_constants_shared(flow, quaternion, momentum, big_a, big_b, big_c, ic, i
         flow[FL_QN_W], flow[FL_QN_X] = quaternion[0], quaternion[1]
         flow[FL_QN_Y], flow[FL_QN_Z] = quaternion[2], quaternion[3]
         mk, pk = elliptic_constants(mo)  # unused by a uniform rotation; returned for one signature
-        return mo, mk, pk
+        return mk, pk
     mx, my, mz = fx * m0x, fy * m0y, fz * m0z
     (nuh, nul, perh, perl, cgh, cgl, wh, wl, kah, kal, param, param_c, char_n, ok, complete_pi) = (
         phase_constants_dd(mode, mx, my, mz, inertia_dd)
@@ -459,7 +470,7 @@ def flow_constants_shared(flow, quaternion, momentum, big_a, big_b, big_c, ic, i
         ph, pl = dd_mul(kah, kal, pn_k(arg0, mk, pk), 0.0)
     ch, cl = dd_add(g0, 0.0, -ph, -pl)
     flow[FL_G_CONST_HI], flow[FL_G_CONST_LO] = ch, cl
-    return mo, mk, pk
+    return mk, pk
 
 
 @jit
@@ -570,17 +581,13 @@ def kappa_pn(kah, kal, rh, rl, s, c, d, pk):
 def _fourier_constants(flow, mk, pk):
     """Fill the FL_FOURIER_* / FL_LINEAR_* slots when the nome series of pn converges fast enough.
 
-    The slope κΠ/K = W/(2K) and 1 − Π/K = 1 − (κΠ/K)/κ are formed in double-double from the
-    double-double W, 2K and κ, so neither the secular slope nor the normalisation of the series
-    (:func:`.pn_fourier.pn_fourier_coefficients`) loses digits when Π ≈ K (n → 0).
+    The slope κΠ/K = W/(2K) is formed in double-double from the double-double W and 2K; the
+    normalisation of the series is in closed form (:mod:`.pn_fourier`), so it needs no 1 − Π/K,
+    which cancels when Π ≈ K (n → 0).
     """
     lh, ll = dd_div(flow[FL_G_ADVANCE_HI], flow[FL_G_ADVANCE_LO], flow[FL_PERIOD_HI], flow[FL_PERIOD_LO])
-    rh, rl = dd_div(lh, ll, flow[FL_KAPPA_HI], flow[FL_KAPPA_LO])
-    one_minus_ratio = dd_add(1.0, 0.0, -rh, -rl)[0]
     k_quarter = mk[MK_K_HI]
-    terms = pn_fourier_coefficients(
-        -pk[NK_N], mk[MK_M], k_quarter, one_minus_ratio, flow[FL_KAPPA_HI], flow[FL_FOURIER_0:]
-    )
+    terms = pn_fourier_coefficients(-pk[NK_N], mk[MK_M], k_quarter, flow[FL_KAPPA_HI], flow[FL_FOURIER_0:])
     flow[FL_FOURIER_TERMS] = terms
     flow[FL_FOURIER_SCALE] = math.pi / k_quarter
     flow[FL_LINEAR_HI], flow[FL_LINEAR_LO] = lh, ll

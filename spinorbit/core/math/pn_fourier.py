@@ -11,7 +11,10 @@ pole of the integrand, sn²(iβ) = −1/f, from the real axis, sc(β | 1 − m) 
 
     c_k = C (ρ^k − σ^k) / (k (1 − q^{2k})),   ρ = e^{−πβ/K},  σ = q²/ρ ≤ ρ,
 
-and the constant C follows from pn'(0) = 1: (π/K) Σ k c_k = 1 − Π/K. β comes without a
+and the constant C follows from pn'(0) = 1: (π/K) Σ k c_k = 1 − Π/K, which Jacobi's form gives in
+closed form, C = √(f / ((1 + f)(f + m))) (checked with mpmath to 40 digits: then
+1 − Π/K = (π/K) C Σ_k (ρ^k − σ^k)/(1 − q^{2k}); no Π, no sum over the terms, no cancellation as
+f → 0, where C → 0 with the periodic part). β comes without a
 trigonometric call: β = F(φ | 1 − m) with sin²φ = 1/(1 + f), i.e. s R_F(c², Δ², 1) with
 c² = f/(1 + f), Δ² = (f + m)/(1 + f).
 
@@ -52,11 +55,28 @@ def pn_fourier_ratio(f, m, k_quarter):
     k_quarter : float
         K(m), the quarter period.
     """
-    s2 = 1.0 / (1.0 + f)
-    c2 = f * s2
-    delta2 = (f + m) * s2
-    beta = math.sqrt(s2) * rf(c2, delta2, 1.0)
-    return math.exp(-math.pi * beta / k_quarter)
+    return _pole_ratios(f, m, k_quarter, nome(m, k_quarter))[0]
+
+
+@jit
+def _pole_ratios(f, m, k_quarter, q):
+    """(ρ, w, 1 − w) with w = σ/ρ = q²/ρ² ≤ 1, so that ρ^k − σ^k = ρ^k (1 − w^k) without cancellation.
+
+    f ≥ m: β = s R_F(c², Δ², 1) (module docstring) and w = (q/ρ)² ≤ 0.07, so 1 − w is exact enough.
+    f < m: the pole is near the nome's (β → K' as f → 0, ρ → σ), so from γ = K' − β =
+    F(arctan √(f/m) | 1 − m) = √f R_F(m, m(1 + f), f + m): ρ = q e^{x}, 1 − w = −expm1(−2x),
+    x = πγ/K, and nothing cancels as f → 0 (the periodic part keeps its relative accuracy).
+    """
+    if f >= m:
+        s2 = 1.0 / (1.0 + f)
+        beta = math.sqrt(s2) * rf(f * s2, (f + m) * s2, 1.0)
+        rho = math.exp(-math.pi * beta / k_quarter)
+        ratio = q / rho
+        w = ratio * ratio
+        return rho, w, 1.0 - w
+    x = math.pi * math.sqrt(f) * rf(m, m * (1.0 + f), f + m) / k_quarter
+    one_minus_w = -math.expm1(-2.0 * x)
+    return q * math.exp(x), 1.0 - one_minus_w, one_minus_w
 
 
 # Nome from the modulus (DLMF 20.9.4 inverted, q = Σ a_j λ^{4j+1}, OEIS A005797), where it converges fast:
@@ -90,7 +110,7 @@ def nome(m, k_quarter):
 
 
 @jit
-def pn_fourier_coefficients(f, m, k_quarter, one_minus_ratio, scale, out):
+def pn_fourier_coefficients(f, m, k_quarter, scale, out):
     """Write scale · c_k, k = 1..N, into out[0:N] and return N (0 if the series is not used).
 
     Parameters
@@ -101,8 +121,6 @@ def pn_fourier_coefficients(f, m, k_quarter, one_minus_ratio, scale, out):
         Parameter, 0 ≤ m < 1.
     k_quarter : float
         K(m).
-    one_minus_ratio : float
-        1 − Π(n|m)/K(m), formed by the caller without cancellation (it fixes C through pn'(0) = 1).
     scale : float
         Factor applied to every coefficient (κ of the flow, rad per unit of pn).
     out : ndarray
@@ -115,33 +133,37 @@ def pn_fourier_coefficients(f, m, k_quarter, one_minus_ratio, scale, out):
     """
     if not (f > 0.0) or not (0.0 <= m < 1.0):
         return 0
-    rho = pn_fourier_ratio(f, m, k_quarter)
+    q = nome(m, k_quarter)
+    rho, w, one_minus_w = _pole_ratios(f, m, k_quarter, q)
     if not (0.0 < rho <= FOURIER_RHO_MAX):  # ρ underflows only for m < 1e-200 (K'/K > 237); NaN too
         return 0
-    q = nome(m, k_quarter)
-    sigma = q * q / rho
     q2 = q * q
+    norm = scale * math.sqrt(f / ((1.0 + f) * (f + m)))  # scale · C (module docstring)
     # N: the first with ρ^N ≤ FOURIER_TAIL, found by the loop that forms ρ^k anyway (no log, no
-    # division; ρ ≤ FOURIER_RHO_MAX keeps N ≤ FOURIER_MAX_TERMS)
-    rho_k, sigma_k, q2_k = 1.0, 1.0, 1.0
-    slope = 0.0  # Σ k c_k / C
-    terms = FOURIER_MAX_TERMS
-    for k in range(FOURIER_MAX_TERMS):
+    # division; ρ ≤ FOURIER_RHO_MAX keeps N ≤ FOURIER_MAX_TERMS). ρ^k − σ^k = ρ^k (1 − w^k) with
+    # 1 − w^{k+1} = (1 − w^k) + w^k (1 − w): positive terms only
+    rho_k, q2_k = norm, 1.0  # C ρ^k: the scale rides along, no second pass
+    t, w_k = one_minus_w, 1.0
+    stop = FOURIER_TAIL * abs(norm)
+    k = 0
+    while q2_k > FOURIER_TAIL and k < FOURIER_MAX_TERMS:  # the few terms with 1/(1 − q^{2k}) ≠ 1
         rho_k *= rho
-        sigma_k *= sigma
-        b = rho_k - sigma_k
-        if q2_k > FOURIER_TAIL:  # 1/(1 − q^{2k}) is 1 to the last bit once q^{2k} < ε/10
-            q2_k *= q2
-            b /= 1.0 - q2_k
-        out[k] = b * _RECIPROCALS[k]
-        slope += b
-        if rho_k <= FOURIER_TAIL:
-            terms = k + 1
-            break
-    norm = scale * one_minus_ratio * k_quarter / (math.pi * slope)
-    for k in range(terms):
-        out[k] *= norm
-    return terms
+        q2_k *= q2
+        out[k] = rho_k * t / ((1.0 - q2_k) * (k + 1.0))
+        w_k *= w
+        t += w_k * one_minus_w
+        k += 1
+        if abs(rho_k) <= stop:
+            return k
+    # 1/(1 − q^{2k}) is 1 to the last bit once q^{2k} < ε/10: no division in the rest
+    for j in range(k, FOURIER_MAX_TERMS):
+        rho_k *= rho
+        out[j] = rho_k * t * _RECIPROCALS[j]
+        w_k *= w
+        t += w_k * one_minus_w
+        if abs(rho_k) <= stop:
+            return j + 1
+    return FOURIER_MAX_TERMS
 
 
 @jit

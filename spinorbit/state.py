@@ -462,6 +462,27 @@ class RotationState:
         attitude_user = p.T @ attitude_ref @ elements.reference
         return cls.from_matrix(body, attitude_user, (p.T @ momentum) / body.moment_values)
 
+    def principal_flow_start(self, horizon_days: float) -> tuple[np.ndarray, np.ndarray]:
+        """(principal quaternion, principal momentum) that the exact free flow starts from, checked for a
+        flow reaching ``horizon_days`` (the largest |dt|, days): what :meth:`propagate_torque_free` and the
+        planner's vectorised sensitivities (:mod:`spinorbit.scene.bounds`) both start from.
+
+        Raises InvalidStateError when the flow would leave its domain (the fastest angle beyond
+        :data:`MAX_FLOW_PHASE`) or the momentum is outside :data:`ANDOYER_G_RANGE`. At rest the flow is the
+        constant state (exact) and nothing is checked.
+        """
+        attitude, momentum = self.principal_attitude_and_momentum()
+        if np.any(momentum):
+            momentum = self._rotating_momentum()
+            phase = float(np.linalg.norm(momentum)) / self._body.principal_moments[0] * horizon_days
+            if not phase <= MAX_FLOW_PHASE:
+                raise InvalidStateError(
+                    f"dt up to {horizon_days!r} d is beyond the free flow's domain: the fastest angle "
+                    f"of this motion turns by {phase:.3g} rad > {MAX_FLOW_PHASE:g} rad, where one ulp of dt already "
+                    "moves the attitude by more than 0.1 rad. Propagate from a later state, or shorten dt."
+                )
+        return _rotations.attitude_to_quat(attitude), momentum
+
     def propagate_torque_free(self, dt, closed_forms=True) -> tuple[np.ndarray, u.Quantity]:
         """Exact torque-free motion (paper eq. 12) at times ``dt`` after this state.
 
@@ -488,20 +509,10 @@ class RotationState:
         if not np.all(np.isfinite(times)):
             first = float(times[~np.isfinite(times)][0])
             raise NonFiniteStateError(f"dt must hold finite time offsets; got {first!r} among {times.size} values.")
-        attitude, momentum = self.principal_attitude_and_momentum()
-        if np.any(momentum):  # at rest the flow is the constant state (exact); else check magnitude and phase
-            momentum = self._rotating_momentum()
-            phase = float(np.linalg.norm(momentum)) / self._body.principal_moments[0] * float(np.abs(times).max())
-            if not phase <= MAX_FLOW_PHASE:
-                raise InvalidStateError(
-                    f"dt up to {float(np.abs(times).max())!r} d is beyond the free flow's domain: the fastest angle "
-                    f"of this motion turns by {phase:.3g} rad > {MAX_FLOW_PHASE:g} rad, where one ulp of dt already "
-                    "moves the attitude by more than 0.1 rad. Propagate from a later state, or shorten dt."
-                )
+        principal_q0, momentum = self.principal_flow_start(float(np.abs(times).max()))
         p = self._body.to_principal
         principal_q, principal_m = _torque_free.torque_free_states(
-            _rotations.attitude_to_quat(attitude), momentum, *self._body.principal_moments, times,
-            closed_forms=closed_forms,
+            principal_q0, momentum, *self._body.principal_moments, times, closed_forms=closed_forms,
         )
         # v_inertial = M(q_p) v_principal = M(q_p) P v_user, so q_user = q_p ⊗ q(P).
         p0, p1, p2, p3 = _rotations.matrix_to_quat(np.ascontiguousarray(p))

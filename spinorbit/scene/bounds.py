@@ -202,7 +202,7 @@ def attitude_sensitivities(states, span_days):
     n = len(states)
     horizons = np.array(SENSITIVITY_HORIZONS) * span_days
     kick = SENSITIVITY_PROBE_RAD / span_days
-    starts = [_flow_start(state, horizons[-1]) for state in states]
+    starts = [state.principal_flow_start(float(horizons[-1])) for state in states]
     p = np.array([state.body.to_principal for state in states])
     values = np.array([state.body.moment_values for state in states])
     kicked = np.repeat(np.array([state.angular_velocity_rad_per_day for state in states])[:, None, :], 3, axis=1)  # rad/day
@@ -221,22 +221,6 @@ def attitude_sensitivities(states, span_days):
     for axis in range(3):  # max(κ, largest) in Python's sense: a NaN axis leaves κ as it was
         kappas = np.where(largest[:, axis] > kappas, largest[:, axis], kappas)
     return kappas
-
-
-def _flow_start(state, horizon):
-    """(principal quaternion, principal momentum) of ``state``, InvalidStateError when its exact flow to
-    ``horizon`` days would leave the flow's domain (RotationState.propagate_torque_free's check)."""
-    from spinorbit.core.math.rotations import attitude_to_quat
-    from spinorbit.state import MAX_FLOW_PHASE, InvalidStateError
-
-    attitude, momentum = state.principal_attitude_and_momentum()
-    phase = float(np.linalg.norm(momentum)) / state.body.principal_moments[0] * horizon
-    if not phase <= MAX_FLOW_PHASE:
-        raise InvalidStateError(
-            f"dt up to {horizon!r} d is beyond the free flow's domain: the fastest angle of this motion turns by "
-            f"{phase:.3g} rad > {MAX_FLOW_PHASE:g} rad, where one ulp of dt already moves the attitude by more "
-            "than 0.1 rad. Propagate from a later state, or shorten dt.")
-    return attitude_to_quat(np.ascontiguousarray(attitude)), momentum
 
 
 def _free_flows(quaternions, momenta, moments, horizons):
@@ -378,7 +362,7 @@ def action_sensitivities(state, span_days):
     from spinorbit.core.math.rotations import rotation_angle_between_many
 
     horizons = np.array(SENSITIVITY_HORIZONS) * span_days
-    q, momentum = _flow_start(state, horizons[-1])
+    q, momentum = state.principal_flow_start(float(horizons[-1]))
     moments = np.array(state.body.principal_moments, dtype=float)
     size = float(np.linalg.norm(momentum))
     omega = momentum / moments

@@ -263,9 +263,6 @@ def _rows(scenes, ends, normals, moments, momenta):
         directions = pole_directions(_Stacked(p, values), unit_quaternions(quaternions), omegas)
         end_momenta = np.matmul((values * omegas)[:, None, :], p.T)[:, 0]  # the table's P (I ω), row by row
         start_momenta = np.matmul(p, momenta[:, :, None])[:, :, 0]  # the properties' momentum P (I ω)
-        for momentum in start_momenta:
-            if not np.any(momentum):  # what the start pole's property refuses
-                raise InvalidStateError("the body is not rotating (zero spin): it has no spin pole.")
         start_poles = _start_poles(states, momenta)
     else:
         directions, end_momenta, start_momenta, start_poles = [], [], [], []

@@ -184,3 +184,41 @@ def test_bad_route_and_integrators_are_refused():
     # the route is part of what fixes the bits: a checkpoint of one route is not another's
     assert Ensemble(ek.kepler_member, members(1)).fingerprint != Ensemble(ek.kepler_member, members(1),
                                                                           route="member").fingerprint
+
+
+def test_member_zero_leads_every_chunk_so_the_rows_do_not_depend_on_the_chunk_size(both):
+    rows, batch, _ = both
+    from spinorbit.ensemble.ensemble import _PROCESS_LEADERS, clear_process_samplings
+
+    clear_process_samplings()
+    for size in (1, 6):  # every member its own chunk, and one chunk of all: the fixture's chunks of 3 bit for bit
+        table = Ensemble(ek.kepler_member, rows, chunk_size=size).run(executor="serial")
+        assert table.meta["member_routes"] == {"batch": 6}
+        for name in batch.colnames:
+            assert columns(table, name).tobytes() == columns(batch, name).tobytes(), (size, name)
+    assert len(_PROCESS_LEADERS) == 1  # one leader plan in this process for both runs and all their chunks
+
+
+def test_members_that_cannot_afford_member_zeros_drops_are_led_by_the_first_of_them():
+    rounded, *apophis = members(4)
+    rounded.update(ROUND)
+    # member 0 drops the Sun, which the Apophis members cannot afford: the two of chunk 1 form their own group
+    # (led by the first of them, whose plan keeps the Sun) and still run by the batch route; the one beside
+    # member 0 in chunk 0 is alone, so its own Scene runs it
+    table = Ensemble(ek.kepler_member, [rounded, *apophis], chunk_size=2).run(executor="serial")
+    assert table.meta["member_routes"] == {"batch": 3, "scene": 1}
+    alone = Ensemble(ek.kepler_member, apophis, route="member").run(executor="serial")
+    for name in FLOAT_COLUMNS + ("error_estimate",):  # their own plans agree with their leaders': their Scene rows
+        assert columns(table, name)[1:].tobytes() == columns(alone, name).tobytes(), name
+
+
+def test_a_member_zero_that_cannot_be_built_leaves_the_others_their_own_leaders(both):
+    rows, batch, _ = both
+    broken = [dict(rows[0], omega_x=float("nan")), *rows[1:]]
+    ensemble = Ensemble(ek.kepler_member, broken, chunk_size=3)
+    table = ensemble.run(executor="serial")
+    [failure] = ensemble.failures
+    assert failure["index"] == 0 and table["error"][0]
+    assert table.meta["member_routes"] == {"batch": 5}
+    for name in FLOAT_COLUMNS + ("error_estimate",):  # led by their chunks' first members: the same plans here
+        assert columns(table, name)[1:].tobytes() == columns(batch, name)[1:].tobytes(), name

@@ -3,8 +3,10 @@
 A chunk's members whose Scenes agree on everything the plan depends on except the rotation state and
 the body's moments (:func:`group_key`: the same orbit object, perturbers, epoch, output time,
 tolerances, quantities and integrator option) form a **group**. The group's plan is the Scene plan of
-its first member (the *leader*, :meth:`~spinorbit.scene.Scene.plan`): its route, its perturbers kept
-and dropped, its integrator. Every member of the group then gets, from its own state and moments,
+its *leader* (:meth:`~spinorbit.scene.Scene.plan`, taken with what follows from it as a
+:class:`GroupPlan`): its route, its perturbers kept and dropped, its integrator. The ensemble names
+the leader (:func:`spinorbit.ensemble.ensemble.run_chunk`: its member 0 where it fits the group, else
+the group's first member). Every member of the group then gets, from its own state and moments,
 
 - its **bounds**: the worst-attitude bound of every perturber
   (:func:`~spinorbit.scene.bounds.dropped_torque_bound` on the group's shared survey, with the member's
@@ -41,8 +43,8 @@ the Taylor method), the row is the group plan's, whose error estimate holds for 
 same: it is made of the member's own bounds and its own a posteriori check. Which members ran where
 is in the table's ``meta["member_routes"]``.
 
-A group is planned from its chunk alone, so its rows do not depend on the executor or the number of
-workers. A member that fails (its bounds, or its integration stopping) is recorded alone; a batch
+A group's leader is fixed by the ensemble, not by where its chunk runs, so its rows do not depend on
+the executor or the number of workers. A member that fails (its bounds, or its integration stopping) is recorded alone; a batch
 call that refuses its input as a whole sends its members to the per-member route, where each fails or
 runs on its own.
 """
@@ -54,7 +56,7 @@ from astropy import units as u
 
 from spinorbit.core.integrators.batch_quaternion import integrate_quaternion_batch
 
-__all__ = ["BATCH_INTEGRATORS", "group_key", "run_group"]
+__all__ = ["BATCH_INTEGRATORS", "GroupPlan", "group_key", "plan_group", "run_group"]
 
 #: The batch integrator of each plan integrator: a function with integrate_quaternion_batch's signature
 #: ``(y0s, t0, t_end, models, rtol, ...) -> (end states (N, 7), stats dict of (N,) arrays)``. A plan
@@ -297,40 +299,58 @@ def _rows(scenes, ends, normals, moments, momenta):
     return rows
 
 
-def run_group(group, shared, at_days, integrators=None):
-    """Run one group [(index, Scene, parameters)] of a chunk by the batch route.
+class GroupPlan:
+    """What a group takes from its leader (:func:`plan_group`): the leader Scene, its plan, its perturber
+    survey, the kept sources (and whether a sampled one is among them), the orbit normals and the run's days."""
 
-    Returns (rows, failures, fallback): outcome rows and the exceptions of failed members by index, and
-    the members [(index, Scene, parameters)] that go to the per-member route (the plan cannot be shared
-    with them, or no batch integrator runs it). The scenes plan and sample within ``shared``.
-    """
+    def __init__(self, leader, plan, survey, sources, sampled, normals, t0, t_out):
+        self.leader, self.plan, self.survey, self.sources, self.sampled = leader, plan, survey, sources, sampled
+        self.normals, self.t0, self.t_out = normals, t0, t_out
+
+
+def plan_group(leader, shared, integrators=None):
+    """The :class:`GroupPlan` of the Scene ``leader`` planned within the samples ``shared``, or None when its
+    plan cannot be shared by the batch route (the plan fails, is not a one-way run on a batch integrator,
+    bounds a back-reaction, or its samples do not cover the run): its group then runs member by member."""
     from spinorbit.coupling.one_way import one_way_days
-    from spinorbit.core.integrators.dop853 import STATUS_MESSAGES, IntegrationError
-    from spinorbit.scene.bounds import attitude_sensitivities
     from spinorbit.scene.routes import scene_orbit_normals
-    from spinorbit.scene.tolerances import DROP_SHARE, first_tolerance, sampling_error_bound
-    from spinorbit.state import MAX_FLOW_PHASE
     from spinorbit.time import time_from_tdb_days
 
     integrators = BATCH_INTEGRATORS if integrators is None else integrators
-    rows, failures = {}, {}
-    leader = group[0][1]
     with leader.sharing_samples(shared):
         try:
             plan = leader.plan()
         except Exception:  # noqa: BLE001 — the leader's own Scene run records it
-            return rows, failures, list(group)
+            return None
         if (plan.route != "one-way" or plan.integrator not in integrators or plan.back_reaction_rad != 0.0
                 or plan.back_reaction_bound_rad is not None):
-            return rows, failures, list(group)
+            return None
         survey = _survey(leader, plan)
         sources, samples, sampled = _kept_sources(leader, plan)
         normals, _ = scene_orbit_normals(leader, plan) if leader.orbit is not None else (None, None)
-        epoch = time_from_tdb_days(leader.epoch_day)
-        t0, t_out = one_way_days(epoch, time_from_tdb_days(leader.output_days))
+        t0, t_out = one_way_days(time_from_tdb_days(leader.epoch_day), time_from_tdb_days(leader.output_days))
     lo, hi = samples.span
     if min(t0, t_out.min()) < lo or max(t0, t_out.max()) > hi:
-        return rows, failures, list(group)
+        return None
+    return GroupPlan(leader, plan, survey, sources, sampled, normals, t0, t_out)
+
+
+def run_group(group, group_plan, at_days, integrators=None):
+    """Run one group [(index, Scene, parameters)] of a chunk by the batch route, on its leader's ``group_plan``.
+
+    Returns (rows, failures, fallback): outcome rows and the exceptions of failed members by index, and
+    the members [(index, Scene, parameters)] that go to the per-member route (the plan cannot be shared
+    with them). The members sample within the leader's samples (the plan's sources).
+    """
+    from spinorbit.core.integrators.dop853 import STATUS_MESSAGES, IntegrationError
+    from spinorbit.scene.bounds import attitude_sensitivities
+    from spinorbit.scene.tolerances import DROP_SHARE, first_tolerance, sampling_error_bound
+    from spinorbit.state import MAX_FLOW_PHASE
+
+    integrators = BATCH_INTEGRATORS if integrators is None else integrators
+    rows, failures = {}, {}
+    leader, plan, survey, normals = group_plan.leader, group_plan.plan, group_plan.survey, group_plan.normals
+    sources, sampled, t0, t_out = group_plan.sources, group_plan.sampled, group_plan.t0, group_plan.t_out
     tolerance, span = plan.tolerance_rad, leader.span_days
     # members whose free flow over the span stays in its domain (attitude_sensitivity would refuse the others)
     fits = []

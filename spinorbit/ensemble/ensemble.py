@@ -50,10 +50,11 @@ __all__ = ["ROUTES", "Ensemble", "EnsembleError", "EnsembleInterrupted", "clear_
 #: Most members in a default chunk; the default is ceil(n / 32) up to this (chunks few enough to
 #: spread over many workers, large enough that a chunk's shared sampling pays).
 MAX_DEFAULT_CHUNK = 16
-#: With the batch route a chunk's group is planned once and integrated in one call per attempt, so its
-#: default chunks are larger: ceil(n / BATCH_CHUNKS) members, at most MAX_BATCH_CHUNK (4 chunks share 2
-#: workers evenly; the plan and the calls are paid once per chunk: benchmarks/bench_ensemble.py).
-BATCH_CHUNKS = 4
+#: With the batch route a chunk's group is integrated in one call per attempt and takes the plan its
+#: process made once, so its default chunks are ceil(n / BATCH_CHUNKS) members, at most MAX_BATCH_CHUNK:
+#: 8 chunks, not fewer, so that members of unequal cost (their retries) still share 2 workers evenly
+#: at the end of the run (benchmarks/bench_ensemble.py's parallel efficiency).
+BATCH_CHUNKS = 8
 MAX_BATCH_CHUNK = 64
 
 
@@ -122,11 +123,6 @@ MEMO_KEYS = 8
 _PROCESS_SAMPLINGS = {}
 
 
-def clear_process_samplings():
-    """Forget the samplings this process keeps across chunks (e.g. after changing an orbit in place)."""
-    _PROCESS_SAMPLINGS.clear()
-
-
 def _process_memo(scene):
     """The memo of this process's samplings for the scene's orbit, span and ephemerides (SharedSamples(memo))."""
     key = _sharing_key(scene)
@@ -161,7 +157,44 @@ def free_rows(free, at_days, rows, failures):
 ROUTES = ("auto", "member")
 
 
-def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None, route="auto", integrators=None):
+#: Most ensemble leaders whose group plans a process keeps across chunks (one per ensemble run in it).
+LEADER_KEYS = 4
+#: {(make_scene, the leader's parameters as fingerprint text): (leader's keys, GroupPlan or None)}: the group
+#: plan of an ensemble's leader in this process, made once and taken by every chunk whose group it fits.
+_PROCESS_LEADERS = {}
+
+
+def clear_process_samplings():
+    """Forget the samplings and leader plans this process keeps across chunks (e.g. after changing an orbit)."""
+    _PROCESS_SAMPLINGS.clear()
+    _PROCESS_LEADERS.clear()
+
+
+def _leader_plan(make_scene, leader, at_days, samples_of, integrators):
+    """((sharing key, group key), GroupPlan or None) of the ensemble's leader ``(index, parameters)`` in this
+    process (planned once: :func:`~spinorbit.ensemble.batch.plan_group`), or None when it cannot lead a
+    group (it fails to build, or cannot be batched)."""
+    from spinorbit.ensemble.batch import group_key, plan_group
+
+    text = "|".join(f"{name}={_fingerprint_text(value)}" for name, value in leader[1].items())
+    token = (make_scene, text, None if at_days is None else at_days.tobytes(),
+             tuple(sorted(integrators.items())) if integrators else None)
+    if token not in _PROCESS_LEADERS:
+        try:
+            scene = build_member(make_scene, leader[1])
+        except Exception:  # noqa: BLE001 — the leader's failure is recorded where it runs as a member
+            scene = None
+        key = None if scene is None else group_key(scene, at_days)
+        entry = None if key is None else ((_sharing_key(scene), key),
+                                          plan_group(scene, samples_of(scene), integrators))
+        if len(_PROCESS_LEADERS) >= LEADER_KEYS:
+            _PROCESS_LEADERS.pop(next(iter(_PROCESS_LEADERS)))
+        _PROCESS_LEADERS[token] = entry
+    return _PROCESS_LEADERS[token]
+
+
+def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None, route="auto", integrators=None,
+              leader=None):
     """Run one chunk of members in this process (what a worker does): (rows, failures, tables).
 
     ``members`` is a list of (index, parameter dict); ``scenes`` optionally ``{index: Scene}`` of
@@ -176,9 +209,12 @@ def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None,
     bits in any process or batch). With ``route="auto"`` (and no tables kept) the members that can
     share a plan run as groups by the batch route (:func:`spinorbit.ensemble.batch.run_group`, its
     batch integrators ``integrators``, default :data:`~spinorbit.ensemble.batch.BATCH_INTEGRATORS`);
-    every row records its route in ``ensemble_route`` ("batch", "scene" or "torque-free").
+    every row records its route in ``ensemble_route`` ("batch", "scene" or "torque-free"). A group
+    takes the plan of ``leader`` (the ensemble's (index, parameters) whose plan leads, planned once
+    per process) when the leader would be in it, else its first member's; the members the leader's
+    plan does not fit (its drops) are led by the first of them.
     """
-    from spinorbit.ensemble.batch import group_key, run_group
+    from spinorbit.ensemble.batch import group_key, plan_group, run_group
     from spinorbit.scene.sampling import SharedSamples
 
     rows, failures, tables, shared, free, built = {}, {}, {}, {}, [], []
@@ -205,8 +241,25 @@ def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None,
             key = group_key(member[1], at_days)
             (single.append(member) if key is None else
              groups.setdefault((_sharing_key(member[1]), key), []).append(member))
-        for group in groups.values():
-            group_rows, group_failures, fallback = run_group(group, samples_of(group[0][1]), at_days, integrators)
+        led = None
+        if leader is not None and groups:
+            led = _leader_plan(make_scene, leader, at_days, samples_of, integrators)
+        for keys, group in groups.items():
+            # the ensemble leader's plan where it fits the group (and could be made), else the first member's
+            group_plan = led[1] if led is not None and keys == led[0] else None
+            led_by_ensemble = group_plan is not None
+            if group_plan is None:
+                group_plan = plan_group(group[0][1], samples_of(group[0][1]), integrators)
+            if group_plan is None:  # no plan to share: every member through its own Scene
+                single.extend(group)
+                continue
+            group_rows, group_failures, fallback = run_group(group, group_plan, at_days, integrators)
+            if led_by_ensemble and len(fallback) > 1:  # those the ensemble's plan does not fit: led by their first
+                second = plan_group(fallback[0][1], samples_of(fallback[0][1]), integrators)
+                if second is not None:
+                    more_rows, more_failures, fallback = run_group(fallback, second, at_days, integrators)
+                    group_rows.update(more_rows)
+                    group_failures.update(more_failures)
             rows.update({i: {**row, "ensemble_route": "batch"} for i, row in group_rows.items()})
             failures.update({i: failure_record(i, p, group_failures[i]) for i, _, p in group if i in group_failures})
             single.extend(fallback)
@@ -242,8 +295,8 @@ class Ensemble:
         ``seed_entropy`` and ``seed_spawn_key`` of :func:`~spinorbit.ensemble.samplers.sample_parameters`,
         which are recorded, not passed).
     chunk_size : int, optional
-        Members per chunk; default ``min(64, ceil(n / 4))`` with ``route="auto"`` (a chunk's group is
-        planned once), ``min(16, ceil(n / 32))`` with ``route="member"``. It fixes the work units, so
+        Members per chunk; default ``min(64, ceil(n / 8))`` with ``route="auto"`` (a chunk's group
+        shares a plan), ``min(16, ceil(n / 32))`` with ``route="member"``. It fixes the work units, so
         results do not depend on the executor or the number of workers.
     at : astropy.time.Time, optional
         Times (among every member's output times) at which to report the outcome; default the last
@@ -398,6 +451,10 @@ class Ensemble:
         free_rows(free, self.at_days, rows, failures)
         return rows, failures, shipped, scenes
 
+    def _leader(self):
+        """(0, parameters) of the member whose plan its batch groups share (:func:`run_chunk`), or None."""
+        return (0, self.member_parameters(0)) if self.route == "auto" else None
+
     def _first_is_torque_free(self, chunk):
         """Whether the chunk's first member is torque-free (built here once to see; a failure counts as no)."""
         try:
@@ -461,6 +518,7 @@ class Ensemble:
                                              and self._first_is_torque_free(pending[0]))
             partial, futures = {}, {}
             columns = self._plain_columns() if pending else {}
+            leader = self._leader()
             for chunk in pending:
                 members = self.chunk_members(chunk)
                 if keep_tables or not classify_here:
@@ -473,12 +531,12 @@ class Ensemble:
                     finish(chunk, rows, failures, {})
                 elif pool is None:
                     more_rows, more_failures, tables = run_chunk(self.make_scene, ship, self.at_days, keep_tables, scenes,
-                                                                 self.route, self.batch_integrators)
+                                                                 self.route, self.batch_integrators, leader)
                     finish(chunk, {**rows, **more_rows}, {**failures, **more_failures}, tables)
                 else:  # submitted at once: the workers start while the next chunks are prepared
                     partial[chunk] = (rows, failures)
                     futures[pool.submit(run_chunk, self.make_scene, ship, self.at_days, keep_tables, None, self.route,
-                                        self.batch_integrators)] = chunk
+                                        self.batch_integrators, leader)] = chunk
             for future in concurrent.futures.as_completed(futures):
                 chunk = futures[future]
                 try:
@@ -516,16 +574,16 @@ class Ensemble:
         if missing:
             raise EnsembleError(f"rerun: the chunks {missing} have not run yet; call run() (with the checkpoint) first.")
         clock = _time.perf_counter()
-        results = []
+        results, leader = [], self._leader()
         with open_executor(executor) as (pool, description):
             for index in indices:  # each alone, by the same path as in run(): torque-free ones in this process
                 rows, failures, ship, scenes = self._split([(index, self.member_parameters(index))])
                 if ship:
                     job = (pool.submit(run_chunk, self.make_scene, ship, self.at_days, False, None, self.route,
-                                       self.batch_integrators) if pool is not None else None)
+                                       self.batch_integrators, leader) if pool is not None else None)
                     rows, failures, _ = (job.result() if job is not None else
                                          run_chunk(self.make_scene, ship, self.at_days, False, scenes, self.route,
-                                                   self.batch_integrators))
+                                                   self.batch_integrators, leader))
                 results.append((rows, failures, {}))
         for index, (rows, failures, _) in zip(indices, results):
             self._rows.pop(index, None)

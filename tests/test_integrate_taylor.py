@@ -276,3 +276,17 @@ def test_convergence_radius_is_the_smaller_of_the_two_estimates():
     assert convergence_radius(0.0, 1e-8, 9) == 1e-8 ** (-1.0 / 9)
     assert convergence_radius(1e-8, 0.0, 9) == 1e-8 ** (-1.0 / 8)
     assert math.isinf(convergence_radius(0.0, 0.0, 9))
+
+
+@pytest.mark.parametrize("rows", [1, 3, 4, 7, 10])
+def test_horner_in_groups_of_four_rows_is_each_rows_polynomial(rows):
+    """horner's grouped rows (the last group shifted back, rows < 4 one by one) give each row's own Horner sum."""
+    from spinorbit.core.integrators.taylor_recurrences import horner
+
+    rng = np.random.default_rng(rows)
+    order, dt = 11, 0.37
+    s = rng.normal(size=(rows + 2, order + 1))
+    out = np.full(rows, np.nan)
+    horner(s, rows, order, dt, out)
+    expected = [np.polynomial.polynomial.polyval(dt, s[i]) for i in range(rows)]
+    np.testing.assert_allclose(out, expected, rtol=1e-14)

@@ -407,12 +407,31 @@ def orbit_radius(s, n_pert, orbit_orders, order):
 
 @jit(fastmath=FUSED_MULTIPLY_ADD)
 def horner(s, rows, order, dt, out):
-    """out[i] = Σ_k s[i, k] dt^k for i < rows (the Taylor polynomial at t + dt)."""
-    for i in range(rows):
-        acc = s[i, order]
+    """out[i] = Σ_k s[i, k] dt^k for i < rows (the Taylor polynomial at t + dt); ``out`` is not a view of s.
+
+    Four rows' Horner sums in one loop: each is a chain of ``order`` dependent multiply-adds, and four
+    independent chains side by side take about the time of one (one row after the other, the chains
+    were half of the evaluation's time: 42 → 23 ns for the 7 state rows at order 11, same bits). The
+    last group of four is shifted back to end at the last row; a row evaluated twice gets the same value.
+    """
+    if rows < 4:
+        for i in range(rows):
+            acc = s[i, order]
+            for k in range(order - 1, -1, -1):
+                acc = acc * dt + s[i, k]
+            out[i] = acc
+        return
+    i = 0
+    while i < rows:
+        i = min(i, rows - 4)
+        a0, a1, a2, a3 = s[i, order], s[i + 1, order], s[i + 2, order], s[i + 3, order]
         for k in range(order - 1, -1, -1):
-            acc = acc * dt + s[i, k]
-        out[i] = acc
+            a0 = a0 * dt + s[i, k]
+            a1 = a1 * dt + s[i + 1, k]
+            a2 = a2 * dt + s[i + 2, k]
+            a3 = a3 * dt + s[i + 3, k]
+        out[i], out[i + 1], out[i + 2], out[i + 3] = a0, a1, a2, a3
+        i += 4
 
 
 @jit

@@ -24,7 +24,7 @@ from spinorbit.core.elements.canonical import (
     inertia_constants,
     motion_from_momentum_into,
 )
-from spinorbit.core.jit import jit
+from spinorbit.core.jit import INLINE, jit
 from spinorbit.core.math.carlson import rf
 from spinorbit.core.math.ddouble import (
     dd_add,
@@ -394,7 +394,7 @@ def flow_constants_shared(flow, quaternion, momentum, big_a, big_b, big_c, ic, i
     return mo, mk, pk
 
 
-@jit
+@jit(inline=INLINE)
 def flow_constants_buffers(flow, mo, quaternion, momentum, big_a, big_b, big_c, ic, inertia_dd):
     """:func:`flow_constants_shared` into a caller's (MO_SIZE,) motion-constants array too; returns
     (mk, pk). One buffer for a loop's states: the allocation cost ≈ 20 ns of each set-up.
@@ -510,7 +510,7 @@ def _rotate(w, x, y, z, vx, vy, vz):
             vz + w * tz + (x * ty - y * tx))
 
 
-@jit
+@jit(inline=INLINE)
 def _node_of_state(quaternion, m0x, m0y, m0z, fx, fy, fz, mx, my):
     """(g0, node quaternion) of a state: :func:`.canonical.node_angles_of` from the quaternion.
 
@@ -577,7 +577,7 @@ def kappa_pn(kah, kal, rh, rl, s, c, d, pk):
     return dd_mul(kah, kal, xh, xl)
 
 
-@jit
+@jit(inline=INLINE)
 def _fourier_constants(flow, mk, pk):
     """Fill the FL_FOURIER_* / FL_LINEAR_* slots when the nome series of pn converges fast enough.
 
@@ -593,7 +593,7 @@ def _fourier_constants(flow, mk, pk):
     flow[FL_LINEAR_HI], flow[FL_LINEAR_LO] = lh, ll
 
 
-@jit
+@jit(inline=INLINE)
 def flow_kappa_pn(flow, rh, rl, s, c, d, pk):
     """κ · pn(r) for |r| ≤ K as a double-double, by whichever form the set-up chose.
 

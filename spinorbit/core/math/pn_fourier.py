@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from spinorbit.core.jit import jit
+from spinorbit.core.jit import INLINE, jit
 from spinorbit.core.math.carlson import rf
 
 # Tail of the series: N terms with ρ^N below this (the first omitted term over the first kept is
@@ -109,7 +109,7 @@ def nome(m, k_quarter):
     return math.exp(-math.pi * rf(0.0, m, 1.0) / k_quarter)  # K' = K(1 − m) = R_F(0, m, 1)
 
 
-@jit
+@jit(inline=INLINE)
 def pn_fourier_coefficients(f, m, k_quarter, scale, out):
     """Write scale · c_k, k = 1..N, into out[0:N] and return N (0 if the series is not used).
 
@@ -166,7 +166,7 @@ def pn_fourier_coefficients(f, m, k_quarter, scale, out):
     return FOURIER_MAX_TERMS
 
 
-@jit
+@jit(inline=INLINE)
 def sine_series(theta, coefficients, offset, terms):
     """Σ_{k=1}^{terms} a_k sin(kθ), a_k = coefficients[offset + k − 1], by Clenshaw's recurrence.
 

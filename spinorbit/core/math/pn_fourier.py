@@ -66,8 +66,11 @@ def pole_integral(f, m):
     f ≥ m (near False): β = s R_F(c², Δ², 1) (module docstring). f < m (near True): the pole is near
     the nome's (β → K' as f → 0), so γ = K' − β = F(arctan √(f/m) | 1 − m) = √f R_F(m, m(1 + f), f + m)
     instead. No K is needed, so callers can start this R_F before their AGM, or pair it with
-    another one (:func:`.carlson.rf_pair`).
+    another one (:func:`.carlson.rf_pair`). Outside the series' domain (f ≤ 0, m ∉ [0, 1), NaN) the
+    arguments (1, 1, 1) with prefactor 0: R_F(0, 0, 1) at f = m = 0 would never meet its stop.
     """
+    if not (f > 0.0) or not (0.0 <= m < 1.0):
+        return 0.0, 1.0, 1.0, 1.0, False
     if f >= m:
         s2 = 1.0 / (1.0 + f)
         return math.sqrt(s2), f * s2, (f + m) * s2, 1.0, False

@@ -11,6 +11,11 @@ error-model choices are made once, here, with their reasons.
   one fused multiply-add (one rounding instead of two, so results change at the rounding level only;
   no reassociation, no finite-math assumptions). For the Taylor recurrences, whose time is Cauchy
   products (issue 18).
+- ``INLINE`` (opt-in, ``@jit(inline=INLINE)``): numba inlines the function into every caller at its own
+  IR level, before LLVM sees it. For the per-state and per-time kernels of the torque-free flow that
+  take arrays: a call between separately compiled functions pays NRT reference counting for every array
+  argument or slice (an atomic call each), and LLVM left those calls in place; inlined, the counts
+  cancel and the array stays in registers. One time per state 25 % cheaper (issue 18).
 - ``error_model="numpy"``: division by zero gives inf/NaN instead of raising inside kernels, so a
   kernel never needs a Python exception path; the public wrappers validate input before calling.
 """
@@ -20,6 +25,7 @@ import numba
 # No ``nopython`` key: njit is always nopython, and numba 0.68 warns (an error under the test
 # suite's ``filterwarnings = error``) when it is passed explicitly.
 FUSED_MULTIPLY_ADD = frozenset({"contract"})
+INLINE = "always"
 JIT_OPTIONS = dict(cache=True, fastmath=False, error_model="numpy")
 
 

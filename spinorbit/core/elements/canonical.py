@@ -55,7 +55,7 @@ import math
 import numpy as np
 
 from spinorbit.core.elements.andoyer import node_frame
-from spinorbit.core.jit import jit
+from spinorbit.core.jit import INLINE, jit
 from spinorbit.core.math.elliptic_integrals import ellipf_k, pn_constants, pn_k
 from spinorbit.core.math.elliptic_periods import parameter_constants
 from spinorbit.core.math.jacobi import sncndn_k
@@ -160,7 +160,7 @@ def motion_constants(mode, big_g, d_c, a_d, b_d, a, b, c, a_b, b_c, a_c):
     return mo
 
 
-@jit
+@jit(inline=INLINE)
 def motion_constants_into(mo, mode, big_g, d_c, a_d, b_d, a, b, c, a_b, b_c, a_c):
     """:func:`motion_constants` into a caller's (MO_SIZE,) array (loops over many states reuse one
     buffer: the allocation cost ≈ 20 ns of the torque-free set-up)."""
@@ -209,7 +209,7 @@ def motion_from_momentum(mx, my, mz, ic):
     return mo, flip
 
 
-@jit
+@jit(inline=INLINE)
 def motion_from_momentum_into(mo, mx, my, mz, ic):
     """:func:`motion_from_momentum` into a caller's (MO_SIZE,) array; returns the flip."""
     a, b, c, a_b, b_c, a_c = ic

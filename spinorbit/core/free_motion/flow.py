@@ -107,7 +107,7 @@ from spinorbit.core.free_motion.regular_precession import (
     precession_constants,
     symmetry_axis,
 )
-from spinorbit.core.jit import jit
+from spinorbit.core.jit import INLINE, jit
 from spinorbit.core.math.ddouble import (
     TWO_PI_HI,
     TWO_PI_LO,
@@ -158,7 +158,7 @@ def evaluate_flow(t, flow, mo, mk, pk, q_out, m_out):
     q_out[0], q_out[1], q_out[2], q_out[3], m_out[0], m_out[1], m_out[2] = flow_state(t, flow, mo, mk, pk)
 
 
-@jit
+@jit(inline=INLINE)
 def flow_state(t, flow, mo, mk, pk):
     """(q_w, q_x, q_y, q_z, M_x, M_y, M_z) at time t of the motion described by flow constants.
 

@@ -24,8 +24,8 @@ from spinorbit.core.elements.canonical import (
     inertia_constants,
     motion_from_momentum_into,
 )
-from spinorbit.core.jit import jit
-from spinorbit.core.math.carlson import rf
+from spinorbit.core.jit import INLINE, jit
+from spinorbit.core.math.carlson import rf, rf_pair
 from spinorbit.core.math.ddouble import (
     dd_add,
     dd_difference_ratio,
@@ -61,7 +61,8 @@ from spinorbit.core.math.elliptic_periods import (
 from spinorbit.core.math.jacobi import sncndn_reduced
 from spinorbit.core.math.pn_fourier import (
     FOURIER_MAX_TERMS,
-    pn_fourier_coefficients,
+    pn_fourier_coefficients_at,
+    pole_integral,
     sine_series,
 )
 
@@ -259,14 +260,13 @@ def phase_constants_dd(mode, mx, my, mz, inertia_dd):
 
     Returns
     -------
-    tuple of 15 floats
-        (ν_hi, ν_lo, P_hi, P_lo, cG_hi, cG_lo, W_hi, W_lo, κ_hi, κ_lo, p, p_c, n, ok, Π): the argument
-        rate ν (argument per time unit), the half period P = 2K(p) of the argument, the secular rate
-        c G of g (rad per time unit), the advance W = 2 κ Π(n|p) of g per half period (rad), the pn
-        coefficient κ (rad), and the parameter, complementary parameter and characteristic rounded
-        once from their double-double values (for the double kernels: near the separatrix p_c from
-        doubles would lose ε/p_c); ok = 0 when the double-double p_c is not positive (the
-        separatrix), 1 otherwise; Π(n|p) rounded once (NaN at the separatrix).
+    tuple of 11 floats
+        (ν_hi, ν_lo, cG_hi, cG_lo, κ_hi, κ_lo, f_hi, f_lo, p_c,hi, p_c,lo, p): the argument rate ν
+        (argument per time unit), the secular rate c G of g (rad per time unit), the pn coefficient
+        κ (rad), f = −n and p_c = 1 − p as double-doubles (the inputs of :func:`complete_k_pi_dd`;
+        p_c ≤ 0 at the separatrix), and the parameter p rounded once from its double-double value
+        (for the double kernels: near the separatrix p_c from doubles would lose ε/p_c). The AGM is
+        the caller's, so that work which does not need K can be issued before it.
 
     Notes
     -----
@@ -305,11 +305,7 @@ def phase_constants_dd(mode, mx, my, mz, inertia_dd):
     # κ = (a−c) G / ν
     kah, kal = dd_mul(ach, acl, gh, gl)
     kah, kal = dd_div(kah, kal, nuh, nul)
-    if not pch > 0.0:
-        return nuh, nul, math.inf, 0.0, cgh, cgl, 0.0, 0.0, kah, kal, param, pch, -fh, 0.0, math.nan
-    kh, kl, pih, pil = complete_k_pi_dd(fh, fl, pch, pcl)
-    wh, wl = dd_mul(kah, kal, 2.0 * pih, 2.0 * pil)
-    return nuh, nul, 2.0 * kh, 2.0 * kl, cgh, cgl, wh, wl, kah, kal, param, pch, -fh, 1.0, pih + pil
+    return nuh, nul, cgh, cgl, kah, kal, fh, fl, pch, pcl, param
 
 
 @jit
@@ -394,7 +390,7 @@ def flow_constants_shared(flow, quaternion, momentum, big_a, big_b, big_c, ic, i
     return mo, mk, pk
 
 
-@jit
+@jit(inline=INLINE)
 def flow_constants_buffers(flow, mo, quaternion, momentum, big_a, big_b, big_c, ic, inertia_dd):
     """:func:`flow_constants_shared` into a caller's (MO_SIZE,) motion-constants array too; returns
     (mk, pk). One buffer for a loop's states: the allocation cost ≈ 20 ns of each set-up.
@@ -428,22 +424,30 @@ def flow_constants_buffers(flow, mo, quaternion, momentum, big_a, big_b, big_c, 
         mk, pk = elliptic_constants(mo)  # unused by a uniform rotation; returned for one signature
         return mk, pk
     mx, my, mz = fx * m0x, fy * m0y, fz * m0z
-    (nuh, nul, perh, perl, cgh, cgl, wh, wl, kah, kal, param, param_c, char_n, ok, complete_pi) = (
-        phase_constants_dd(mode, mx, my, mz, inertia_dd)
-    )
-    if ok > 0.0 and mo[MO_PARAM_C] > 0.0:
+    nuh, nul, cgh, cgl, kah, kal, fh, fl, pch, pcl, param = phase_constants_dd(mode, mx, my, mz, inertia_dd)
+    periodic = pch > 0.0 and mo[MO_PARAM_C] > 0.0
+    if periodic:
+        # The two R_F of the set-up need no K: the amplitude's F (the start of the argument) and the
+        # distance of pn's pole (the nome series). They run as one pair, issued before the AGM, so
+        # their latencies overlap instead of adding up.
+        j0_am, s_am, c_am = _amplitude_of_momentum(mx, my, mz, mode, ic)
+        pre, x, y, z, near = pole_integral(fh, param)
+        rf_am, rf_pole = rf_pair(c_am * c_am, c_am * c_am + pch * (s_am * s_am), 1.0, x, y, z)
+    perh, perl, wh, wl = math.inf, 0.0, 0.0, 0.0
+    if pch > 0.0:  # the double-double p_c: off the separatrix (the period, even where p_c rounds to 0)
+        kh, kl, pih, pil = complete_k_pi_dd(fh, fl, pch, pcl)
+        perh, perl = 2.0 * kh, 2.0 * kl
+        wh, wl = dd_mul(kah, kal, 2.0 * pih, 2.0 * pil)
+    if periodic:
         # kernel constants from the once-rounded double-double p, p_c, n (not from ratios of rounded
         # differences: near the separatrix those lose ε/p_c in p_c), with K and Π from the
         # compensated AGM above instead of a second AGM and a Carlson R_J per state
-        mk = parameter_constants_with_k(param, param_c, 0.5 * perh, 0.5 * perl)
-        pk = characteristic_constants_with_complete(char_n, param, complete_pi)
-        periodic = True
+        mk = parameter_constants_with_k(param, pch, kh, kl)
+        pk = characteristic_constants_with_complete(-fh, param, pih + pil)
+        arg0 = 2.0 * j0_am * kh + (2.0 * j0_am * kl + s_am * rf_am)
     else:  # the separatrix: the kernels' closed forms, from the motion constants
         mk, pk = elliptic_constants(mo)
-        periodic = False
-    if periodic:
-        arg0 = _argument_of_momentum(mx, my, mz, mode, ic, mk)
-    else:  # m_c = 0: F = atanh(sin am) in Carlson's form, ±inf past ±π/2 (ellipf_k's cases)
+        # m_c = 0: F = atanh(sin am) in Carlson's form, ±inf past ±π/2 (ellipf_k's cases)
         arg0 = ellipf_k(amplitude_from_momentum(mx, my, mz, mo, ic), mk)
     g0, qn = _node_of_state(quaternion, m0x, m0y, m0z, fx, fy, fz, mx, my)
     flow[FL_QN_W], flow[FL_QN_X], flow[FL_QN_Y], flow[FL_QN_Z] = qn
@@ -455,7 +459,7 @@ def flow_constants_buffers(flow, mo, quaternion, momentum, big_a, big_b, big_c, 
     flow[FL_G_ADVANCE_HI], flow[FL_G_ADVANCE_LO] = wh, wl
     flow[FL_KAPPA_HI], flow[FL_KAPPA_LO] = kah, kal
     if periodic:
-        _fourier_constants(flow, mk, pk)
+        _fourier_constants(flow, mk, pk, pre * rf_pole, near)
     # g0 − κ pn(arg0), with pn(arg0) = 2Π j0 + pn(r0) split as at every later time, so that the
     # large parts cancel exactly at t = 0 (κ pn is huge for nearly symmetric bodies)
     if periodic:
@@ -478,9 +482,23 @@ def _argument_of_momentum(mx, my, mz, mode, ic, mk):
     """The elliptic argument F(am | p) at the working-frame momentum (u in SAM, v in LAM), 0 ≤ p < 1.
 
     :func:`.canonical.amplitude_from_momentum` followed by :func:`.elliptic_integrals.ellipf_k`,
-    without the atan2 and the sin, cos of its result: sin and cos of the amplitude are the
-    momentum's own ratios, and the whole turns of π (|am| ≤ π, so j ∈ {−1, 0, 1}) follow from
-    their signs. F = 2jK + sin r · R_F(cos² r, cos² r + p_c sin² r, 1) (note §6.3).
+    without the atan2 and the sin, cos of its result (:func:`_amplitude_of_momentum`):
+    F = 2jK + sin r · R_F(cos² r, cos² r + p_c sin² r, 1) (note §6.3). The set-up forms the same
+    sum with this R_F paired with another (:func:`flow_constants_buffers`).
+    """
+    j, s, c = _amplitude_of_momentum(mx, my, mz, mode, ic)
+    f_r = s * rf(c * c, c * c + mk[MK_MC] * (s * s), 1.0)
+    return 2.0 * j * mk[MK_K_HI] + (2.0 * j * mk[MK_K_LO] + f_r)
+
+
+@jit
+def _amplitude_of_momentum(mx, my, mz, mode, ic):
+    """(j, sin r, cos r) of the amplitude am = jπ + r, |r| ≤ π/2, at the working-frame momentum.
+
+    sin and cos of the amplitude are the momentum's own ratios (the atan2 of
+    :func:`.canonical.amplitude_from_momentum`), and the whole turns of π (|am| ≤ π, so
+    j ∈ {−1, 0, 1}) follow from their signs. At M = 0 along both axes, (0, 0, 1): atan2(0, 0) = 0
+    (spin exactly about C in SAM).
     """
     _a, _b, _c, a_b, b_c, a_c = ic
     if mode == MODE_SAM:
@@ -489,15 +507,14 @@ def _argument_of_momentum(mx, my, mz, mode, ic, mk):
         ys, xs = math.sqrt(a_b) * my, math.sqrt(a_c) * mz
     norm2 = ys * ys + xs * xs  # not hypot (≈ 15 ns): momenta below 1e150 cannot overflow it
     if not norm2 > 0.0:
-        return 0.0  # atan2(0, 0) = 0 (spin exactly about C in SAM)
+        return 0.0, 0.0, 1.0
     inv = 1.0 / math.sqrt(norm2)
     s, c = ys * inv, xs * inv
     j = 0.0
     if c < 0.0:  # am beyond ±π/2: r = am − jπ, sin r = −s, cos r = −c
         j = math.copysign(1.0, s)
         s, c = -s, -c
-    f_r = s * rf(c * c, c * c + mk[MK_MC] * (s * s), 1.0)
-    return 2.0 * j * mk[MK_K_HI] + (2.0 * j * mk[MK_K_LO] + f_r)
+    return j, s, c
 
 
 @jit
@@ -510,7 +527,7 @@ def _rotate(w, x, y, z, vx, vy, vz):
             vz + w * tz + (x * ty - y * tx))
 
 
-@jit
+@jit(inline=INLINE)
 def _node_of_state(quaternion, m0x, m0y, m0z, fx, fy, fz, mx, my):
     """(g0, node quaternion) of a state: :func:`.canonical.node_angles_of` from the quaternion.
 
@@ -577,9 +594,12 @@ def kappa_pn(kah, kal, rh, rl, s, c, d, pk):
     return dd_mul(kah, kal, xh, xl)
 
 
-@jit
-def _fourier_constants(flow, mk, pk):
+@jit(inline=INLINE)
+def _fourier_constants(flow, mk, pk, distance, near):
     """Fill the FL_FOURIER_* / FL_LINEAR_* slots when the nome series of pn converges fast enough.
+
+    ``distance``, ``near``: the pole of pn's integrand (:func:`.pn_fourier.pole_integral`, its R_F
+    formed by the caller).
 
     The slope κΠ/K = W/(2K) is formed in double-double from the double-double W and 2K; the
     normalisation of the series is in closed form (:mod:`.pn_fourier`), so it needs no 1 − Π/K,
@@ -587,13 +607,14 @@ def _fourier_constants(flow, mk, pk):
     """
     lh, ll = dd_div(flow[FL_G_ADVANCE_HI], flow[FL_G_ADVANCE_LO], flow[FL_PERIOD_HI], flow[FL_PERIOD_LO])
     k_quarter = mk[MK_K_HI]
-    terms = pn_fourier_coefficients(-pk[NK_N], mk[MK_M], k_quarter, flow[FL_KAPPA_HI], flow[FL_FOURIER_0:])
+    terms = pn_fourier_coefficients_at(-pk[NK_N], mk[MK_M], k_quarter, flow[FL_KAPPA_HI], distance, near,
+                                       flow[FL_FOURIER_0:])
     flow[FL_FOURIER_TERMS] = terms
     flow[FL_FOURIER_SCALE] = math.pi / k_quarter
     flow[FL_LINEAR_HI], flow[FL_LINEAR_LO] = lh, ll
 
 
-@jit
+@jit(inline=INLINE)
 def flow_kappa_pn(flow, rh, rl, s, c, d, pk):
     """κ · pn(r) for |r| ≤ K as a double-double, by whichever form the set-up chose.
 

@@ -27,25 +27,70 @@ def _duplicate(x, y, z):
 
 
 @jit
+def _rf_mean(x, y, z):
+    """(x + y + z)/3, as a product with the rounded 1/3: one rounding more than the quotient, no
+    division (R_F's loop forms it at every step; a divider is shared with the square roots)."""
+    return (x + y + z) * (1.0 / 3.0)
+
+
+@jit
+def _rf_start(x, y, z):
+    """(A₀, Q) of R_F's duplication: the mean and Carlson's stopping bound Q = C·max|A₀ − arg|."""
+    a0 = _rf_mean(x, y, z)
+    return a0, RF_STOP * max(abs(a0 - x), abs(a0 - y), abs(a0 - z))
+
+
+@jit
+def _rf_series(x, y, z, a):
+    """R_F from the last iterates and their mean a: the Taylor series of degree 5 (DLMF 19.36.1).
+
+    Divisions by constants as products with their reciprocals: the terms are below 1e-5, so the
+    extra rounding is far below ε of the sum.
+    """
+    inv = 1.0 / a
+    dx = (a - x) * inv
+    dy = (a - y) * inv
+    dz = -(dx + dy)
+    e2 = dx * dy - dz * dz
+    e3 = dx * dy * dz
+    return (1.0 - e2 * (1.0 / 10.0) + e3 * (1.0 / 14.0) + e2 * e2 * (1.0 / 24.0)
+            - e2 * e3 * (3.0 / 44.0)) / math.sqrt(a)
+
+
+@jit
 def rf(x, y, z):
     """Carlson's R_F(x, y, z) = ½∫₀^∞ dt / √((t+x)(t+y)(t+z)) (DLMF 19.16.1).
 
     x, y, z ≥ 0, at most one zero. Duplication (DLMF 19.26.18) until the Taylor series of degree 5
     (DLMF 19.36.1) is accurate to ε; series variables from the current iterates.
     """
-    a0 = (x + y + z) / 3.0
-    q = RF_STOP * max(abs(a0 - x), abs(a0 - y), abs(a0 - z))
-    a = a0
+    a, q = _rf_start(x, y, z)
     while q >= abs(a):
         _, _, _, _, x, y, z = _duplicate(x, y, z)
-        a = (x + y + z) / 3.0
+        a = _rf_mean(x, y, z)
         q *= 0.25
-    dx = (a - x) / a
-    dy = (a - y) / a
-    dz = -(dx + dy)
-    e2 = dx * dy - dz * dz
-    e3 = dx * dy * dz
-    return (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / math.sqrt(a)
+    return _rf_series(x, y, z, a)
+
+
+@jit
+def rf_pair(x1, y1, z1, x2, y2, z2):
+    """(R_F(x1, y1, z1), R_F(x2, y2, z2)), each bit for bit as :func:`rf` gives it.
+
+    The two duplications run in one loop, each stepping only until its own stop, so their chains of
+    square roots (the latency of R_F) overlap instead of following one another.
+    """
+    a1, q1 = _rf_start(x1, y1, z1)
+    a2, q2 = _rf_start(x2, y2, z2)
+    while q1 >= abs(a1) or q2 >= abs(a2):
+        if q1 >= abs(a1):
+            _, _, _, _, x1, y1, z1 = _duplicate(x1, y1, z1)
+            a1 = _rf_mean(x1, y1, z1)
+            q1 *= 0.25
+        if q2 >= abs(a2):
+            _, _, _, _, x2, y2, z2 = _duplicate(x2, y2, z2)
+            a2 = _rf_mean(x2, y2, z2)
+            q2 *= 0.25
+    return _rf_series(x1, y1, z1, a1), _rf_series(x2, y2, z2, a2)
 
 
 @jit

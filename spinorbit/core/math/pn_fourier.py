@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from spinorbit.core.jit import jit
+from spinorbit.core.jit import INLINE, jit
 from spinorbit.core.math.carlson import rf
 
 # Tail of the series: N terms with ρ^N below this (the first omitted term over the first kept is
@@ -55,26 +55,42 @@ def pn_fourier_ratio(f, m, k_quarter):
     k_quarter : float
         K(m), the quarter period.
     """
-    return _pole_ratios(f, m, k_quarter, nome(m, k_quarter))[0]
+    prefactor, x, y, z, near = pole_integral(f, m)
+    return _pole_ratios(prefactor * rf(x, y, z), near, k_quarter, nome(m, k_quarter))[0]
 
 
 @jit
-def _pole_ratios(f, m, k_quarter, q):
-    """(ρ, w, 1 − w) with w = σ/ρ = q²/ρ² ≤ 1, so that ρ^k − σ^k = ρ^k (1 − w^k) without cancellation.
+def pole_integral(f, m):
+    """The distance of the pole as prefactor · R_F(x, y, z): (prefactor, x, y, z, near).
 
-    f ≥ m: β = s R_F(c², Δ², 1) (module docstring) and w = (q/ρ)² ≤ 0.07, so 1 − w is exact enough.
-    f < m: the pole is near the nome's (β → K' as f → 0, ρ → σ), so from γ = K' − β =
-    F(arctan √(f/m) | 1 − m) = √f R_F(m, m(1 + f), f + m): ρ = q e^{x}, 1 − w = −expm1(−2x),
-    x = πγ/K, and nothing cancels as f → 0 (the periodic part keeps its relative accuracy).
+    f ≥ m (near False): β = s R_F(c², Δ², 1) (module docstring). f < m (near True): the pole is near
+    the nome's (β → K' as f → 0), so γ = K' − β = F(arctan √(f/m) | 1 − m) = √f R_F(m, m(1 + f), f + m)
+    instead. No K is needed, so callers can start this R_F before their AGM, or pair it with
+    another one (:func:`.carlson.rf_pair`). Outside the series' domain (f ≤ 0, m ∉ [0, 1), NaN) the
+    arguments (1, 1, 1) with prefactor 0: R_F(0, 0, 1) at f = m = 0 would never meet its stop.
     """
+    if not (f > 0.0) or not (0.0 <= m < 1.0):
+        return 0.0, 1.0, 1.0, 1.0, False
     if f >= m:
         s2 = 1.0 / (1.0 + f)
-        beta = math.sqrt(s2) * rf(f * s2, (f + m) * s2, 1.0)
-        rho = math.exp(-math.pi * beta / k_quarter)
+        return math.sqrt(s2), f * s2, (f + m) * s2, 1.0, False
+    return math.sqrt(f), m, m * (1.0 + f), f + m, True
+
+
+@jit
+def _pole_ratios(distance, near, k_quarter, q):
+    """(ρ, w, 1 − w) with w = σ/ρ = q²/ρ² ≤ 1, so that ρ^k − σ^k = ρ^k (1 − w^k) without cancellation.
+
+    ``distance`` and ``near`` as :func:`pole_integral` gives them. β (not near): ρ = e^{−πβ/K} and
+    w = (q/ρ)² ≤ 0.07, so 1 − w is exact enough. γ (near): ρ = q e^{x}, 1 − w = −expm1(−2x),
+    x = πγ/K, and nothing cancels as f → 0 (the periodic part keeps its relative accuracy).
+    """
+    if not near:
+        rho = math.exp(-math.pi * distance / k_quarter)
         ratio = q / rho
         w = ratio * ratio
         return rho, w, 1.0 - w
-    x = math.pi * math.sqrt(f) * rf(m, m * (1.0 + f), f + m) / k_quarter
+    x = math.pi * distance / k_quarter
     one_minus_w = -math.expm1(-2.0 * x)
     return q * math.exp(x), 1.0 - one_minus_w, one_minus_w
 
@@ -133,8 +149,20 @@ def pn_fourier_coefficients(f, m, k_quarter, scale, out):
     """
     if not (f > 0.0) or not (0.0 <= m < 1.0):
         return 0
+    prefactor, x, y, z, near = pole_integral(f, m)
+    return pn_fourier_coefficients_at(f, m, k_quarter, scale, prefactor * rf(x, y, z), near, out)
+
+
+@jit(inline=INLINE)
+def pn_fourier_coefficients_at(f, m, k_quarter, scale, distance, near, out):
+    """:func:`pn_fourier_coefficients` from the pole's distance (``distance``, ``near``: :func:`pole_integral`).
+
+    For the flow's set-up, which forms that R_F together with another one before its AGM.
+    """
+    if not (f > 0.0) or not (0.0 <= m < 1.0):
+        return 0
     q = nome(m, k_quarter)
-    rho, w, one_minus_w = _pole_ratios(f, m, k_quarter, q)
+    rho, w, one_minus_w = _pole_ratios(distance, near, k_quarter, q)
     if not (0.0 < rho <= FOURIER_RHO_MAX):  # ρ underflows only for m < 1e-200 (K'/K > 237); NaN too
         return 0
     q2 = q * q
@@ -166,7 +194,7 @@ def pn_fourier_coefficients(f, m, k_quarter, scale, out):
     return FOURIER_MAX_TERMS
 
 
-@jit
+@jit(inline=INLINE)
 def sine_series(theta, coefficients, offset, terms):
     """Σ_{k=1}^{terms} a_k sin(kθ), a_k = coefficients[offset + k − 1], by Clenshaw's recurrence.
 

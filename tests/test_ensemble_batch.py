@@ -188,7 +188,7 @@ def test_bad_route_and_integrators_are_refused():
 
 def test_member_zero_leads_every_chunk_so_the_rows_do_not_depend_on_the_chunk_size(both):
     rows, batch, _ = both
-    from spinorbit.ensemble.ensemble import _PROCESS_LEADERS, clear_process_samplings
+    from spinorbit.ensemble.process_memo import _PROCESS_LEADERS, clear_process_samplings
 
     clear_process_samplings()
     for size in (1, 6):  # every member its own chunk, and one chunk of all: the fixture's chunks of 3 bit for bit

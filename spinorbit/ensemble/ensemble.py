@@ -41,6 +41,7 @@ from spinorbit.ensemble.outcomes import (
     outcome_row,
 )
 from spinorbit.ensemble.free import torque_free_rows
+from spinorbit.ensemble.process_memo import clear_process_samplings, leader_plan, process_memo, sharing_key
 from spinorbit.ensemble.samplers import SEED_COLUMNS, sample_parameters
 from spinorbit.ensemble.store import ChunkStore
 
@@ -110,30 +111,6 @@ def failure_record(index, parameters, error):
             "type": type(error).__name__, "message": str(error)}
 
 
-def _sharing_key(scene):
-    """Members with the same orbit object, span, user ephemerides and sample tolerance sample once."""
-    return (id(scene.orbit), float(scene.epoch_day), float(scene.output_days[-1]),
-            tuple(id(p) for p in scene.moving), scene.sample_tolerance)
-
-
-#: Most sharing keys whose samplings a worker process keeps across chunks (an ensemble has one or a few).
-MEMO_KEYS = 8
-#: {sharing key: (orbit, moving perturbers, memo)}: this process's samplings, kept across chunks. The
-#: orbit and ephemerides are held, so the ids in the key stay theirs while the entry lives.
-_PROCESS_SAMPLINGS = {}
-
-
-def _process_memo(scene):
-    """The memo of this process's samplings for the scene's orbit, span and ephemerides (SharedSamples(memo))."""
-    key = _sharing_key(scene)
-    entry = _PROCESS_SAMPLINGS.get(key)
-    if entry is None or entry[0] is not scene.orbit:
-        if len(_PROCESS_SAMPLINGS) >= MEMO_KEYS:
-            _PROCESS_SAMPLINGS.pop(next(iter(_PROCESS_SAMPLINGS)))
-        entry = _PROCESS_SAMPLINGS[key] = (scene.orbit, tuple(scene.moving), {})
-    return entry[2]
-
-
 def torque_free(scene):
     """The member needs no integration: no perturbers and no orbit."""
     return not scene.named and not scene.fixed and not scene.moving and scene.orbit is None
@@ -155,42 +132,6 @@ def free_rows(free, at_days, rows, failures):
 #: group together (:mod:`spinorbit.ensemble.batch`), the rest through their own Scene; "member" runs
 #: every member through its own Scene.
 ROUTES = ("auto", "member")
-
-
-#: Most ensemble leaders whose group plans a process keeps across chunks (one per ensemble run in it).
-LEADER_KEYS = 4
-#: {(make_scene, the leader's parameters as fingerprint text): (leader's keys, GroupPlan or None)}: the group
-#: plan of an ensemble's leader in this process, made once and taken by every chunk whose group it fits.
-_PROCESS_LEADERS = {}
-
-
-def clear_process_samplings():
-    """Forget the samplings and leader plans this process keeps across chunks (e.g. after changing an orbit)."""
-    _PROCESS_SAMPLINGS.clear()
-    _PROCESS_LEADERS.clear()
-
-
-def _leader_plan(make_scene, leader, at_days, samples_of, integrators):
-    """((sharing key, group key), GroupPlan or None) of the ensemble's leader ``(index, parameters)`` in this
-    process (planned once: :func:`~spinorbit.ensemble.batch.plan_group`), or None when it cannot lead a
-    group (it fails to build, or cannot be batched)."""
-    from spinorbit.ensemble.batch import group_key, plan_group
-
-    text = "|".join(f"{name}={_fingerprint_text(value)}" for name, value in leader[1].items())
-    token = (make_scene, text, None if at_days is None else at_days.tobytes(),
-             tuple(sorted(integrators.items())) if integrators else None)
-    if token not in _PROCESS_LEADERS:
-        try:
-            scene = build_member(make_scene, leader[1])
-        except Exception:  # noqa: BLE001 — the leader's failure is recorded where it runs as a member
-            scene = None
-        key = None if scene is None else group_key(scene, at_days)
-        entry = None if key is None else ((_sharing_key(scene), key),
-                                          plan_group(scene, samples_of(scene), integrators))
-        if len(_PROCESS_LEADERS) >= LEADER_KEYS:
-            _PROCESS_LEADERS.pop(next(iter(_PROCESS_LEADERS)))
-        _PROCESS_LEADERS[token] = entry
-    return _PROCESS_LEADERS[token]
 
 
 def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None, route="auto", integrators=None,
@@ -232,7 +173,7 @@ def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None,
 
     def samples_of(scene):
         # the scene stays referenced with its samples, so an id() in the key is never reused in the chunk
-        return shared.setdefault(_sharing_key(scene), (scene, SharedSamples(_process_memo(scene))))[1]
+        return shared.setdefault(sharing_key(scene), (scene, SharedSamples(process_memo(scene))))[1]
 
     single = built
     if route == "auto" and not keep_tables:
@@ -240,10 +181,11 @@ def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None,
         for member in built:
             key = group_key(member[1], at_days)
             (single.append(member) if key is None else
-             groups.setdefault((_sharing_key(member[1]), key), []).append(member))
+             groups.setdefault((sharing_key(member[1]), key), []).append(member))
         led = None
         if leader is not None and groups:
-            led = _leader_plan(make_scene, leader, at_days, samples_of, integrators)
+            text = "|".join(f"{name}={_fingerprint_text(value)}" for name, value in leader[1].items())
+            led = leader_plan(make_scene, leader, at_days, samples_of, integrators, build_member, text)
         for keys, group in groups.items():
             # the ensemble leader's plan where it fits the group (and could be made), else the first member's
             group_plan = led[1] if led is not None and keys == led[0] else None

@@ -44,9 +44,9 @@ same: it is made of the member's own bounds and its own a posteriori check. Whic
 is in the table's ``meta["member_routes"]``.
 
 A group's leader is fixed by the ensemble, not by where its chunk runs, so its rows do not depend on
-the executor or the number of workers. A member that fails (its bounds, or its integration stopping) is recorded alone; a batch
-call that refuses its input as a whole sends its members to the per-member route, where each fails or
-runs on its own.
+the executor or the number of workers. A member that fails (its bounds, or its integration stopping)
+is recorded alone; a batch call that refuses its input as a whole sends its members to the
+per-member route, where each fails or runs on its own.
 """
 
 from __future__ import annotations

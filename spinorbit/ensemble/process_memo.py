@@ -51,7 +51,8 @@ def leader_plan(make_scene, leader, at_days, samples_of, integrators, build, tex
     """((sharing key, group key), GroupPlan or None) of the ensemble's leader ``(index, parameters)`` in this
     process (planned once: :func:`~spinorbit.ensemble.batch.plan_group`), or None when it cannot lead a
     group (it fails to build, or cannot be batched). ``build(make_scene, parameters)`` builds a member,
-    ``text`` is the leader's parameters as fingerprint text (what, with make_scene, names it)."""
+    ``text`` is the leader's parameters as fingerprint text (what, with make_scene, names it); both are
+    passed in because :mod:`spinorbit.ensemble.ensemble`, which defines them, imports this module."""
     from spinorbit.ensemble.batch import group_key, plan_group
 
     token = (make_scene, text, None if at_days is None else at_days.tobytes(),

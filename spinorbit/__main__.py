@@ -1,5 +1,5 @@
 """``python -m spinorbit``: the same as the ``spinorbit`` command."""
 
-from spinorbit.cli import main
+from spinorbit.cli import console_main
 
-raise SystemExit(main())
+raise SystemExit(console_main())

@@ -15,7 +15,8 @@ error-model choices are made once, here, with their reasons.
   IR level, before LLVM sees it. For the per-state and per-time kernels of the torque-free flow that
   take arrays: a call between separately compiled functions pays NRT reference counting for every array
   argument or slice (an atomic call each), and LLVM left those calls in place; inlined, the counts
-  cancel and the array stays in registers. One time per state 25 % cheaper (issue 18).
+  cancel and the array stays in registers (one time per state measurably cheaper:
+  ``benchmarks/bench_torque_free.py``, issue 18).
 - ``error_model="numpy"``: division by zero gives inf/NaN instead of raising inside kernels, so a
   kernel never needs a Python exception path; the public wrappers validate input before calling.
 """

@@ -444,7 +444,7 @@ def flow_constants_buffers(flow, mo, quaternion, momentum, big_a, big_b, big_c, 
         # compensated AGM above instead of a second AGM and a Carlson R_J per state
         mk = parameter_constants_with_k(param, pch, kh, kl)
         pk = characteristic_constants_with_complete(-fh, param, pih + pil)
-        arg0 = 2.0 * j0_am * kh + (2.0 * j0_am * kl + s_am * rf_am)
+        arg0 = _argument_from_amplitude(j0_am, s_am, rf_am, kh, kl)
     else:  # the separatrix: the kernels' closed forms, from the motion constants
         mk, pk = elliptic_constants(mo)
         # m_c = 0: F = atanh(sin am) in Carlson's form, ±inf past ±π/2 (ellipf_k's cases)
@@ -487,8 +487,13 @@ def _argument_of_momentum(mx, my, mz, mode, ic, mk):
     sum with this R_F paired with another (:func:`flow_constants_buffers`).
     """
     j, s, c = _amplitude_of_momentum(mx, my, mz, mode, ic)
-    f_r = s * rf(c * c, c * c + mk[MK_MC] * (s * s), 1.0)
-    return 2.0 * j * mk[MK_K_HI] + (2.0 * j * mk[MK_K_LO] + f_r)
+    return _argument_from_amplitude(j, s, rf(c * c, c * c + mk[MK_MC] * (s * s), 1.0), mk[MK_K_HI], mk[MK_K_LO])
+
+
+@jit(inline=INLINE)
+def _argument_from_amplitude(j, sin_r, rf_r, k_hi, k_lo):
+    """F = 2jK + sin r · R_F(cos² r, cos² r + p_c sin² r, 1), K = k_hi + k_lo: the small terms summed first."""
+    return 2.0 * j * k_hi + (2.0 * j * k_lo + sin_r * rf_r)
 
 
 @jit

@@ -147,9 +147,7 @@ def pn_fourier_coefficients(f, m, k_quarter, scale, out):
     int
         N, the number of terms written; 0 when ρ > FOURIER_RHO_MAX (use the Carlson form).
     """
-    if not (f > 0.0) or not (0.0 <= m < 1.0):
-        return 0
-    prefactor, x, y, z, near = pole_integral(f, m)
+    prefactor, x, y, z, near = pole_integral(f, m)  # outside the domain: prefactor 0, and `_at` returns 0
     return pn_fourier_coefficients_at(f, m, k_quarter, scale, prefactor * rf(x, y, z), near, out)
 
 

@@ -122,6 +122,23 @@ def _convert(time: Time, scale: str) -> Time:
             ) from error
 
 
+def _stored_jd(tdb: Time):
+    """(jd1, jd2) of a TDB time: the doubles astropy stores, or its public properties where those differ.
+
+    astropy's ``jd1``/``jd2`` properties cost ~8 µs each (they rebuild the input's shape and unbox a
+    scalar) for the same numbers, so the stored ones are read when they are plainly the same: not
+    masked, and held by astropy's format object with the time's own shape. ``_time`` is not public
+    API; if a later astropy moves it, the public properties are used (``tests/test_time.py`` checks
+    both give the same bits). Read on every call, never cached: a Time is mutable.
+    """
+    stored = getattr(tdb, "_time", None)
+    jd1, jd2 = getattr(stored, "jd1", None), getattr(stored, "jd2", None)
+    if (tdb.masked or not isinstance(jd1, np.ndarray) or not isinstance(jd2, np.ndarray)
+            or jd1.shape != tdb.shape or jd2.shape != tdb.shape):
+        return tdb.jd1, tdb.jd2
+    return jd1, jd2
+
+
 def tdb_day_and_fraction(time: Time) -> tuple[np.ndarray | float, np.ndarray | float]:
     """Split a time into whole TDB days since J2000 and a fraction of a day, both exact.
 
@@ -148,12 +165,7 @@ def tdb_day_and_fraction(time: Time) -> tuple[np.ndarray | float, np.ndarray | f
     tdb = _convert(_check_time(time), "tdb")
     # astropy keeps jd1 integer-valued (or half-integer) and |jd2| ≤ 0.5 d; jd1 − J2000 is an exact
     # difference of integers. Re-splitting with round() moves only exactly representable values.
-    if tdb.masked:
-        jd1, jd2 = tdb.jd1, tdb.jd2  # masked arrays, as astropy's properties give them
-    else:
-        # the stored doubles themselves: astropy's jd1/jd2 properties cost ~8 µs each (they rebuild the
-        # input's shape and unbox a scalar), the same numbers; read on every call, never cached (a Time is mutable)
-        jd1, jd2 = tdb._time.jd1, tdb._time.jd2
+    jd1, jd2 = _stored_jd(tdb)
     offset = jd1 - J2000_JD_TDB
     day = np.round(offset + jd2)
     fraction = (offset - day) + jd2

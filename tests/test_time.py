@@ -127,3 +127,28 @@ def test_day_and_fraction_read_the_same_doubles_as_astropys_jd1_jd2(value):
         assert isinstance(got[0], float)
         time[()] = Time(2451546.0, format="jd", scale="tdb")
         assert tdb_day_and_fraction(time) == (1.0, 0.0)
+
+
+@pytest.mark.parametrize("make", [
+    lambda t: t, lambda t: t.reshape(3, 4), lambda t: t.reshape(3, 4)[:, 1:], lambda t: t[::-2], lambda t: t[5],
+    lambda t: Time(t[4:8], scale="utc"),  # 1960-2100 only: UTC outside it warns of a dubious year
+])
+def test_stored_doubles_are_astropys_public_jd1_jd2(make):
+    # _stored_jd reads astropy's stored doubles only where they are the public jd1/jd2 (views, slices,
+    # reshapes, scalars, converted scales): the same bits and shape either way
+    from spinorbit.time import _stored_jd
+
+    time = make(Time(np.linspace(2415020.5, 2488069.5, 12) + 0.123, format="jd", scale="tdb"))
+    time = Time(time, scale="tdb")
+    jd1, jd2 = _stored_jd(time)
+    assert np.asarray(jd1).tobytes() == np.asarray(time.jd1).tobytes() and np.shape(jd1) == time.shape
+    assert np.asarray(jd2).tobytes() == np.asarray(time.jd2).tobytes() and np.shape(jd2) == time.shape
+
+
+def test_masked_time_takes_the_public_properties():
+    from spinorbit.time import _stored_jd
+
+    time = Time([2451545.0, 2451546.5], format="jd", scale="tdb")
+    time[1] = np.ma.masked
+    jd1, _ = _stored_jd(time)
+    assert np.ma.is_masked(jd1)

@@ -131,6 +131,147 @@ def closed_form_section(write=True):
     return rows
 
 
+# ------------------------------------------------------------------ where one time per state goes
+
+def _floor_kernels():
+    """Kernels timing the set-up's pieces one at a time over many states (compiled here, not cached:
+    they measure, they are not part of the package). Each returns a sum so that nothing is optimised away."""
+    from spinorbit.core.elements.canonical import (
+        MO_MODE, MO_SIZE, amplitude_from_momentum, flip_signs, motion_from_momentum_into)
+    from spinorbit.core.free_motion.flow_constants import (
+        FLOW_SIZE, complete_k_pi_dd, flow_constants_buffers, moment_constants, phase_constants_dd)
+    from spinorbit.core.free_motion.flow import flow_state
+    from spinorbit.core.jit import jit
+    from spinorbit.core.math.carlson import rf, rf_pair
+    from spinorbit.core.math.pn_fourier import pn_fourier_coefficients_at, pole_integral, sine_series
+
+    @jit(cache=False)
+    def inputs(momenta, a, b, c):
+        """Per state: mode, flipped momentum, phase constants, amplitude's sin/cos, the pole's R_F arguments."""
+        n = momenta.shape[0]
+        out = np.empty((n, 19))
+        mo = np.empty(MO_SIZE)
+        ic, inertia_dd = moment_constants(a, b, c)
+        for i in range(n):
+            fx, fy, fz = flip_signs(motion_from_momentum_into(mo, momenta[i, 0], momenta[i, 1], momenta[i, 2], ic))
+            mode = mo[MO_MODE]
+            mx, my, mz = fx * momenta[i, 0], fy * momenta[i, 1], fz * momenta[i, 2]
+            _, _, _, _, kah, _, fh, fl, pch, pcl, param = phase_constants_dd(int(mode), mx, my, mz, inertia_dd)
+            am = amplitude_from_momentum(mx, my, mz, mo, ic)
+            pre, x, y, z, near = pole_integral(fh, param)
+            kh = complete_k_pi_dd(fh, fl, pch, pcl)[0]
+            out[i] = (mode, mx, my, mz, fh, fl, pch, pcl, param, math.sin(am), math.cos(am), pre, x, y, z,
+                      1.0 if near else 0.0, kah, kh, pre * rf(x, y, z))
+        return out
+
+    @jit(cache=False)
+    def whole(quaternions, momenta, a, b, c, t):
+        flow, mo = np.empty(FLOW_SIZE), np.empty(MO_SIZE)
+        ic, inertia_dd = moment_constants(a, b, c)
+        acc = 0.0
+        for i in range(quaternions.shape[0]):
+            mk, pk = flow_constants_buffers(flow, mo, quaternions[i], momenta[i], a, b, c, ic, inertia_dd)
+            state = flow_state(t, flow, mo, mk, pk)
+            acc += state[0] + state[4]
+        return acc
+
+    @jit(cache=False)
+    def set_up(quaternions, momenta, a, b, c):
+        flow, mo = np.empty(FLOW_SIZE), np.empty(MO_SIZE)
+        ic, inertia_dd = moment_constants(a, b, c)
+        acc = 0.0
+        for i in range(quaternions.shape[0]):
+            flow_constants_buffers(flow, mo, quaternions[i], momenta[i], a, b, c, ic, inertia_dd)
+            acc += flow[0] + flow[5] + flow[10]
+        return acc
+
+    @jit(cache=False)
+    def motion(momenta, a, b, c):
+        mo = np.empty(MO_SIZE)
+        ic, _ = moment_constants(a, b, c)
+        acc = 0.0
+        for i in range(momenta.shape[0]):
+            acc += motion_from_momentum_into(mo, momenta[i, 0], momenta[i, 1], momenta[i, 2], ic) + mo[3]
+        return acc
+
+    @jit(cache=False)
+    def phase(x, a, b, c):
+        _, inertia_dd = moment_constants(a, b, c)
+        acc = 0.0
+        for i in range(x.shape[0]):
+            r = phase_constants_dd(int(x[i, 0]), x[i, 1], x[i, 2], x[i, 3], inertia_dd)
+            acc += r[0] + r[4] + r[6] + r[10]
+        return acc
+
+    @jit(cache=False)
+    def integrals(x):
+        acc = 0.0
+        for i in range(x.shape[0]):
+            s, c = x[i, 9], x[i, 10]
+            f1, f2 = rf_pair(c * c, c * c + x[i, 6] * (s * s), 1.0, x[i, 12], x[i, 13], x[i, 14])
+            acc += f1 + f2
+        return acc
+
+    @jit(cache=False)
+    def agm(x):
+        acc = 0.0
+        for i in range(x.shape[0]):
+            kh, _, pih, _ = complete_k_pi_dd(x[i, 4], x[i, 5], x[i, 6], x[i, 7])
+            acc += kh + pih
+        return acc
+
+    @jit(cache=False)
+    def series(x, out):
+        acc = 0.0
+        for i in range(x.shape[0]):
+            terms = pn_fourier_coefficients_at(x[i, 4], x[i, 8], x[i, 17], x[i, 16], x[i, 18], x[i, 15] > 0.0, out)
+            acc += sine_series(0.3 + 1e-6 * i, out, 0, terms) + terms
+        return acc
+
+    return inputs, whole, set_up, motion, phase, integrals, agm, series
+
+
+def one_time_floor(quaternions, momenta, t, repeats=7):
+    """CPU ns per state of the one-time-per-state kernel and of its set-up's pieces (interleaved medians)."""
+    inputs, whole, set_up, motion, phase, integrals, agm, series = _floor_kernels()
+    x = inputs(momenta, *MOMENTS)
+    out = np.empty(128)
+    jobs = {
+        "one time per state (set-up + one evaluation)": lambda: whole(quaternions, momenta, *MOMENTS, t),
+        "the set-up alone (`flow_constants_buffers`)": lambda: set_up(quaternions, momenta, *MOMENTS),
+        "motion constants from the momentum (mode, flip, energy differences)": lambda: motion(momenta, *MOMENTS),
+        "phase constants in double-double (rates, κ, n, p, p_c)": lambda: phase(x, *MOMENTS),
+        "the two R_F (the amplitude's F, pn's pole), paired": lambda: integrals(x),
+        "the compensated AGM (K and Π in double-double)": lambda: agm(x),
+        "pn's nome series: its coefficients and one sum": lambda: series(x, out),
+    }
+    timings, _ = interleaved_timings(list(jobs.values()), repeats, clock=time.process_time, warm_up=True)
+    return {name: timing.median / len(momenta) * 1e9 for name, timing in zip(jobs, timings)}
+
+
+def floor_text(floor, one_time_rate):
+    names = list(floor)
+    whole, set_up = floor[names[0]], floor[names[1]]
+    pieces = sum(floor[name] for name in names[2:])
+    budget = 1e9 / GOAL_ONE_TIME_STATES_PER_SECOND
+    lines = ["", "Where one time per state goes (CPU ns per state, the workload's states, each piece timed "
+             "alone in a loop of its own; medians of interleaved repeats):", "",
+             "| part | ns per state |", "|---|---:|"]
+    lines += [f"| {name} | {floor[name]:.0f} |" for name in names]
+    lines += [f"| one evaluation (the first row less the second) | {whole - set_up:.0f} |",
+              f"| the rest of the set-up (node frame, elliptic kernels' constants, remainders; the second row "
+              f"less the pieces) | {set_up - pieces:.0f} |", "",
+              f"The goal's budget is {budget:.0f} ns per state; the whole call measures "
+              f"{1e9 / one_time_rate:.0f} ns (the kernel above plus the Python wrapper's checks and the "
+              f"outputs' stores). With the evaluation and the wrapper as they are, the set-up would have to "
+              f"fall from {set_up:.0f} to {set_up - (1e9 / one_time_rate - budget):.0f} ns "
+              f"({100 * (1e9 / one_time_rate - budget) / set_up:.0f} % less), with no piece above "
+              f"{max(floor[name] for name in names[2:]):.0f} ns and each already in the form the earlier "
+              f"rounds found fastest (the two R_F paired, K and Π from one compensated AGM, the nome series' "
+              f"terms counted by the loop that forms them)."]
+    return lines
+
+
 #: ``--quick`` (benchmarks/run_all.py's smoke run): (N_STATES, N_TIMES, SPAN_PERIODS, EXACT_REPEATS,
 #: N_STATES_HEYOKA), print only.
 QUICK_SIZES = (50, 100, 10.0, 2, 2)
@@ -250,6 +391,8 @@ def main():
         "the span, not with the number of output times; the exact solution's cost is per output time "
         "and does not depend on the span.",
     ]
+    lines += floor_text(one_time_floor(quaternions_many, momenta_many, float(one_time[0]),
+                                       repeats=min(EXACT_REPEATS, 7)), one_time_rate)
     markdown = "\n".join(lines)
     print(markdown)
     if write:

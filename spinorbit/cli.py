@@ -117,9 +117,9 @@ def console_main() -> int:
     """The ``spinorbit`` console script and ``python -m spinorbit``: :func:`main` in a process of its own.
 
     The process ends right after the command, and the interpreter's last garbage collection at exit
-    walks every object numba and astropy made (about 0.2 s of a warm one-second ``spinorbit moon``,
-    ``benchmarks/bench_startup.py``). Freezing them (:func:`gc.freeze`) skips that walk; the OS frees
-    the memory. Atexit handlers and the destructors of objects without reference cycles still run.
+    walks every object numba and astropy made, a large part of a warm ``spinorbit moon``'s wall time
+    (``benchmarks/bench_startup.py --before REV`` times the command against an older revision).
+    Freezing them (:func:`gc.freeze`) skips that walk; the OS frees the memory. Atexit handlers and the destructors of objects without reference cycles still run.
     In-process callers (tests, notebooks) use :func:`main`, which leaves the collector alone.
     """
     status = main()

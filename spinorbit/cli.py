@@ -120,7 +120,8 @@ def console_main() -> int:
     walks every object numba and astropy made, a large part of a warm ``spinorbit moon``'s wall time
     (``benchmarks/bench_startup.py --before REV`` times the command against an older revision).
     Freezing them (:func:`gc.freeze`) skips that walk; the OS frees the memory. Atexit handlers and
-    the destructors of objects without reference cycles still run. In-process callers (tests, notebooks) use :func:`main`, which leaves the collector alone.
+    the destructors of objects without reference cycles still run. In-process callers (tests,
+    notebooks) use :func:`main`, which leaves the collector alone.
     """
     status = main()
     gc.freeze()

@@ -66,8 +66,8 @@ from spinorbit.core.math.pn_fourier import (
     sine_series,
 )
 
-# The compensated AGM for K and Π stops when the last term of the Π series is below this fraction of
-# the result (the double-double unit roundoff is 2^-106 ≈ 1.2e-32) ...
+# The compensated AGM for K and Π stops when the bound on what the rest of the Π series can still
+# change is below this fraction of Π (the double-double unit roundoff is 2^-106 ≈ 1.2e-32) ...
 AGM_TOLERANCE = 1e-33
 # ... and the AGM gap (a − g)/a is below this: K = π/(a + g) then differs from π/(2 M) by
 # (a − g)²/(16 a²) < 1e-33 relative. The compensated gap is only known to ≈ ε² (first-order
@@ -203,8 +203,11 @@ def complete_k_pi_dd(f_hi, f_lo, mc_hi, mc_lo):
         a, al = 0.5 * s, 0.5 * (e5 + (al + gl))
         g = math.sqrt(ag)
         gl = (fma(-g, g, ag) + agl) * (0.5 / g)
-        # the gap with its correction (the double chain alone may stay an ulp apart forever)
-        if abs(prod) * weight <= AGM_TOLERANCE * abs(t) and abs((a - g) + (al - gl)) <= AGM_GAP * a:
+        # The rest of T is taken as the last weight (all later D = 1), off by at most weight·(1 − D) =
+        # weight·prod; in Π = K (2 + f T) / (2 (1 + f)) that is f·weight·prod of 2 + f T (t ≤ T). The
+        # gap with its correction: the double chain alone may stay an ulp apart forever.
+        if (f_hi * (abs(prod) * weight) <= AGM_TOLERANCE * (2.0 + f_hi * abs(t))
+                and abs((a - g) + (al - gl)) <= AGM_GAP * a):
             break
     t, e6 = two_sum(t, weight)
     tl += e6

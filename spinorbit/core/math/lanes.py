@@ -1,0 +1,384 @@
+"""Eight doubles in one SIMD register: a numba type for running scalar kernels on eight states at once.
+
+``Lanes`` is an LLVM ``<8 x double>`` and ``LaneMask`` an ``<8 x i1>``. Arithmetic (+, −, ×, /, unary
+−, ``abs``, ``math.sqrt``, :func:`spinorbit.core.math.ddouble.fma`) and comparisons act lane by lane,
+with a double on either side broadcast to every lane. Each lane's operation is the IEEE-754 operation
+of the scalar code (no reassociation, no contraction), so a kernel written once and compiled for
+floats and for ``Lanes`` gives every lane the scalar result bit for bit. Where the scalar code
+branches, the lane form keeps each lane's own path with :func:`select` and loops while
+:func:`any_lane` holds (the drivers of :func:`spinorbit.core.math.carlson.rf_lanes` and
+:func:`spinorbit.core.free_motion.flow_constants.complete_k_pi_lanes`).
+
+Why: the set-up of one torque-free state is bound by the divider and the square root (the AGM and
+Carlson's duplication), which a scalar loop uses one double at a time; ``<8 x double>`` issues eight
+(``docs/design.md``, "Eight states in one register").
+"""
+
+import math
+import operator
+
+from llvmlite import ir
+from numba import types
+from numba.core import cgutils
+from numba.extending import intrinsic, models, overload, register_model
+
+WIDTH = 8
+
+
+class LanesType(types.Type):
+    """numba type of eight doubles in one vector register."""
+
+    def __init__(self):
+        super().__init__(name="Lanes")
+
+
+class LaneMaskType(types.Type):
+    """numba type of eight booleans, one per lane."""
+
+    def __init__(self):
+        super().__init__(name="LaneMask")
+
+
+lanes_type = LanesType()
+mask_type = LaneMaskType()
+_VECTOR = ir.VectorType(ir.DoubleType(), WIDTH)
+_MASK = ir.VectorType(ir.IntType(1), WIDTH)
+
+
+@register_model(LanesType)
+class _LanesModel(models.PrimitiveModel):
+    def __init__(self, dmm, fe_type):
+        super().__init__(dmm, fe_type, _VECTOR)
+
+
+@register_model(LaneMaskType)
+class _MaskModel(models.PrimitiveModel):
+    def __init__(self, dmm, fe_type):
+        super().__init__(dmm, fe_type, _MASK)
+
+
+def _as_vector(context, builder, value, value_type):
+    """The LLVM vector of a Lanes value, or of a number broadcast to every lane."""
+    if value_type == lanes_type:
+        return value
+    scalar = context.cast(builder, value, value_type, types.float64)
+    return _splat(builder, scalar)
+
+
+def _splat(builder, scalar):
+    vector = ir.Constant(_VECTOR, ir.Undefined)
+    vector = builder.insert_element(vector, scalar, ir.Constant(ir.IntType(32), 0))
+    return builder.shuffle_vector(vector, vector, ir.Constant(ir.VectorType(ir.IntType(32), WIDTH), [0] * WIDTH))
+
+
+def _is_operand(t):
+    return t == lanes_type or isinstance(t, (types.Float, types.Integer))
+
+
+def _lanes_binary(instruction):
+    """An intrinsic applying one LLVM floating-point instruction lane by lane (numbers broadcast)."""
+
+    @intrinsic
+    def kernel(typingctx, a, b):
+        if not (_is_operand(a) and _is_operand(b) and lanes_type in (a, b)):
+            return None
+
+        def codegen(context, builder, signature, args):
+            x = _as_vector(context, builder, args[0], signature.args[0])
+            y = _as_vector(context, builder, args[1], signature.args[1])
+            return getattr(builder, instruction)(x, y)
+
+        return lanes_type(a, b), codegen
+
+    return kernel
+
+
+_add = _lanes_binary("fadd")
+_sub = _lanes_binary("fsub")
+_mul = _lanes_binary("fmul")
+_div = _lanes_binary("fdiv")
+
+def _register_binary(python_operator, kernel):
+    """``python_operator`` on (Lanes or number, Lanes or number), at least one Lanes, by ``kernel``."""
+
+    def implementation(a, b):
+        if _is_operand(a) and _is_operand(b) and lanes_type in (a, b):
+            return lambda a, b: kernel(a, b)
+        return None
+
+    overload(python_operator)(implementation)
+
+
+for _operator, _kernel in ((operator.add, _add), (operator.sub, _sub), (operator.mul, _mul),
+                           (operator.truediv, _div), (operator.iadd, _add), (operator.isub, _sub),
+                           (operator.imul, _mul), (operator.itruediv, _div)):
+    _register_binary(_operator, _kernel)
+
+
+def _lanes_compare(predicate):
+    @intrinsic
+    def kernel(typingctx, a, b):
+        if not (_is_operand(a) and _is_operand(b) and lanes_type in (a, b)):
+            return None
+
+        def codegen(context, builder, signature, args):
+            x = _as_vector(context, builder, args[0], signature.args[0])
+            y = _as_vector(context, builder, args[1], signature.args[1])
+            return builder.fcmp_ordered(predicate, x, y)
+
+        return mask_type(a, b), codegen
+
+    return kernel
+
+
+for _operator, _predicate in ((operator.lt, "<"), (operator.le, "<="), (operator.gt, ">"),
+                              (operator.ge, ">="), (operator.eq, "==")):
+    _register_binary(_operator, _lanes_compare(_predicate))
+
+
+@intrinsic
+def _mask_and(typingctx, a, b):
+    if a != mask_type or b != mask_type:
+        return None
+    return mask_type(a, b), lambda context, builder, signature, args: builder.and_(*args)
+
+
+@intrinsic
+def _mask_or(typingctx, a, b):
+    if a != mask_type or b != mask_type:
+        return None
+    return mask_type(a, b), lambda context, builder, signature, args: builder.or_(*args)
+
+
+@intrinsic
+def _mask_not(typingctx, a):
+    if a != mask_type:
+        return None
+    return mask_type(a), lambda context, builder, signature, args: builder.not_(args[0])
+
+
+@overload(operator.and_)
+def _overload_and(a, b):
+    if a == mask_type and b == mask_type:
+        return lambda a, b: _mask_and(a, b)
+    return None
+
+
+@overload(operator.or_)
+def _overload_or(a, b):
+    if a == mask_type and b == mask_type:
+        return lambda a, b: _mask_or(a, b)
+    return None
+
+
+@overload(operator.invert)
+def _overload_invert(a):
+    if a == mask_type:
+        return lambda a: _mask_not(a)
+    return None
+
+
+def _vector_intrinsic(builder, name, *values):
+    """Call the LLVM intrinsic ``name`` on <8 x double> operands (llvmlite names no vector overloads)."""
+    signature = ir.FunctionType(_VECTOR, [_VECTOR] * len(values))
+    function = cgutils.get_or_insert_function(builder.module, signature, f"{name}.v{WIDTH}f64")
+    return builder.call(function, list(values))
+
+
+@intrinsic
+def _neg(typingctx, a):
+    if a != lanes_type:
+        return None
+    return lanes_type(a), lambda context, builder, signature, args: builder.fneg(args[0])
+
+
+@intrinsic
+def _abs(typingctx, a):
+    if a != lanes_type:
+        return None
+    return lanes_type(a), lambda context, builder, signature, args: _vector_intrinsic(builder, "llvm.fabs", args[0])
+
+
+@intrinsic
+def _sqrt(typingctx, a):
+    if a != lanes_type:
+        return None
+    return lanes_type(a), lambda context, builder, signature, args: _vector_intrinsic(builder, "llvm.sqrt", args[0])
+
+
+@overload(operator.neg)
+def _overload_neg(a):
+    if a == lanes_type:
+        return lambda a: _neg(a)
+    return None
+
+
+@overload(abs)
+def _overload_abs(a):
+    if a == lanes_type:
+        return lambda a: _abs(a)
+    return None
+
+
+@overload(math.sqrt)
+def _overload_sqrt(a):
+    if a == lanes_type:
+        return lambda a: _sqrt(a)
+    return None
+
+
+def fma_typing(a, b, c):
+    """(signature, codegen) of a·b + c rounded once in every lane (``llvm.fma``, numbers broadcast)
+    when an operand is ``Lanes``, else None: :func:`spinorbit.core.math.ddouble.fma` takes this branch,
+    so the one fma of the package serves both forms."""
+    if not all(_is_operand(t) for t in (a, b, c)) or lanes_type not in (a, b, c):
+        return None
+
+    def codegen(context, builder, signature, args):
+        values = [_as_vector(context, builder, v, t) for v, t in zip(args, signature.args)]
+        return _vector_intrinsic(builder, "llvm.fma", *values)
+
+    return lanes_type(a, b, c), codegen
+
+
+@intrinsic
+def select(typingctx, mask, a, b):
+    """Lane by lane: a where ``mask`` holds, else b (numbers broadcast)."""
+    if mask != mask_type or not (_is_operand(a) and _is_operand(b)):
+        return None
+
+    def codegen(context, builder, signature, args):
+        x = _as_vector(context, builder, args[1], signature.args[1])
+        y = _as_vector(context, builder, args[2], signature.args[2])
+        return builder.select(args[0], x, y)
+
+    return lanes_type(mask, a, b), codegen
+
+
+@intrinsic
+def any_lane(typingctx, mask):
+    """True if ``mask`` holds in at least one lane."""
+    if mask != mask_type:
+        return None
+
+    def codegen(context, builder, signature, args):
+        signature = ir.FunctionType(ir.IntType(1), [_MASK])
+        function = cgutils.get_or_insert_function(builder.module, signature, f"llvm.vector.reduce.or.v{WIDTH}i1")
+        return builder.call(function, [args[0]])
+
+    return types.boolean(mask), codegen
+
+
+@intrinsic
+def broadcast(typingctx, value):
+    """A number in every lane."""
+    if not isinstance(value, (types.Float, types.Integer)):
+        return None
+    return lanes_type(value), lambda context, builder, signature, args: _as_vector(context, builder, args[0], signature.args[0])
+
+
+def _is_vector_array(t):
+    """A one-dimensional C-contiguous float64 array: eight consecutive doubles are one vector."""
+    return isinstance(t, types.Array) and t.dtype == types.float64 and t.ndim == 1 and t.layout == "C"
+
+
+@intrinsic
+def load_lanes(typingctx, array, start):
+    """array[start:start + 8] of a C-contiguous float64 array (the caller keeps it in bounds)."""
+    if not (_is_vector_array(array) and isinstance(start, types.Integer)):
+        return None
+
+    def codegen(context, builder, signature, args):
+        ary = context.make_array(signature.args[0])(context, builder, args[0])
+        pointer = builder.gep(ary.data, [args[1]])
+        return builder.load(builder.bitcast(pointer, _VECTOR.as_pointer()), align=8)
+
+    return lanes_type(array, start), codegen
+
+
+@intrinsic
+def store_lanes(typingctx, array, start, value):
+    """array[start:start + 8] = value (C-contiguous float64; the caller keeps it in bounds)."""
+    if not (_is_vector_array(array) and isinstance(start, types.Integer) and value == lanes_type):
+        return None
+
+    def codegen(context, builder, signature, args):
+        ary = context.make_array(signature.args[0])(context, builder, args[0])
+        pointer = builder.gep(ary.data, [args[1]])
+        builder.store(args[2], builder.bitcast(pointer, _VECTOR.as_pointer()), align=8)
+        return context.get_dummy_value()
+
+    return types.none(array, start, value), codegen
+
+
+@intrinsic
+def all_lanes(typingctx):
+    """A mask that holds in every lane."""
+    return mask_type(), lambda context, builder, signature, args: ir.Constant(_MASK, [1] * WIDTH)
+
+
+@intrinsic
+def select_tuple(typingctx, mask, new, old):
+    """Lane by lane, element by element: ``new`` where ``mask`` holds, else ``old`` (tuples of equal
+    length whose elements are Lanes or numbers; numbers broadcast); a tuple of Lanes."""
+    if not (mask == mask_type and isinstance(new, types.BaseTuple) and isinstance(old, types.BaseTuple)
+            and len(new) == len(old) and all(_is_operand(t) for t in (*new, *old))):
+        return None
+    result_type = types.UniTuple(lanes_type, len(new))
+
+    def codegen(context, builder, signature, args):
+        result = ir.Constant(context.get_value_type(result_type), ir.Undefined)
+        for i in range(len(new)):
+            x = _as_vector(context, builder, builder.extract_value(args[1], i), new[i])
+            y = _as_vector(context, builder, builder.extract_value(args[2], i), old[i])
+            result = builder.insert_value(result, builder.select(args[0], x, y), i)
+        return result
+
+    return result_type(mask, new, old), codegen
+
+
+def constant_like(template, value):
+    """``value`` in the form of ``template``: a double, or ``Lanes`` with it in every lane (compiled code only)."""
+    raise NotImplementedError("constant_like is for compiled code")
+
+
+@overload(constant_like)
+def _overload_constant_like(template, value):
+    if template == lanes_type:
+        return lambda template, value: broadcast(value)
+    if isinstance(template, types.Float):
+        return lambda template, value: float(value)
+    return None
+
+
+@overload(max)
+def _overload_max(*values):
+    # Python's max: the first value unless a later one is larger (so a NaN never replaces a number)
+    if len(values) == 1 and isinstance(values[0], types.BaseTuple):
+        values = tuple(values[0])
+    if not (len(values) in (2, 3) and all(v == lanes_type for v in values)):
+        return None
+    if len(values) == 2:
+        return lambda *values: select(values[1] > values[0], values[1], values[0])
+
+    def max3(*values):
+        first = select(values[1] > values[0], values[1], values[0])
+        return select(values[2] > first, values[2], first)
+
+    return max3
+
+
+@intrinsic
+def lane_of(typingctx, values, lane):
+    """The doubles of one lane of a tuple of Lanes (a tuple of floats)."""
+    if not (isinstance(values, types.UniTuple) and values.dtype == lanes_type and isinstance(lane, types.Integer)):
+        return None
+    result_type = types.UniTuple(types.float64, values.count)
+
+    def codegen(context, builder, signature, args):
+        result = ir.Constant(context.get_value_type(result_type), ir.Undefined)
+        for i in range(values.count):
+            result = builder.insert_value(result, builder.extract_element(builder.extract_value(args[0], i), args[1]), i)
+        return result
+
+    return result_type(values, lane), codegen

@@ -23,7 +23,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _report import Timing, interleaved_timings, machine_line, write_section  # noqa: E402
 
 from spinorbit import special  # noqa: E402
-from spinorbit.core.free_motion.flow_constants import complete_k_pi_dd  # noqa: E402
+from spinorbit.core.math.complete_agm import complete_k_pi_dd  # noqa: E402
 from spinorbit.core.math import elliptic as E  # noqa: E402
 from spinorbit.core.math.elliptic_integrals import complete_k_pi  # noqa: E402
 

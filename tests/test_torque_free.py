@@ -21,9 +21,9 @@ from spinorbit.core.free_motion.flow_constants import (
     FL_MODE,
     FL_PERIOD_HI,
     FL_RATE_HI,
-    complete_k_pi_dd,
     flow_constants,
 )
+from spinorbit.core.math.complete_agm import complete_k_pi_dd
 from spinorbit.core.math.elliptic_integrals import NK_N, complete_k_pi
 from spinorbit.core.math.elliptic_periods import MK_K_HI, MK_M
 from spinorbit.core.math.elliptic_periods import ellipk

@@ -74,6 +74,7 @@ from spinorbit.core.elements.canonical import (
 )
 from spinorbit.core.jit import jit
 from spinorbit.core.math.carlson import rd, rf, rj
+from spinorbit.core.math.ddouble import parity
 from spinorbit.core.math.elliptic_periods import (
     MK_HEAD,
     MK_K_HI,
@@ -154,7 +155,7 @@ def associate_integrals(x, mk, f, want_jn=True, want_cn2_t=True):
     j, r = reduce_by_period(x, mk[MK_HEAD], mk[MK_TAIL])
     q, qc = mk[MK_MU], mk[MK_MUC]
     s, c, d = sncndn_reduced(r, q, qc, mk[MK_SQRT_MUC], mk[MK_K_HI], mk[MK_K_LO])
-    sign = 1.0 - 2.0 * (abs(j) % 2.0)
+    sign = 1.0 - 2.0 * parity(j)
     s2, c2, d2 = s * s, c * c, d * d
     s3 = s * s2 / 3.0
     jm = s3 * rd(c2, 1.0, d2)

@@ -101,6 +101,14 @@ from spinorbit.core.free_motion.flow_constants import (
     half_angles,
     moment_constants,
 )
+from spinorbit.core.free_motion.flow_blocks import (
+    BLOCK,
+    INTEGRALS_SIZE,
+    STAGE_SIZE,
+    finish_lane,
+    integrals_of_block,
+    set_up_block_start,
+)
 from spinorbit.core.free_motion.regular_precession import (
     NO_SYMMETRY_AXIS,
     evaluate_precession,
@@ -116,6 +124,7 @@ from spinorbit.core.math.ddouble import (
     dd_remainder,
     dd_remainder_dd,
     dd_scale,
+    parity,
 )
 from spinorbit.core.math.elliptic_integrals import pn_k
 from spinorbit.core.math.elliptic_periods import (
@@ -187,7 +196,7 @@ def flow_state(t, flow, mo, mk, pk):
         if j != 0.0:
             wh, wl = dd_scale(flow[FL_G_ADVANCE_HI], flow[FL_G_ADVANCE_LO], j)
             gh, gl = dd_add(gh, gl, wh, wl)
-            if abs(j) % 2.0 == 1.0:  # sn, cn change sign every half period; dn does not
+            if parity(j) == 1.0:  # sn, cn change sign every half period; dn does not
                 s, c = -s, -c
     else:  # separatrix (m = 1): no period; closed forms in the kernels
         r = ah + al
@@ -234,32 +243,83 @@ def propagate_many_into(quaternions, momenta, moments, times, q_out, m_out, clos
     ``moments`` is (N, 3) (broadcast by the caller for shared moments). ``closed_forms``: bodies with
     two equal moments take the regular precession (:mod:`.regular_precession`, trig only) instead
     of the elliptic flow at parameter 0; False forces the elliptic flow (tests, benchmarks).
+
+    Consecutive states of one body form a run; within it, blocks of eight rotating states of a
+    triaxial body are set up together (:mod:`.flow_blocks`, the same results bit for bit), and the
+    other states one by one in a loop of their own (in the blocks' loop their code cost every block
+    ≈ 10 % of its time: ``docs/design.md``).
     """
-    flow = np.empty(FLOW_SIZE)  # one buffer for every state's constants (an allocation each cost ≈ 25 ns)
-    mo = np.empty(MO_SIZE)
-    ic, inertia_dd = moment_constants(moments[0, 0], moments[0, 1], moments[0, 2])
-    body = 0  # the row ic, inertia_dd belong to: recomputed only when the moments change
-    for i in range(quaternions.shape[0]):
+    flows = np.empty((BLOCK, FLOW_SIZE))  # buffers for every state's constants (an allocation each cost ≈ 25 ns)
+    mos = np.empty((BLOCK, MO_SIZE))
+    stages = np.empty((STAGE_SIZE, BLOCK))
+    integrals = np.empty((INTEGRALS_SIZE, BLOCK))
+    motions = np.empty((4, BLOCK))
+    n = quaternions.shape[0]
+    pending = np.empty(n // BLOCK + 1, dtype=np.int64)  # first states of the blocks left to the single loop
+    start = 0
+    while start < n:
+        a, b, c = moments[start, 0], moments[start, 1], moments[start, 2]
+        stop = start + 1
+        while stop < n and moments[stop, 0] == a and moments[stop, 1] == b and moments[stop, 2] == c:
+            stop += 1
+        ic, inertia_dd = moment_constants(a, b, c)
+        elliptic = not closed_forms or symmetry_axis(a, b, c) == NO_SYMMETRY_AXIS
+        whole = start + (stop - start) // BLOCK * BLOCK
+        count = 0
+        for first in range(start, whole, BLOCK):
+            if not (elliptic and _block_rotates(momenta, first)):
+                pending[count] = first
+                count += 1
+                continue
+            all_periodic = set_up_block_start(flows, mos, stages, motions, quaternions, momenta, first, a, b, c, ic,
+                                              inertia_dd)
+            integrals_of_block(stages, integrals, all_periodic)
+            for lane in range(BLOCK):
+                i = first + lane
+                mk, pk = finish_lane(flows, mos, stages, integrals, lane, quaternions[i], momenta[i], ic)
+                _evaluate_into(times, flows[lane], mos[lane], mk, pk, q_out, m_out, i)
+        for block in range(count + 1):
+            first, last = (pending[block], pending[block] + BLOCK) if block < count else (whole, stop)
+            for i in range(first, last):
+                _propagate_state(quaternions, momenta, times, q_out, m_out, i, a, b, c, closed_forms, flows[0],
+                                 mos[0], ic, inertia_dd)
+        start = stop
+
+
+@jit(inline=INLINE)
+def _propagate_state(quaternions, momenta, times, q_out, m_out, i, a, b, c, closed_forms, flow, mo, ic, inertia_dd):
+    """State i (moments a ≤ b ≤ c) at every time, by itself: no rotation, the regular precession, or
+    the elliptic flow."""
+    if momenta[i, 0] == 0.0 and momenta[i, 1] == 0.0 and momenta[i, 2] == 0.0:
+        for k in range(times.shape[0]):  # no rotation at all
+            q_out[i, k, :] = quaternions[i]
+            m_out[i, k, :] = 0.0
+        return
+    axis = symmetry_axis(a, b, c) if closed_forms else NO_SYMMETRY_AXIS
+    if axis != NO_SYMMETRY_AXIS:
+        pc = precession_constants(quaternions[i], momenta[i], a, b, c, axis)
+        for k in range(times.shape[0]):
+            evaluate_precession(times[k], pc, q_out[i, k], m_out[i, k])
+        return
+    mk, pk = flow_constants_buffers(flow, mo, quaternions[i], momenta[i], a, b, c, ic, inertia_dd)
+    _evaluate_into(times, flow, mo, mk, pk, q_out, m_out, i)
+
+
+@jit(inline=INLINE)
+def _block_rotates(momenta, first):
+    """True if none of states first … first + BLOCK − 1 has a zero momentum."""
+    for i in range(first, first + BLOCK):
         if momenta[i, 0] == 0.0 and momenta[i, 1] == 0.0 and momenta[i, 2] == 0.0:
-            for k in range(times.shape[0]):  # no rotation at all
-                q_out[i, k, :] = quaternions[i]
-                m_out[i, k, :] = 0.0
-            continue
-        axis = symmetry_axis(moments[i, 0], moments[i, 1], moments[i, 2]) if closed_forms else NO_SYMMETRY_AXIS
-        if axis != NO_SYMMETRY_AXIS:
-            pc = precession_constants(quaternions[i], momenta[i], moments[i, 0], moments[i, 1], moments[i, 2], axis)
-            for k in range(times.shape[0]):
-                evaluate_precession(times[k], pc, q_out[i, k], m_out[i, k])
-            continue
-        if moments[i, 0] != moments[body, 0] or moments[i, 1] != moments[body, 1] or moments[i, 2] != moments[body, 2]:
-            ic, inertia_dd = moment_constants(moments[i, 0], moments[i, 1], moments[i, 2])
-            body = i
-        mk, pk = flow_constants_buffers(
-            flow, mo, quaternions[i], momenta[i], moments[i, 0], moments[i, 1], moments[i, 2], ic, inertia_dd
-        )
-        for k in range(times.shape[0]):  # element stores: views q_out[i, k] cost ~10% of an evaluation
-            (q_out[i, k, 0], q_out[i, k, 1], q_out[i, k, 2], q_out[i, k, 3],
-             m_out[i, k, 0], m_out[i, k, 1], m_out[i, k, 2]) = flow_state(times[k], flow, mo, mk, pk)
+            return False
+    return True
+
+
+@jit(inline=INLINE)
+def _evaluate_into(times, flow, mo, mk, pk, q_out, m_out, i):
+    """The motion at every time into q_out[i] (T, 4) and m_out[i] (T, 3)."""
+    for k in range(times.shape[0]):  # element stores: views q_out[i, k] cost ~10% of an evaluation
+        (q_out[i, k, 0], q_out[i, k, 1], q_out[i, k, 2], q_out[i, k, 3],
+         m_out[i, k, 0], m_out[i, k, 1], m_out[i, k, 2]) = flow_state(times[k], flow, mo, mk, pk)
 
 
 def _as_states(quaternions, momenta, moments):

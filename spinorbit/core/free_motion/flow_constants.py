@@ -21,23 +21,19 @@ from spinorbit.core.elements.canonical import (
     amplitude_from_momentum,
     elliptic_constants,
     flip_signs,
-    inertia_constants,
     motion_from_momentum_into,
 )
 from spinorbit.core.jit import INLINE, jit
 from spinorbit.core.math.carlson import rf, rf_pair
+from spinorbit.core.math.complete_agm import complete_k_pi_dd
+from spinorbit.core.free_motion.phase_constants import moment_constants, phase_constants_dd
 from spinorbit.core.math.ddouble import (
     dd_add,
-    dd_difference_ratio,
     dd_div,
     dd_mul,
     dd_remainder_dd,
     dd_scale,
     dd_sqrt,
-    fma,
-    quick_two_sum,
-    two_prod,
-    two_sum,
 )
 from spinorbit.core.math.elliptic_integrals import (
     METHOD_LARGE_NEGATIVE,
@@ -54,8 +50,6 @@ from spinorbit.core.math.elliptic_periods import (
     MK_M,
     MK_MC,
     MK_SQRT_MUC,
-    PI_HI,
-    PI_LO,
     parameter_constants_with_k,
 )
 from spinorbit.core.math.jacobi import sncndn_reduced
@@ -65,16 +59,6 @@ from spinorbit.core.math.pn_fourier import (
     pole_integral,
     sine_series,
 )
-
-# The compensated AGM for K and Π stops when the bound on what the rest of the Π series can still
-# change is below this fraction of Π (the double-double unit roundoff is 2^-106 ≈ 1.2e-32) ...
-AGM_TOLERANCE = 1e-33
-# ... and the AGM gap (a − g)/a is below this: K = π/(a + g) then differs from π/(2 M) by
-# (a − g)²/(16 a²) < 1e-33 relative. The compensated gap is only known to ≈ ε² (first-order
-# corrections), so the stop cannot ask for AGM_TOLERANCE there.
-AGM_GAP = 1e-16
-# f = −n up to 1e30 needs ≈ 50 halvings of p_k before the quadratic phase; 200 is never reached.
-AGM_MAX_STEPS = 200
 
 # Indices into the per-state flow constants (see flow_constants). The MO_* motion constants, the
 # elliptic constants and these describe one torque-free motion completely.
@@ -120,195 +104,6 @@ FLOW_SIZE = FL_FOURIER_0 + FOURIER_MAX_TERMS
 # --------------------------------------------------------------------------------------------------
 # Double-double constants of one motion
 # --------------------------------------------------------------------------------------------------
-
-
-@jit
-def complete_k_pi_dd(f_hi, f_lo, mc_hi, mc_lo):
-    """K(p) and Π(n | p) for n = −f ≤ 0, 0 ≤ p < 1, as double-doubles (DLMF 19.8.5, 19.8.6–8).
-
-    Parameters
-    ----------
-    f_hi, f_lo : float
-        f = −n ≥ 0 as a double-double (dimensionless; up to 1e30 checked).
-    mc_hi, mc_lo : float
-        Complementary parameter p_c = 1 − p > 0 as a double-double.
-
-    Returns
-    -------
-    k_hi, k_lo, pi_hi, pi_lo : float
-        K(p) = π / (2 M(1, √p_c)) and Π(n | p) = ∫₀^{π/2} dθ / ((1 − n sin²θ) √(1 − p sin²θ)).
-
-    Notes
-    -----
-    DLMF 19.8.6 reads Π = K/2 · (2 + n/(1 − n) Σ_{k≥0} Q_k), with p_0² = 1 − n, Q_0 = 1,
-    ε_k = (p_k² − a_k g_k)/(p_k² + a_k g_k), Q_{k+1} = Q_k ε_k / 2, p_{k+1} = (p_k² + a_k g_k)/(2 p_k).
-    For n → −∞ the bracket cancels catastrophically (Σ Q → 2, Π → 0). Written with
-    T = 1 − Σ_{k≥1} Q_k = Σ_{k≥1} 2^{-k} D_k, D_k = 1 − Π_{i<k} ε_i, the result is
-    Π = K/2 · (2 + f T)/(1 + f), and D_{k+1} = D_k + δ_k (1 − D_k) with δ_k = 1 − ε_k = 2 a_k g_k /
-    (p_k² + a_k g_k) sums positive terms only (ε_k ≥ 0 for n ≤ 0). Once ε_k = 0 all later D are 1,
-    so the tail of T is the last weight 2^{-k}.
-
-    Arithmetic: compensated, not double-double. Each quantity is a double x plus a double x' that
-    carries its error to first order: the double AGM runs unchanged on the x's, and x' collects the
-    exact rounding error of every operation (``two_prod`` by FMA, ``two_sum``, the residual of
-    every quotient and root) plus the propagated x' of the operands, never renormalised. The
-    neglected terms are products of two errors, ≈ ε² ≈ 5e-32 relative per step. The quotients'
-    and roots' corrections multiply by a reciprocal instead of dividing again, and the x chain
-    never waits for the x' chain, so one step costs about four roundings' worth of division and
-    root instead of the double-double's eight (``benchmarks/bench_elliptic.py`` times both AGMs).
-    Checked against mpmath (50 digits) for p_c from 1e-16 to 1 and f from 0 to 1e30
-    (``tests/test_torque_free.py``, AGM_TOLERANCE there).
-    """
-    a, al = 1.0, 0.0
-    g = math.sqrt(mc_hi)
-    gl = (fma(-g, g, mc_hi) + mc_lo) * (0.5 / g)
-    one_h, one_l = two_sum(1.0, f_hi)
-    one_l += f_lo
-    p = math.sqrt(one_h)
-    pl = (fma(-p, p, one_h) + one_l) * (0.5 / p)
-    prod, prodl = 1.0, 0.0  # Π_{i<k} ε_i = 1 − D_k, kept as a product (no cancellation)
-    d, dl = 0.0, 0.0  # D_k
-    t, tl = 0.0, 0.0  # partial sum of T
-    weight = 1.0
-    for _ in range(AGM_MAX_STEPS):
-        ag = a * g
-        agl = fma(a, g, -ag) + (a * gl + al * g)
-        p2 = p * p
-        p2l = fma(p, p, -p2) + 2.0 * p * pl
-        den, e1 = two_sum(p2, ag)
-        denl = e1 + (p2l + agl)
-        num, e2 = two_sum(p2, -ag)
-        numl = e2 + (p2l - agl)
-        inv = 1.0 / den
-        eps_k = num * inv
-        eps_l = (fma(-eps_k, den, num) + (numl - eps_k * denl)) * inv
-        ag2 = 2.0 * ag
-        dlt = ag2 * inv
-        dlt_l = (fma(-dlt, den, ag2) + (2.0 * agl - dlt * denl)) * inv
-        x = dlt * prod
-        xl = fma(dlt, prod, -x) + (dlt * prodl + dlt_l * prod)
-        d, e3 = two_sum(d, x)
-        dl += e3 + xl
-        new_prod = prod * eps_k
-        prodl = fma(prod, eps_k, -new_prod) + (prod * eps_l + prodl * eps_k)
-        prod = new_prod
-        weight *= 0.5
-        t, e4 = two_sum(t, weight * d)
-        tl += e4 + weight * dl
-        half_p = 0.5 / p
-        new_p = den * half_p
-        pl = (fma(-new_p, 2.0 * p, den) + (denl - new_p * 2.0 * pl)) * half_p
-        p = new_p
-        s, e5 = two_sum(a, g)
-        a, al = 0.5 * s, 0.5 * (e5 + (al + gl))
-        g = math.sqrt(ag)
-        gl = (fma(-g, g, ag) + agl) * (0.5 / g)
-        # The rest of T is taken as the last weight (all later D = 1), off by at most weight·(1 − D) =
-        # weight·prod; in Π = K (2 + f T) / (2 (1 + f)) that is f·weight·prod of 2 + f T (t ≤ T). The
-        # gap with its correction: the double chain alone may stay an ulp apart forever.
-        if (f_hi * (abs(prod) * weight) <= AGM_TOLERANCE * (2.0 + f_hi * abs(t))
-                and abs((a - g) + (al - gl)) <= AGM_GAP * a):
-            break
-    t, e6 = two_sum(t, weight)
-    tl += e6
-    s, e7 = two_sum(a, g)
-    sl = e7 + (al + gl)
-    # K = π / (a + g), Π = K (2 + f T) / (2 (1 + f)), with the same first-order corrections
-    k = PI_HI / s
-    kl = (fma(-k, s, PI_HI) + (PI_LO - k * sl)) / s
-    ft = f_hi * t
-    ftl = fma(f_hi, t, -ft) + (f_hi * tl + f_lo * t)
-    top, e8 = two_sum(2.0, ft)
-    topl = e8 + ftl
-    ratio = top / one_h
-    ratio_l = (fma(-ratio, one_h, top) + (topl - ratio * one_l)) / one_h
-    pi_k = 0.5 * k * ratio
-    pi_l = fma(0.5 * k, ratio, -pi_k) + 0.5 * (k * ratio_l + kl * ratio)
-    kh, kl = quick_two_sum(k, kl)
-    pih, pil = quick_two_sum(pi_k, pi_l)
-    return kh, kl, pih, pil
-
-
-@jit
-def _dd_lin(ah, al, xh, xl, bh, bl, yh, yl):
-    """a·x + b·y for double-doubles."""
-    uh, ul = dd_mul(ah, al, xh, xl)
-    vh, vl = dd_mul(bh, bl, yh, yl)
-    return dd_add(uh, ul, vh, vl)
-
-
-@jit
-def moment_constants(big_a, big_b, big_c):
-    """The per-body part of the set-up: (:func:`.canonical.inertia_constants`, double-double
-    (a − b, b − c, a − c, c) as an 8-tuple), formed once for states that share their moments."""
-    abh, abl = dd_difference_ratio(big_a, big_b)
-    bch, bcl = dd_difference_ratio(big_b, big_c)
-    ach, acl = dd_difference_ratio(big_a, big_c)
-    ch, cl = dd_div(1.0, 0.0, big_c, 0.0)
-    return inertia_constants(big_a, big_b, big_c), (abh, abl, bch, bcl, ach, acl, ch, cl)
-
-
-@jit
-def phase_constants_dd(mode, mx, my, mz, inertia_dd):
-    """Secular constants of a SAM/LAM motion as double-doubles from the exact double inputs.
-
-    Parameters
-    ----------
-    mode : int
-        MODE_SAM or MODE_LAM (from :func:`.canonical.motion_from_momentum`).
-    mx, my, mz : float
-        Body angular momentum (any flip: only squares enter).
-    inertia_dd : tuple
-        The double-double (a − b, b − c, a − c, c) of :func:`moment_constants`.
-
-    Returns
-    -------
-    tuple of 11 floats
-        (ν_hi, ν_lo, cG_hi, cG_lo, κ_hi, κ_lo, f_hi, f_lo, p_c,hi, p_c,lo, p): the argument rate ν
-        (argument per time unit), the secular rate c G of g (rad per time unit), the pn coefficient
-        κ (rad), f = −n and p_c = 1 − p as double-doubles (the inputs of :func:`complete_k_pi_dd`;
-        p_c ≤ 0 at the separatrix), and the parameter p rounded once from its double-double value
-        (for the double kernels: near the separatrix p_c from doubles would lose ε/p_c). The AGM is
-        the caller's, so that work which does not need K can be issued before it.
-
-    Notes
-    -----
-    With P_a = (a−b) M_y² + (a−c) M_z² = (a−d) G², Q = (a−c) M_x² + (b−c) M_y² = (d−c) G² and
-    R = (b−c) M_z² − (a−b) M_x² = (b−d) G² (``canonical`` module docstring, eqs. 5, 7, 8):
-    SAM ν² = P_a (b−c), p = (a−b) Q / (P_a (b−c)), p_c = (a−c) R / (P_a (b−c)), n = −(a−b)/(b−c);
-    LAM ν² = Q (a−b), p = P_a (b−c) / ((a−b) Q), p_c = −(a−c) R / ((a−b) Q), n = −P_a / Q;
-    κ = (a−c) G / ν in both modes.
-    """
-    abh, abl, bch, bcl, ach, acl, ch, cl = inertia_dd
-    x2h, x2l = two_prod(mx, mx)
-    y2h, y2l = two_prod(my, my)
-    z2h, z2l = two_prod(mz, mz)
-    pah, pal = _dd_lin(abh, abl, y2h, y2l, ach, acl, z2h, z2l)
-    qh, ql = _dd_lin(ach, acl, x2h, x2l, bch, bcl, y2h, y2l)
-    rh, rl = _dd_lin(bch, bcl, z2h, z2l, -abh, -abl, x2h, x2l)
-    g2h, g2l = dd_add(x2h, x2l, y2h, y2l)
-    g2h, g2l = dd_add(g2h, g2l, z2h, z2l)
-    gh, gl = dd_sqrt(g2h, g2l)
-    if mode == MODE_SAM:
-        denh, denl = dd_mul(pah, pal, bch, bcl)
-        nu2h, nu2l = denh, denl
-        ah_, al_ = dd_mul(ach, acl, rh, rl)
-        fh, fl = dd_div(abh, abl, bch, bcl)
-        numh, numl = dd_mul(abh, abl, qh, ql)
-    else:
-        denh, denl = dd_mul(abh, abl, qh, ql)
-        nu2h, nu2l = denh, denl
-        ah_, al_ = dd_mul(-ach, -acl, rh, rl)
-        fh, fl = dd_div(pah, pal, qh, ql)
-        numh, numl = dd_mul(pah, pal, bch, bcl)
-    pch, pcl = dd_div(ah_, al_, denh, denl)
-    param = dd_div(numh, numl, denh, denl)[0]
-    nuh, nul = dd_sqrt(nu2h, nu2l)
-    cgh, cgl = dd_mul(ch, cl, gh, gl)
-    # κ = (a−c) G / ν
-    kah, kal = dd_mul(ach, acl, gh, gl)
-    kah, kal = dd_div(kah, kal, nuh, nul)
-    return nuh, nul, cgh, cgl, kah, kal, fh, fl, pch, pcl, param
 
 
 @jit
@@ -397,7 +192,68 @@ def flow_constants_shared(flow, quaternion, momentum, big_a, big_b, big_c, ic, i
 def flow_constants_buffers(flow, mo, quaternion, momentum, big_a, big_b, big_c, ic, inertia_dd):
     """:func:`flow_constants_shared` into a caller's (MO_SIZE,) motion-constants array too; returns
     (mk, pk). One buffer for a loop's states: the allocation cost ≈ 20 ns of each set-up.
+
+    The set-up in three parts: :func:`set_up_start` up to the two R_F and the AGM, the integrals
+    (:func:`integrals_of_state`), :func:`set_up_finish` after them. :mod:`.flow_blocks` runs the
+    middle part for eight states at once between the same two ends.
     """
+    staged = set_up_start(flow, mo, quaternion, momentum, big_a, big_b, big_c, ic, inertia_dd)
+    if staged[ST_KIND] == KIND_UNIFORM:
+        return elliptic_constants(mo)  # unused by a uniform rotation; returned for one signature
+    return set_up_finish(flow, mo, quaternion, momentum, ic, staged, integrals_of_state(staged))
+
+
+# What set_up_start hands to the integrals and to set_up_finish (a tuple of floats, so that
+# .flow_blocks can keep eight of them in an array across the integrals of all eight).
+(
+    ST_KIND,  # KIND_* below
+    ST_MX,  # working-frame momentum (the flip applied)
+    ST_MY,
+    ST_MZ,
+    ST_F_HI,  # f = −n and p_c as double-doubles, p as a double (phase_constants_dd)
+    ST_F_LO,
+    ST_PC_HI,
+    ST_PC_LO,
+    ST_PARAM,
+    ST_AMPLITUDE_J,  # the amplitude at t = 0: whole turns of π, sin and cos of the rest
+    ST_AMPLITUDE_SIN,
+    ST_AMPLITUDE_COS,
+    ST_POLE_PREFACTOR,  # the pole of pn's integrand: prefactor · R_F(x, y, z), and which form
+    ST_POLE_X,
+    ST_POLE_Y,
+    ST_POLE_Z,
+    ST_POLE_NEAR,
+) = range(17)
+STAGE_SIZE = 17
+# KIND_PERIODIC needs both R_F and the AGM; KIND_AGM_ONLY (p_c > 0 in double-double but the motion's
+# rounded p_c is 0) only the AGM; KIND_SEPARATRIX neither; KIND_UNIFORM is complete after the start.
+KIND_UNIFORM, KIND_PERIODIC, KIND_AGM_ONLY, KIND_SEPARATRIX = 0.0, 1.0, 2.0, 3.0
+# The integrals' results: (R_F of the amplitude, R_F of the pole, K_hi, K_lo, Π_hi, Π_lo)
+INTEGRALS_SIZE = 6
+
+
+@jit(inline=INLINE)
+def set_up_start(flow, mo, quaternion, momentum, big_a, big_b, big_c, ic, inertia_dd):
+    """The set-up up to its integrals: the flow slots known before them, and the ``ST_*`` tuple.
+
+    :func:`set_up_motion`, the phase constants (:func:`.phase_constants.phase_constants_dd`), then
+    :func:`set_up_phase`; :mod:`.flow_blocks` forms the phase constants of eight states at once between them.
+    """
+    mode, mx, my, mz = set_up_motion(flow, mo, quaternion, momentum, big_a, big_b, big_c, ic)
+    if mode == MODE_UNIFORM:
+        return UNIFORM_STAGE
+    phase = phase_constants_dd(mode, mx, my, mz, inertia_dd)
+    return set_up_phase(flow, mo, mode, mx, my, mz, phase, ic)
+
+
+# set_up_start's tuple for a uniform rotation: its flow constants are complete
+UNIFORM_STAGE = (KIND_UNIFORM, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+@jit(inline=INLINE)
+def set_up_motion(flow, mo, quaternion, momentum, big_a, big_b, big_c, ic):
+    """Mode, flip and motion constants into flow and mo (a uniform rotation's constants complete);
+    returns (mode, working-frame M_x, M_y, M_z)."""
     m0x, m0y, m0z = momentum[0], momentum[1], momentum[2]
     flip = motion_from_momentum_into(mo, m0x, m0y, m0z, ic)
     flow[:] = 0.0
@@ -408,37 +264,76 @@ def flow_constants_buffers(flow, mo, quaternion, momentum, big_a, big_b, big_c, 
     flow[FL_FLIP_X], flow[FL_FLIP_Y], flow[FL_FLIP_Z] = fx, fy, fz
     flow[FL_M0_X], flow[FL_M0_Y], flow[FL_M0_Z] = m0x, m0y, m0z
     if mode == MODE_UNIFORM:
-        # Permanent rotation: ω = I⁻¹M ∥ M, q(t) = q0 ⊗ (cos(|ω|t/2), k sin(|ω|t/2)), k = ω/|ω|.
-        # |ω|/2 in double-double, so the half angle does not drift either.
-        oxh, oxl = dd_div(m0x, 0.0, big_a, 0.0)
-        oyh, oyl = dd_div(m0y, 0.0, big_b, 0.0)
-        ozh, ozl = dd_div(m0z, 0.0, big_c, 0.0)
-        xxh, xxl = dd_mul(oxh, oxl, oxh, oxl)
-        yyh, yyl = dd_mul(oyh, oyl, oyh, oyl)
-        zzh, zzl = dd_mul(ozh, ozl, ozh, ozl)
-        sqh, sql = dd_add(xxh, xxl, yyh, yyl)
-        sqh, sql = dd_add(sqh, sql, zzh, zzl)
-        rh, rl = dd_sqrt(sqh, sql)
-        flow[FL_RATE_HI], flow[FL_RATE_LO] = 0.5 * rh, 0.5 * rl
-        if rh > 0.0:
-            flow[FL_AXIS_X], flow[FL_AXIS_Y], flow[FL_AXIS_Z] = oxh / rh, oyh / rh, ozh / rh
-        flow[FL_QN_W], flow[FL_QN_X] = quaternion[0], quaternion[1]
-        flow[FL_QN_Y], flow[FL_QN_Z] = quaternion[2], quaternion[3]
-        mk, pk = elliptic_constants(mo)  # unused by a uniform rotation; returned for one signature
-        return mk, pk
-    mx, my, mz = fx * m0x, fy * m0y, fz * m0z
-    nuh, nul, cgh, cgl, kah, kal, fh, fl, pch, pcl, param = phase_constants_dd(mode, mx, my, mz, inertia_dd)
-    periodic = pch > 0.0 and mo[MO_PARAM_C] > 0.0
-    if periodic:
-        # The two R_F of the set-up need no K: the amplitude's F (the start of the argument) and the
-        # distance of pn's pole (the nome series). They run as one pair, issued before the AGM, so
-        # their latencies overlap instead of adding up.
-        j0_am, s_am, c_am = _amplitude_of_momentum(mx, my, mz, mode, ic)
-        pre, x, y, z, near = pole_integral(fh, param)
-        rf_am, rf_pole = rf_pair(c_am * c_am, c_am * c_am + pch * (s_am * s_am), 1.0, x, y, z)
+        _uniform_rotation_constants(flow, quaternion, m0x, m0y, m0z, big_a, big_b, big_c)
+    return mode, fx * m0x, fy * m0y, fz * m0z
+
+
+@jit(inline=INLINE)
+def set_up_phase(flow, mo, mode, mx, my, mz, phase, ic):
+    """The phase constants (:func:`.phase_constants.phase_constants_dd`'s tuple) into flow, the kind of
+    the motion, and what its integrals need: the ``ST_*`` tuple of :func:`set_up_start`."""
+    nuh, nul, cgh, cgl, kah, kal, fh, fl, pch, pcl, param = phase
+    flow[FL_RATE_HI], flow[FL_RATE_LO] = nuh, nul
+    flow[FL_G_RATE_HI], flow[FL_G_RATE_LO] = cgh, cgl
+    flow[FL_KAPPA_HI], flow[FL_KAPPA_LO] = kah, kal
+    if not pch > 0.0:
+        return (KIND_SEPARATRIX, mx, my, mz, fh, fl, pch, pcl, param, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    if not mo[MO_PARAM_C] > 0.0:  # p_c > 0 in double-double: the period, even where p_c rounds to 0
+        return (KIND_AGM_ONLY, mx, my, mz, fh, fl, pch, pcl, param, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    # The two R_F of the set-up need no K: the amplitude's F (the start of the argument) and the
+    # distance of pn's pole (the nome series). They run as one pair, issued before the AGM, so their
+    # latencies overlap instead of adding up.
+    j0_am, s_am, c_am = _amplitude_of_momentum(mx, my, mz, mode, ic)
+    pre, x, y, z, near = pole_integral(fh, param)
+    return (KIND_PERIODIC, mx, my, mz, fh, fl, pch, pcl, param, j0_am, s_am, c_am, pre, x, y, z,
+            1.0 if near else 0.0)
+
+
+@jit(inline=INLINE)
+def integrals_of_state(staged):
+    """(R_F of the amplitude, R_F of the pole, K_hi, K_lo, Π_hi, Π_lo) of one state, where its kind needs them."""
+    rf_am, rf_pole, kh, kl, pih, pil = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    kind = staged[ST_KIND]
+    if kind == KIND_PERIODIC:
+        c, s = staged[ST_AMPLITUDE_COS], staged[ST_AMPLITUDE_SIN]
+        rf_am, rf_pole = rf_pair(c * c, c * c + staged[ST_PC_HI] * (s * s), 1.0,
+                                 staged[ST_POLE_X], staged[ST_POLE_Y], staged[ST_POLE_Z])
+    if kind == KIND_PERIODIC or kind == KIND_AGM_ONLY:
+        kh, kl, pih, pil = complete_k_pi_dd(staged[ST_F_HI], staged[ST_F_LO], staged[ST_PC_HI], staged[ST_PC_LO])
+    return rf_am, rf_pole, kh, kl, pih, pil
+
+
+@jit(inline=INLINE)
+def _uniform_rotation_constants(flow, quaternion, m0x, m0y, m0z, big_a, big_b, big_c):
+    """Permanent rotation: ω = I⁻¹M ∥ M, q(t) = q0 ⊗ (cos(|ω|t/2), k sin(|ω|t/2)), k = ω/|ω|, with
+    |ω|/2 in double-double, so the half angle does not drift either."""
+    oxh, oxl = dd_div(m0x, 0.0, big_a, 0.0)
+    oyh, oyl = dd_div(m0y, 0.0, big_b, 0.0)
+    ozh, ozl = dd_div(m0z, 0.0, big_c, 0.0)
+    xxh, xxl = dd_mul(oxh, oxl, oxh, oxl)
+    yyh, yyl = dd_mul(oyh, oyl, oyh, oyl)
+    zzh, zzl = dd_mul(ozh, ozl, ozh, ozl)
+    sqh, sql = dd_add(xxh, xxl, yyh, yyl)
+    sqh, sql = dd_add(sqh, sql, zzh, zzl)
+    rh, rl = dd_sqrt(sqh, sql)
+    flow[FL_RATE_HI], flow[FL_RATE_LO] = 0.5 * rh, 0.5 * rl
+    if rh > 0.0:
+        flow[FL_AXIS_X], flow[FL_AXIS_Y], flow[FL_AXIS_Z] = oxh / rh, oyh / rh, ozh / rh
+    flow[FL_QN_W], flow[FL_QN_X] = quaternion[0], quaternion[1]
+    flow[FL_QN_Y], flow[FL_QN_Z] = quaternion[2], quaternion[3]
+
+
+@jit(inline=INLINE)
+def set_up_finish(flow, mo, quaternion, momentum, ic, staged, integrals):
+    """The set-up after its integrals (``integrals``: :func:`integrals_of_state`'s tuple); returns (mk, pk)."""
+    kind = staged[ST_KIND]
+    mx, my, mz = staged[ST_MX], staged[ST_MY], staged[ST_MZ]
+    fh, pch, param = staged[ST_F_HI], staged[ST_PC_HI], staged[ST_PARAM]
+    kah, kal = flow[FL_KAPPA_HI], flow[FL_KAPPA_LO]
+    rf_am, rf_pole, kh, kl, pih, pil = integrals
+    periodic = kind == KIND_PERIODIC
     perh, perl, wh, wl = math.inf, 0.0, 0.0, 0.0
-    if pch > 0.0:  # the double-double p_c: off the separatrix (the period, even where p_c rounds to 0)
-        kh, kl, pih, pil = complete_k_pi_dd(fh, fl, pch, pcl)
+    if periodic or kind == KIND_AGM_ONLY:
         perh, perl = 2.0 * kh, 2.0 * kl
         wh, wl = dd_mul(kah, kal, 2.0 * pih, 2.0 * pil)
     if periodic:
@@ -447,22 +342,20 @@ def flow_constants_buffers(flow, mo, quaternion, momentum, big_a, big_b, big_c, 
         # compensated AGM above instead of a second AGM and a Carlson R_J per state
         mk = parameter_constants_with_k(param, pch, kh, kl)
         pk = characteristic_constants_with_complete(-fh, param, pih + pil)
-        arg0 = _argument_from_amplitude(j0_am, s_am, rf_am, kh, kl)
+        arg0 = _argument_from_amplitude(staged[ST_AMPLITUDE_J], staged[ST_AMPLITUDE_SIN], rf_am, kh, kl)
     else:  # the separatrix: the kernels' closed forms, from the motion constants
         mk, pk = elliptic_constants(mo)
         # m_c = 0: F = atanh(sin am) in Carlson's form, ±inf past ±π/2 (ellipf_k's cases)
         arg0 = ellipf_k(amplitude_from_momentum(mx, my, mz, mo, ic), mk)
-    g0, qn = _node_of_state(quaternion, m0x, m0y, m0z, fx, fy, fz, mx, my)
+    m0x, m0y, m0z = momentum[0], momentum[1], momentum[2]
+    g0, qn = _node_of_state(quaternion, m0x, m0y, m0z, flow[FL_FLIP_X], flow[FL_FLIP_Y], flow[FL_FLIP_Z], mx, my)
     flow[FL_QN_W], flow[FL_QN_X], flow[FL_QN_Y], flow[FL_QN_Z] = qn
     flow[FL_ARG0] = arg0
     flow[FL_PERIODIC] = 1.0 if periodic else 0.0
-    flow[FL_RATE_HI], flow[FL_RATE_LO] = nuh, nul
     flow[FL_PERIOD_HI], flow[FL_PERIOD_LO] = perh, perl
-    flow[FL_G_RATE_HI], flow[FL_G_RATE_LO] = cgh, cgl
     flow[FL_G_ADVANCE_HI], flow[FL_G_ADVANCE_LO] = wh, wl
-    flow[FL_KAPPA_HI], flow[FL_KAPPA_LO] = kah, kal
     if periodic:
-        _fourier_constants(flow, mk, pk, pre * rf_pole, near)
+        _fourier_constants(flow, mk, pk, staged[ST_POLE_PREFACTOR] * rf_pole, staged[ST_POLE_NEAR] > 0.0)
     # g0 − κ pn(arg0), with pn(arg0) = 2Π j0 + pn(r0) split as at every later time, so that the
     # large parts cancel exactly at t = 0 (κ pn is huge for nearly symmetric bodies)
     if periodic:

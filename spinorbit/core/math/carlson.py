@@ -9,6 +9,7 @@ series below ε, then sums that series. Choices and pitfalls: ``docs/elliptic.md
 import math
 
 from spinorbit.core.jit import jit
+from spinorbit.core.math.lanes import any_lane, select
 
 EPSILON = 2.0**-52
 # Carlson (1995) stopping constants: iterate until 4^-n Q < |A_n| with Q = C·max|A0 − arg|, i.e.
@@ -96,6 +97,27 @@ def rf_pair(x1, y1, z1, x2, y2, z2):
             _, _, _, _, x2, y2, z2 = _duplicate(x2, y2, z2)
             a2 = _rf_mean(x2, y2, z2)
             q2 *= 0.25
+    return _rf_series(x1, y1, z1, a1), _rf_series(x2, y2, z2, a2)
+
+
+@jit
+def rf_pair_lanes(x1, y1, z1, x2, y2, z2):
+    """:func:`rf_pair` of eight argument pairs (``Lanes``, :mod:`.lanes`), each lane bit for bit :func:`rf`.
+
+    Every lane duplicates until its own stop and then keeps its iterates (``select``) while the
+    others go on.
+    """
+    a1, q1 = _rf_start(x1, y1, z1)
+    a2, q2 = _rf_start(x2, y2, z2)
+    go1, go2 = q1 >= abs(a1), q2 >= abs(a2)
+    while any_lane(go1 | go2):
+        _, _, _, _, nx1, ny1, nz1 = _duplicate(x1, y1, z1)
+        x1, y1, z1 = select(go1, nx1, x1), select(go1, ny1, y1), select(go1, nz1, z1)
+        a1, q1 = select(go1, _rf_mean(x1, y1, z1), a1), select(go1, q1 * 0.25, q1)
+        _, _, _, _, nx2, ny2, nz2 = _duplicate(x2, y2, z2)
+        x2, y2, z2 = select(go2, nx2, x2), select(go2, ny2, y2), select(go2, nz2, z2)
+        a2, q2 = select(go2, _rf_mean(x2, y2, z2), a2), select(go2, q2 * 0.25, q2)
+        go1, go2 = q1 >= abs(a1), q2 >= abs(a2)
     return _rf_series(x1, y1, z1, a1), _rf_series(x2, y2, z2, a2)
 
 

@@ -92,7 +92,7 @@ def characteristic_constants_with_complete(n, m, complete):
     """:func:`characteristic_constants` for 0 ≤ m < 1 with Π(n|m) already known.
 
     For callers that hold Π from their own (compensated) AGM (the flow set-up,
-    :func:`spinorbit.core.free_motion.flow_constants.complete_k_pi_dd`), so the complete integral is
+    :func:`spinorbit.core.math.complete_agm.complete_k_pi_dd`), so the complete integral is
     not formed a second time in Carlson's form.
     """
     method, f, g = _characteristic_method(n, m)
@@ -278,7 +278,7 @@ AGM_MAX_STEPS_DOUBLE = 200
 def complete_k_pi(f, mc):
     """K(m) and Π(n | m) for n = −f ≤ 0, 0 < mc = 1 − m ≤ 1, in double precision from one AGM.
 
-    The algorithm of :func:`spinorbit.core.free_motion.flow_constants.complete_k_pi_dd` (DLMF 19.8.5,
+    The algorithm of :func:`spinorbit.core.math.complete_agm.complete_k_pi_dd` (DLMF 19.8.5,
     19.8.6–8, written as sums of positive terms so nothing cancels for f → ∞), in doubles: for callers
     that need the two complete integrals as doubles (the periods of :mod:`spinorbit.core.free_motion.summary`),
     at a fraction of the double-double's cost and of Carlson's R_F and R_J. Relative error a few ε

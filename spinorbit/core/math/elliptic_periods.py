@@ -109,7 +109,7 @@ def parameter_constants_with_k(m, mc, k_hi, k_lo):
     """:func:`parameter_constants` for 0 ≤ m < 1 with K(m) already known as a double-double.
 
     For callers that hold K from their own (compensated) AGM (the flow set-up forms K from the
-    exact inputs, :func:`spinorbit.core.free_motion.flow_constants.complete_k_pi_dd`), so the AGM
+    exact inputs, :func:`spinorbit.core.math.complete_agm.complete_k_pi_dd`), so the AGM
     is not run twice per state.
     """
     return _constants_with_quarter_period(m, mc, m, mc, 1.0, k_hi, k_lo)

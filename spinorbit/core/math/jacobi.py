@@ -10,6 +10,7 @@ come from a Maclaurin series and the duplication formulas, written so that nothi
 import math
 
 from spinorbit.core.jit import jit
+from spinorbit.core.math.ddouble import parity
 from spinorbit.core.math.elliptic_periods import (
     MK_HEAD,
     MK_K_HI,
@@ -151,7 +152,7 @@ def sncndn_k(u, mk):
         sech = 1.0 / math.cosh(u)
         return math.tanh(u), sech, sech
     j, r = reduce_by_period(u, mk[MK_HEAD], mk[MK_TAIL])
-    sign = 1.0 - 2.0 * (abs(j) % 2.0)
+    sign = 1.0 - 2.0 * parity(j)
     if mc > 0.0:
         s, c, d = sncndn_reduced(r, mk[MK_M], mc, mk[MK_SQRT_MUC], mk[MK_K_HI], mk[MK_K_LO])
         return sign * s, sign * c, d

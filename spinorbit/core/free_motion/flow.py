@@ -145,7 +145,8 @@ __all__ = [
     "FL_G_RATE_LO", "FL_KAPPA_HI", "FL_KAPPA_LO", "FL_M0_X", "FL_M0_Y", "FL_M0_Z", "FL_MODE",
     "FL_PERIODIC", "FL_PERIOD_HI", "FL_PERIOD_LO", "FL_QN_W", "FL_QN_X", "FL_QN_Y", "FL_QN_Z",
     "FL_RATE_HI", "FL_RATE_LO", "evaluate_flow", "flow_constants", "flow_state", "propagate_many_into",
-    "torque_free_attitudes", "torque_free_states", "torque_free_states_many", "uniform_rotation",
+    "propagate_state_into", "torque_free_attitudes", "torque_free_states", "torque_free_states_many",
+    "uniform_rotation",
 ]
 
 
@@ -281,15 +282,20 @@ def propagate_many_into(quaternions, momenta, moments, times, q_out, m_out, clos
         for block in range(count + 1):
             first, last = (pending[block], pending[block] + BLOCK) if block < count else (whole, stop)
             for i in range(first, last):
-                _propagate_state(quaternions, momenta, times, q_out, m_out, i, a, b, c, closed_forms, flows[0],
+                propagate_state_into(quaternions, momenta, times, q_out, m_out, i, a, b, c, closed_forms, flows[0],
                                  mos[0], ic, inertia_dd)
         start = stop
 
 
 @jit(inline=INLINE)
-def _propagate_state(quaternions, momenta, times, q_out, m_out, i, a, b, c, closed_forms, flow, mo, ic, inertia_dd):
-    """State i (moments a ≤ b ≤ c) at every time, by itself: no rotation, the regular precession, or
-    the elliptic flow."""
+def propagate_state_into(quaternions, momenta, times, q_out, m_out, i, a, b, c, closed_forms, flow, mo, ic, inertia_dd):
+    """Kernel: state i (moments a ≤ b ≤ c) at every time into q_out[i], m_out[i], by itself: no
+    rotation, the regular precession, or the elliptic flow.
+
+    ``flow``, ``mo``: (FLOW_SIZE,) and (MO_SIZE,) buffers; ``ic, inertia_dd``: the body's
+    :func:`.phase_constants.moment_constants`. For callers whose states each have their own body
+    (:func:`.members.free_flow_each`), which gain nothing from :func:`propagate_many_into`'s blocks.
+    """
     if momenta[i, 0] == 0.0 and momenta[i, 1] == 0.0 and momenta[i, 2] == 0.0:
         for k in range(times.shape[0]):  # no rotation at all
             q_out[i, k, :] = quaternions[i]

@@ -5,8 +5,8 @@ An ensemble of torque-free members (``spinorbit.ensemble.free``) differs from
 output times (members need not share an epoch), and the outcome also needs the constants of each
 motion (mode, E/E0, P_ψ, P_φ, sidereal period, :func:`.summary.motion_summary`). One compiled loop
 each, with no Python per member: :func:`motion_summary_each` for the constants of the member's
-initial momentum, :func:`free_flow_each` for the flow, which is :func:`.flow.propagate_many_into`
-on the member's one-row views (the same set-up and evaluation as every other caller of the flow).
+initial momentum, :func:`free_flow_each` for the flow, which is :func:`.flow.propagate_state_into`
+on the member's row (the same set-up and evaluation as every other caller of the flow).
 
 A member's numbers depend on its own inputs only (nothing is shared across the loop), so a member
 evaluated alone and in any batch gives the same bits (``tests/test_ensemble_free.py``).
@@ -14,7 +14,9 @@ evaluated alone and in any batch gives the same bits (``tests/test_ensemble_free
 
 import numpy as np
 
-from spinorbit.core.free_motion.flow import propagate_many_into
+from spinorbit.core.elements.canonical import MO_SIZE
+from spinorbit.core.free_motion.flow import FLOW_SIZE, propagate_state_into
+from spinorbit.core.free_motion.phase_constants import moment_constants
 from spinorbit.core.free_motion.summary import motion_summary
 from spinorbit.core.jit import jit
 
@@ -46,9 +48,11 @@ def free_flow_each(quaternions, momenta, moments, elapsed, q_out, m_out):
     q_out, m_out : (N, K, 4), (N, K, 3) float64
         Attitudes and body momenta at those times (paper eq. 12).
     """
+    flow, mo = np.empty(FLOW_SIZE), np.empty(MO_SIZE)
     for i in range(quaternions.shape[0]):
-        propagate_many_into(quaternions[i:i + 1], momenta[i:i + 1], moments[i:i + 1], elapsed[i],
-                            q_out[i:i + 1], m_out[i:i + 1], True)
+        a, b, c = moments[i, 0], moments[i, 1], moments[i, 2]
+        ic, inertia_dd = moment_constants(a, b, c)
+        propagate_state_into(quaternions, momenta, elapsed[i], q_out, m_out, i, a, b, c, True, flow, mo, ic, inertia_dd)
 
 
 def free_members(quaternions, momenta, moments, elapsed=None):

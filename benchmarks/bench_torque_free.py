@@ -20,6 +20,9 @@ from __future__ import annotations
 import os
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")  # one core; the kernels are serial loops anyway
+# CPU time (process_time) counts every thread of the process: OpenBLAS's idle workers, woken by any
+# numpy linear algebra in the script, spin for a while and were ≈ 4 % of a timing (perf, 2026-12-04)
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import math  # noqa: E402
 import sys  # noqa: E402
@@ -134,20 +137,27 @@ def closed_form_section(write=True):
 # ------------------------------------------------------------------ where one time per state goes
 
 def _floor_kernels():
-    """Kernels timing the set-up's pieces one at a time over many states (compiled here, not cached:
-    they measure, they are not part of the package). Each returns a sum so that nothing is optimised away."""
+    """Kernels timing the one-time-per-state work piece by piece over many states, each piece in its
+    scalar form (one state at a time) and, where the package runs it so, in lanes (eight states in one
+    register, :mod:`spinorbit.core.free_motion.flow_blocks`). Compiled here, not cached: they measure,
+    they are not part of the package. Each returns a sum so that nothing is optimised away."""
     from spinorbit.core.elements.canonical import (
-        MO_MODE, MO_SIZE, amplitude_from_momentum, flip_signs, motion_from_momentum_into)
-    from spinorbit.core.free_motion.flow_constants import (
-        FLOW_SIZE, complete_k_pi_dd, flow_constants_buffers, moment_constants, phase_constants_dd)
-    from spinorbit.core.free_motion.flow import flow_state
+        MO_MODE, MO_SIZE, MODE_SAM, amplitude_from_momentum, flip_signs, motion_from_momentum_into)
+    from spinorbit.core.free_motion.flow import flow_state, propagate_many_into
+    from spinorbit.core.free_motion.flow_blocks import (
+        BLOCK, INTEGRALS_SIZE, STAGE_SIZE, finish_lane, integrals_of_block, set_up_block_start)
+    from spinorbit.core.free_motion.flow_constants import FLOW_SIZE, flow_constants_buffers
+    from spinorbit.core.free_motion.phase_constants import moment_constants, phase_constants_dd, phase_constants_lanes
     from spinorbit.core.jit import jit
-    from spinorbit.core.math.carlson import rf, rf_pair
+    from spinorbit.core.math.carlson import rf, rf_pair, rf_pair_lanes
+    from spinorbit.core.math.complete_agm import complete_k_pi_dd, complete_k_pi_lanes
+    from spinorbit.core.math.lanes import broadcast, load_lanes, store_lanes
     from spinorbit.core.math.pn_fourier import pn_fourier_coefficients_at, pole_integral, sine_series
 
     @jit(cache=False)
     def inputs(momenta, a, b, c):
-        """Per state: mode, flipped momentum, phase constants, amplitude's sin/cos, the pole's R_F arguments."""
+        """Per state (rows of the transpose): mode, flipped momentum, phase constants, amplitude's sin/cos,
+        the pole's R_F arguments, κ, K, the pole's distance."""
         n = momenta.shape[0]
         out = np.empty((n, 19))
         mo = np.empty(MO_SIZE)
@@ -162,10 +172,10 @@ def _floor_kernels():
             kh = complete_k_pi_dd(fh, fl, pch, pcl)[0]
             out[i] = (mode, mx, my, mz, fh, fl, pch, pcl, param, math.sin(am), math.cos(am), pre, x, y, z,
                       1.0 if near else 0.0, kah, kh, pre * rf(x, y, z))
-        return out
+        return np.ascontiguousarray(out.T)
 
     @jit(cache=False)
-    def whole(quaternions, momenta, a, b, c, t):
+    def whole_scalar(quaternions, momenta, a, b, c, t):
         flow, mo = np.empty(FLOW_SIZE), np.empty(MO_SIZE)
         ic, inertia_dd = moment_constants(a, b, c)
         acc = 0.0
@@ -176,13 +186,29 @@ def _floor_kernels():
         return acc
 
     @jit(cache=False)
-    def set_up(quaternions, momenta, a, b, c):
+    def set_up_scalar(quaternions, momenta, a, b, c):
         flow, mo = np.empty(FLOW_SIZE), np.empty(MO_SIZE)
         ic, inertia_dd = moment_constants(a, b, c)
         acc = 0.0
         for i in range(quaternions.shape[0]):
             flow_constants_buffers(flow, mo, quaternions[i], momenta[i], a, b, c, ic, inertia_dd)
             acc += flow[0] + flow[5] + flow[10]
+        return acc
+
+    @jit(cache=False)
+    def set_up_blocks(quaternions, momenta, a, b, c):
+        flows, mos = np.empty((BLOCK, FLOW_SIZE)), np.empty((BLOCK, MO_SIZE))
+        stages, integrals = np.empty((STAGE_SIZE, BLOCK)), np.empty((INTEGRALS_SIZE, BLOCK))
+        motions = np.empty((4, BLOCK))
+        ic, inertia_dd = moment_constants(a, b, c)
+        acc = 0.0
+        for first in range(0, quaternions.shape[0] - BLOCK + 1, BLOCK):
+            periodic = set_up_block_start(flows, mos, stages, motions, quaternions, momenta, first, a, b, c, ic,
+                                          inertia_dd)
+            integrals_of_block(stages, integrals, periodic)
+            for lane in range(BLOCK):
+                finish_lane(flows, mos, stages, integrals, lane, quaternions[first + lane], momenta[first + lane], ic)
+                acc += flows[lane, 0] + flows[lane, 5] + flows[lane, 10]
         return acc
 
     @jit(cache=False)
@@ -198,77 +224,137 @@ def _floor_kernels():
     def phase(x, a, b, c):
         _, inertia_dd = moment_constants(a, b, c)
         acc = 0.0
-        for i in range(x.shape[0]):
-            r = phase_constants_dd(int(x[i, 0]), x[i, 1], x[i, 2], x[i, 3], inertia_dd)
+        for i in range(x.shape[1]):
+            r = phase_constants_dd(int(x[0, i]), x[1, i], x[2, i], x[3, i], inertia_dd)
             acc += r[0] + r[4] + r[6] + r[10]
         return acc
 
     @jit(cache=False)
+    def lane_sum(values):
+        sink = np.empty(BLOCK)
+        store_lanes(sink, 0, values)
+        return sink.sum()
+
+    @jit(cache=False)
+    def phase_lanes(x, a, b, c):
+        _, inertia_dd = moment_constants(a, b, c)
+        acc = broadcast(0.0)
+        for i in range(0, x.shape[1] - BLOCK + 1, BLOCK):
+            r = phase_constants_lanes(load_lanes(x[0], i) == MODE_SAM, load_lanes(x[1], i), load_lanes(x[2], i),
+                                      load_lanes(x[3], i), inertia_dd)
+            acc = acc + r[0] + r[4] + r[6] + r[10]
+        return lane_sum(acc)
+
+    @jit(cache=False)
     def integrals(x):
         acc = 0.0
-        for i in range(x.shape[0]):
-            s, c = x[i, 9], x[i, 10]
-            f1, f2 = rf_pair(c * c, c * c + x[i, 6] * (s * s), 1.0, x[i, 12], x[i, 13], x[i, 14])
+        for i in range(x.shape[1]):
+            s, c = x[9, i], x[10, i]
+            f1, f2 = rf_pair(c * c, c * c + x[6, i] * (s * s), 1.0, x[12, i], x[13, i], x[14, i])
             acc += f1 + f2
         return acc
 
     @jit(cache=False)
+    def integrals_lanes(x):
+        acc = broadcast(0.0)
+        for i in range(0, x.shape[1] - BLOCK + 1, BLOCK):
+            s, c = load_lanes(x[9], i), load_lanes(x[10], i)
+            f1, f2 = rf_pair_lanes(c * c, c * c + load_lanes(x[6], i) * (s * s), broadcast(1.0), load_lanes(x[12], i),
+                                   load_lanes(x[13], i), load_lanes(x[14], i))
+            acc = acc + f1 + f2
+        return lane_sum(acc)
+
+    @jit(cache=False)
     def agm(x):
         acc = 0.0
-        for i in range(x.shape[0]):
-            kh, _, pih, _ = complete_k_pi_dd(x[i, 4], x[i, 5], x[i, 6], x[i, 7])
+        for i in range(x.shape[1]):
+            kh, _, pih, _ = complete_k_pi_dd(x[4, i], x[5, i], x[6, i], x[7, i])
             acc += kh + pih
         return acc
 
     @jit(cache=False)
+    def agm_lanes(x):
+        acc = broadcast(0.0)
+        for i in range(0, x.shape[1] - BLOCK + 1, BLOCK):
+            kh, _, pih, _ = complete_k_pi_lanes(load_lanes(x[4], i), load_lanes(x[5], i), load_lanes(x[6], i),
+                                                load_lanes(x[7], i))
+            acc = acc + kh + pih
+        return lane_sum(acc)
+
+    @jit(cache=False)
     def series(x, out):
         acc = 0.0
-        for i in range(x.shape[0]):
-            terms = pn_fourier_coefficients_at(x[i, 4], x[i, 8], x[i, 17], x[i, 16], x[i, 18], x[i, 15] > 0.0, out)
+        for i in range(x.shape[1]):
+            terms = pn_fourier_coefficients_at(x[4, i], x[8, i], x[17, i], x[16, i], x[18, i], x[15, i] > 0.0, out)
             acc += sine_series(0.3 + 1e-6 * i, out, 0, terms) + terms
         return acc
 
-    return inputs, whole, set_up, motion, phase, integrals, agm, series
+    def kernel(quaternions, momenta, moments, t, q_out, m_out):
+        propagate_many_into(quaternions, momenta, moments, t, q_out, m_out, True)
+
+    return dict(inputs=inputs, whole_scalar=whole_scalar, set_up_scalar=set_up_scalar, set_up_blocks=set_up_blocks,
+                motion=motion, phase=phase, phase_lanes=phase_lanes, integrals=integrals,
+                integrals_lanes=integrals_lanes, agm=agm, agm_lanes=agm_lanes, series=series, kernel=kernel)
 
 
 def one_time_floor(quaternions, momenta, t, repeats=7):
-    """CPU ns per state of the one-time-per-state kernel and of its set-up's pieces (interleaved medians)."""
-    inputs, whole, set_up, motion, phase, integrals, agm, series = _floor_kernels()
-    x = inputs(momenta, *MOMENTS)
+    """CPU ns per state of the one-time-per-state kernel and of its pieces, scalar and in lanes
+    (interleaved medians): {name: (scalar, lanes or None)}."""
+    k = _floor_kernels()
+    x = k["inputs"](momenta, *MOMENTS)
     out = np.empty(128)
+    n = len(momenta)
+    moments = np.ascontiguousarray(np.broadcast_to(np.array(MOMENTS), (n, 3)))
+    times = np.array([t])
+    q_out, m_out = np.empty((n, 1, 4)), np.empty((n, 1, 3))
     jobs = {
-        "one time per state (set-up + one evaluation)": lambda: whole(quaternions, momenta, *MOMENTS, t),
-        "the set-up alone (`flow_constants_buffers`)": lambda: set_up(quaternions, momenta, *MOMENTS),
-        "motion constants from the momentum (mode, flip, energy differences)": lambda: motion(momenta, *MOMENTS),
-        "phase constants in double-double (rates, κ, n, p, p_c)": lambda: phase(x, *MOMENTS),
-        "the two R_F (the amplitude's F, pn's pole), paired": lambda: integrals(x),
-        "the compensated AGM (K and Π in double-double)": lambda: agm(x),
-        "pn's nome series: its coefficients and one sum": lambda: series(x, out),
+        "the kernel (`propagate_many_into`: set-up + one evaluation + stores)": (
+            None, lambda: k["kernel"](quaternions, momenta, moments, times, q_out, m_out)),
+        "set-up + one evaluation, state by state": (lambda: k["whole_scalar"](quaternions, momenta, *MOMENTS, t), None),
+        "the set-up": (lambda: k["set_up_scalar"](quaternions, momenta, *MOMENTS),
+                       lambda: k["set_up_blocks"](quaternions, momenta, *MOMENTS)),
+        "motion constants from the momentum (mode, flip, energy differences)": (
+            lambda: k["motion"](momenta, *MOMENTS), None),
+        "phase constants in double-double (rates, κ, n, p, p_c)": (
+            lambda: k["phase"](x, *MOMENTS), lambda: k["phase_lanes"](x, *MOMENTS)),
+        "the two R_F (the amplitude's F, pn's pole), paired": (
+            lambda: k["integrals"](x), lambda: k["integrals_lanes"](x)),
+        "the compensated AGM (K and Π in double-double)": (lambda: k["agm"](x), lambda: k["agm_lanes"](x)),
+        "pn's nome series: its coefficients and one sum": (lambda: k["series"](x, out), None),
     }
-    timings, _ = interleaved_timings(list(jobs.values()), repeats, clock=time.process_time, warm_up=True)
-    return {name: timing.median / len(momenta) * 1e9 for name, timing in zip(jobs, timings)}
+    functions = [f for pair in jobs.values() for f in pair if f is not None]
+    timings, _ = interleaved_timings(functions, repeats, clock=time.process_time, warm_up=True)
+    per_state = iter(timing.median / n * 1e9 for timing in timings)
+    return {name: tuple(None if f is None else next(per_state) for f in pair) for name, pair in jobs.items()}
 
 
 def floor_text(floor, one_time_rate):
     names = list(floor)
-    whole, set_up = floor[names[0]], floor[names[1]]
-    pieces = sum(floor[name] for name in names[2:])
+    kernel = floor[names[0]][1]
+    whole_scalar = floor[names[1]][0]
+    set_up_scalar, set_up_lanes = floor[names[2]]
+    evaluation = whole_scalar - set_up_scalar
     budget = 1e9 / GOAL_ONE_TIME_STATES_PER_SECOND
-    lines = ["", "Where one time per state goes (CPU ns per state, the workload's states, each piece timed "
-             "alone in a loop of its own; medians of interleaved repeats):", "",
-             "| part | ns per state |", "|---|---:|"]
-    lines += [f"| {name} | {floor[name]:.0f} |" for name in names]
-    lines += [f"| one evaluation (the first row less the second) | {whole - set_up:.0f} |",
-              f"| the rest of the set-up (node frame, elliptic kernels' constants, remainders; the second row "
-              f"less the pieces) | {set_up - pieces:.0f} |", "",
-              f"The goal's budget is {budget:.0f} ns per state; the whole call measures "
-              f"{1e9 / one_time_rate:.0f} ns (the kernel above plus the Python wrapper's checks and the "
-              f"outputs' stores). With the evaluation and the wrapper as they are, the set-up would have to "
-              f"fall from {set_up:.0f} to {set_up - (1e9 / one_time_rate - budget):.0f} ns "
-              f"({100 * (1e9 / one_time_rate - budget) / set_up:.0f} % less), with no piece above "
-              f"{max(floor[name] for name in names[2:]):.0f} ns and each already in the form the earlier "
-              f"rounds found fastest (the two R_F paired, K and Π from one compensated AGM, the nome series' "
-              f"terms counted by the loop that forms them)."]
+    call = 1e9 / one_time_rate
+
+    def cell(value):
+        return "–" if value is None else f"{value:.0f}"
+
+    lines = ["", "Where one time per state goes (CPU ns per state over the workload's states; each piece timed "
+             "alone in a loop of its own, one state at a time and, where the package runs it so, eight states in "
+             "the lanes of one register (`spinorbit.core.free_motion.flow_blocks`); medians of interleaved "
+             "repeats):", "",
+             "| part | one state at a time | eight in lanes |", "|---|---:|---:|"]
+    lines += [f"| {name} | {cell(scalar)} | {cell(lanes)} |" for name, (scalar, lanes) in floor.items()]
+    lines += [f"| one evaluation (the second row less the third's first column) | {evaluation:.0f} | – |", "",
+              f"The goal's budget is {budget:.0f} ns per state; the whole call measures {call:.0f} ns, {kernel:.0f} ns "
+              f"of it in the kernel (the first row), the rest the Python wrapper's checks and the allocation of "
+              f"the outputs. In lanes the set-up costs "
+              f"{set_up_lanes:.0f} ns against {set_up_scalar:.0f} ns state by state: the phase constants, the two "
+              f"R_F and the AGM, whose divisions and square roots bound the scalar set-up, issue eight at a time "
+              f"(the same results bit for bit, `tests/test_lanes.py`). What stays scalar has branches by the "
+              f"state (the motion's mode and flip, the nome series' length, the node frame's atan2) or a "
+              f"library call per state (sin, cos, exp, atan2)."]
     return lines
 
 

@@ -501,14 +501,14 @@ def test_argument_from_momentum_equals_carlson_of_the_amplitude():
 
 
 def test_node_from_quaternion_equals_the_matrix_route():
-    """_node_of_state = node_angles_of on the flipped attitude matrix with l from sn, cn, dn at arg0."""
+    """node_of_state = node_angles_of on the flipped attitude matrix with l from sn, cn, dn at arg0."""
     from spinorbit.core.elements.canonical import (
         amplitude_from_momentum,
         body_from_argument,
         elliptic_constants,
         node_angles_of,
     )
-    from spinorbit.core.free_motion.flow_constants import _node_of_state, node_quaternion
+    from spinorbit.core.free_motion.node_frame import node_of_state, node_quaternion
     from spinorbit.core.math.elliptic_integrals import ellipf_k
     from spinorbit.core.math.rotations import quat_to_matrix
 
@@ -523,6 +523,6 @@ def test_node_from_quaternion_equals_the_matrix_route():
         _, _, _, sin_l, cos_l = body_from_argument(arg0, mo, mk)
         _, cos_i, sin_i, h, g0 = node_angles_of(matrix.T, mx, my, mz, sin_l, cos_l)
         reference = np.array(node_quaternion(cos_i, sin_i, math.sin(h), math.cos(h)))
-        value_g0, value_q = _node_of_state(q, m0[0], m0[1], m0[2], fx, fy, fz, mx, my)
+        value_g0, value_q = node_of_state(q, m0[0], m0[1], m0[2], fx, fy, fz, mx, my)
         assert abs(math.remainder(value_g0 - g0, 2.0 * math.pi)) <= SHORTCUT_TOLERANCE * 4.0, (m0, value_g0, g0)
         assert np.max(np.abs(np.array(value_q) - reference)) <= SHORTCUT_TOLERANCE, (m0, value_q, reference)

@@ -59,6 +59,7 @@ from spinorbit.core.jit import INLINE, jit
 from spinorbit.core.math.elliptic_integrals import ellipf_k, pn_constants, pn_k
 from spinorbit.core.math.elliptic_periods import parameter_constants
 from spinorbit.core.math.jacobi import sncndn_k
+from spinorbit.core.math.lanes import choose
 
 # Body-frame flips: the working frame is the body frame turned by π about one principal axis.
 FLIP_NONE, FLIP_A, FLIP_B, FLIP_C = 0, 1, 2, 3
@@ -169,36 +170,43 @@ def motion_constants_into(mo, mode, big_g, d_c, a_d, b_d, a, b, c, a_b, b_c, a_c
     mo[MO_G] = big_g
     if mode == MODE_UNIFORM:
         return mo
-    d = c + d_c if d_c < a_d else a - a_d  # from the smaller difference: fewer rounding errors
-    mo[MO_D] = d
-    sqrt_ad = math.sqrt(a * d)
-    mo[MO_S] = math.sqrt(d / a) * big_g
-    mo[MO_S_RATE] = sqrt_ad * big_g
-    mo[MO_G_PER_S] = c / sqrt_ad
-    mo[MO_X_AMP] = big_g * math.sqrt(d_c / a_c)
+    d, big_s, s_rate, g_per_s, x_amp, sqrt_ad = motion_shared_terms(big_g, d_c, a_d, a, c, a_c)
+    mo[MO_D], mo[MO_S], mo[MO_S_RATE], mo[MO_G_PER_S], mo[MO_X_AMP] = d, big_s, s_rate, g_per_s, x_amp
     if mode == MODE_SAM:
-        mo[MO_PARAM] = a_b * d_c / (a_d * b_c)
-        mo[MO_PARAM_C] = a_c * b_d / (a_d * b_c)
-        root = math.sqrt(a_d * b_c)
-        mo[MO_ARG_PER_S] = root / sqrt_ad
-        mo[MO_PN_COEFF] = a_c / root
-        mo[MO_PN_N] = -a_b / b_c
-        mo[MO_Y_AMP] = big_g * math.sqrt(d_c / b_c)
-        mo[MO_Z_AMP] = big_g * math.sqrt(a_d / a_c)
-        mo[MO_SIN_L_W] = math.sqrt(b_c)
-        mo[MO_COS_L_W] = math.sqrt(a_c)
+        terms = motion_sam_terms(big_g, d_c, a_d, b_d, a_b, b_c, a_c, sqrt_ad)
     else:
-        mo[MO_PARAM] = a_d * b_c / (a_b * d_c)
-        mo[MO_PARAM_C] = a_c * (-b_d) / (a_b * d_c)
-        root = math.sqrt(a_b * d_c)
-        mo[MO_ARG_PER_S] = root / sqrt_ad
-        mo[MO_PN_COEFF] = a_c / root
-        mo[MO_PN_N] = -a_d / d_c
-        mo[MO_Y_AMP] = big_g * math.sqrt(a_d / a_b)
-        mo[MO_Z_AMP] = big_g * math.sqrt(a_d / a_c)
-        mo[MO_SIN_L_W] = math.sqrt(a_b * d_c)
-        mo[MO_COS_L_W] = math.sqrt(a_c * a_d)
+        terms = motion_lam_terms(big_g, d_c, a_d, b_d, a_b, b_c, a_c, sqrt_ad)
+    (mo[MO_PARAM], mo[MO_PARAM_C], mo[MO_ARG_PER_S], mo[MO_PN_COEFF], mo[MO_PN_N], mo[MO_Y_AMP], mo[MO_Z_AMP],
+     mo[MO_SIN_L_W], mo[MO_COS_L_W]) = terms
     return mo
+
+
+# The pieces of motion_constants_into, plain arithmetic: the torque-free set-up of eight states at
+# once (spinorbit.core.free_motion.flow_blocks) runs them in lanes, each lane keeping its mode's terms.
+
+
+@jit(inline=INLINE)
+def motion_shared_terms(big_g, d_c, a_d, a, c, a_c):
+    """(d, S, ds/dt, the coefficient of s in g, the M_x amplitude, √(a d)) of a SAM or LAM motion."""
+    d = choose(d_c < a_d, c + d_c, a - a_d)  # from the smaller difference: fewer rounding errors
+    sqrt_ad = math.sqrt(a * d)
+    return d, math.sqrt(d / a) * big_g, sqrt_ad * big_g, c / sqrt_ad, big_g * math.sqrt(d_c / a_c), sqrt_ad
+
+
+@jit(inline=INLINE)
+def motion_sam_terms(big_g, d_c, a_d, b_d, a_b, b_c, a_c, sqrt_ad):
+    """SAM: (m, 1 − m, u/s, the pn coefficient, n, the M_y and M_z amplitudes, w_s, w_c)."""
+    root = math.sqrt(a_d * b_c)
+    return (a_b * d_c / (a_d * b_c), a_c * b_d / (a_d * b_c), root / sqrt_ad, a_c / root, -a_b / b_c,
+            big_g * math.sqrt(d_c / b_c), big_g * math.sqrt(a_d / a_c), math.sqrt(b_c), math.sqrt(a_c))
+
+
+@jit(inline=INLINE)
+def motion_lam_terms(big_g, d_c, a_d, b_d, a_b, b_c, a_c, sqrt_ad):
+    """LAM: (μ, 1 − μ, v/s, the pn coefficient, n, the M_y and M_z amplitudes, w_s, w_c)."""
+    root = math.sqrt(a_b * d_c)
+    return (a_d * b_c / (a_b * d_c), a_c * (-b_d) / (a_b * d_c), root / sqrt_ad, a_c / root, -a_d / d_c,
+            big_g * math.sqrt(a_d / a_b), big_g * math.sqrt(a_d / a_c), math.sqrt(a_b * d_c), math.sqrt(a_c * a_d))
 
 
 @jit

@@ -98,17 +98,20 @@ from spinorbit.core.free_motion.flow_constants import (
     flow_constants,
     flow_constants_buffers,
     flow_kappa_pn,
-    half_angles,
-    moment_constants,
 )
 from spinorbit.core.free_motion.flow_blocks import (
     BLOCK,
     INTEGRALS_SIZE,
+    MOTION_SIZE,
+    NODE_SIZE,
     STAGE_SIZE,
     finish_lane,
     integrals_of_block,
+    nodes_of_block,
     set_up_block_start,
 )
+from spinorbit.core.free_motion.node_frame import half_angles
+from spinorbit.core.free_motion.phase_constants import moment_constants
 from spinorbit.core.free_motion.regular_precession import (
     NO_SYMMETRY_AXIS,
     evaluate_precession,
@@ -254,7 +257,8 @@ def propagate_many_into(quaternions, momenta, moments, times, q_out, m_out, clos
     mos = np.empty((BLOCK, MO_SIZE))
     stages = np.empty((STAGE_SIZE, BLOCK))
     integrals = np.empty((INTEGRALS_SIZE, BLOCK))
-    motions = np.empty((4, BLOCK))
+    motions = np.empty((MOTION_SIZE, BLOCK))
+    nodes = np.empty((NODE_SIZE, BLOCK))
     n = quaternions.shape[0]
     pending = np.empty(n // BLOCK + 1, dtype=np.int64)  # first states of the blocks left to the single loop
     start = 0
@@ -275,9 +279,10 @@ def propagate_many_into(quaternions, momenta, moments, times, q_out, m_out, clos
             all_periodic = set_up_block_start(flows, mos, stages, motions, quaternions, momenta, first, a, b, c, ic,
                                               inertia_dd)
             integrals_of_block(stages, integrals, all_periodic)
+            nodes_of_block(flows, stages, nodes, quaternions, momenta, first)
             for lane in range(BLOCK):
                 i = first + lane
-                mk, pk = finish_lane(flows, mos, stages, integrals, lane, quaternions[i], momenta[i], ic)
+                mk, pk = finish_lane(flows, mos, stages, integrals, nodes, lane, quaternions[i], momenta[i], ic)
                 _evaluate_into(times, flows[lane], mos[lane], mk, pk, q_out, m_out, i)
         for block in range(count + 1):
             first, last = (pending[block], pending[block] + BLOCK) if block < count else (whole, stop)

@@ -6,6 +6,11 @@ layout below: the mode and flip, the node frame R1(I) R3(h), and the secular qua
 in double-double (the argument rate ν, the half period 2K, the rate c G of g, the advance 2κΠ of g
 per half period, κ, and g0 − κ pn(arg0)). Why double-double, and the formulas: the module docstring
 of :mod:`.flow` and ``docs/torque_free.md``.
+
+The set-up is written in three parts so that its middle can run for eight states at once
+(:mod:`.flow_blocks`): :func:`set_up_start` (motion constants, the phase constants of
+:mod:`.phase_constants`, the kind of motion), :func:`integrals_of_state` (the two R_F and the AGM
+of :mod:`spinorbit.core.math.complete_agm`), :func:`set_up_finish` (everything after them).
 """
 
 import math
@@ -23,10 +28,11 @@ from spinorbit.core.elements.canonical import (
     flip_signs,
     motion_from_momentum_into,
 )
+from spinorbit.core.free_motion.node_frame import node_of_state
+from spinorbit.core.free_motion.phase_constants import moment_constants, phase_constants_dd
 from spinorbit.core.jit import INLINE, jit
 from spinorbit.core.math.carlson import rf, rf_pair
 from spinorbit.core.math.complete_agm import complete_k_pi_dd
-from spinorbit.core.free_motion.phase_constants import moment_constants, phase_constants_dd
 from spinorbit.core.math.ddouble import (
     dd_add,
     dd_div,
@@ -107,40 +113,6 @@ FLOW_SIZE = FL_FOURIER_0 + FOURIER_MAX_TERMS
 
 
 @jit
-def half_angles(sin_x, cos_x):
-    """(cos(x/2), sin(x/2)) for x ∈ (−π, π] from (sin x, cos x) on the unit circle, no cancellation."""
-    if cos_x >= 0.0:
-        ch = math.sqrt(0.5 * (1.0 + cos_x))
-        return ch, sin_x / (2.0 * ch)
-    sh = math.copysign(math.sqrt(0.5 * (1.0 - cos_x)), sin_x)
-    return sin_x / (2.0 * sh), sh
-
-
-@jit
-def node_quaternion(cos_i, sin_i, sin_h, cos_h):
-    """Quaternion (w, x, y, z) of the node frame (R1(I) R3(h))ᵀ = R3(h)ᵀ R1(I)ᵀ, body → inertial.
-
-    q_z(h) ⊗ q_x(I) from the half angles (:func:`half_angles`, no trigonometric call), as four floats: the matrix of
-    :func:`.andoyer.node_frame` and Shepperd's conversion of it allocated two arrays and cost
-    ≈ 80 ns of the set-up. The sign is the one :func:`.rotations.matrix_to_quat` picks (largest
-    component positive), so the output quaternions keep their sign convention.
-    """
-    ci, si = half_angles(sin_i, cos_i)  # I ∈ [0, π]
-    ch, sh = half_angles(sin_h, cos_h)
-    w, x, y, z = ch * ci, ch * si, sh * si, sh * ci
-    big = w
-    if abs(x) > abs(big):
-        big = x
-    if abs(y) > abs(big):
-        big = y
-    if abs(z) > abs(big):
-        big = z
-    if big < 0.0:
-        return -w, -x, -y, -z
-    return w, x, y, z
-
-
-@jit
 def flow_constants(quaternion, momentum, big_a, big_b, big_c):
     """Everything the per-time evaluation needs for one state (computed once per state).
 
@@ -200,7 +172,9 @@ def flow_constants_buffers(flow, mo, quaternion, momentum, big_a, big_b, big_c, 
     staged = set_up_start(flow, mo, quaternion, momentum, big_a, big_b, big_c, ic, inertia_dd)
     if staged[ST_KIND] == KIND_UNIFORM:
         return elliptic_constants(mo)  # unused by a uniform rotation; returned for one signature
-    return set_up_finish(flow, mo, quaternion, momentum, ic, staged, integrals_of_state(staged))
+    g0, qn = node_of_state(quaternion, momentum[0], momentum[1], momentum[2], flow[FL_FLIP_X], flow[FL_FLIP_Y],
+                           flow[FL_FLIP_Z], staged[ST_MX], staged[ST_MY])
+    return set_up_finish(flow, mo, ic, staged, integrals_of_state(staged), g0, qn)
 
 
 # What set_up_start hands to the integrals and to set_up_finish (a tuple of floats, so that
@@ -254,8 +228,14 @@ UNIFORM_STAGE = (KIND_UNIFORM, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
 def set_up_motion(flow, mo, quaternion, momentum, big_a, big_b, big_c, ic):
     """Mode, flip and motion constants into flow and mo (a uniform rotation's constants complete);
     returns (mode, working-frame M_x, M_y, M_z)."""
+    flip = motion_from_momentum_into(mo, momentum[0], momentum[1], momentum[2], ic)
+    return motion_into_flow(flow, mo, quaternion, momentum, flip, big_a, big_b, big_c)
+
+
+@jit(inline=INLINE)
+def motion_into_flow(flow, mo, quaternion, momentum, flip, big_a, big_b, big_c):
+    """:func:`set_up_motion` after the motion constants ``mo`` and the flip are known."""
     m0x, m0y, m0z = momentum[0], momentum[1], momentum[2]
-    flip = motion_from_momentum_into(mo, m0x, m0y, m0z, ic)
     flow[:] = 0.0
     mode = int(mo[MO_MODE])
     flow[FL_MODE] = mode
@@ -324,8 +304,9 @@ def _uniform_rotation_constants(flow, quaternion, m0x, m0y, m0z, big_a, big_b, b
 
 
 @jit(inline=INLINE)
-def set_up_finish(flow, mo, quaternion, momentum, ic, staged, integrals):
-    """The set-up after its integrals (``integrals``: :func:`integrals_of_state`'s tuple); returns (mk, pk)."""
+def set_up_finish(flow, mo, ic, staged, integrals, g0, qn):
+    """The set-up after its integrals (``integrals``: :func:`integrals_of_state`'s tuple) and the node
+    frame (g0 and the node quaternion ``qn``: :func:`.node_frame.node_of_state`); returns (mk, pk)."""
     kind = staged[ST_KIND]
     mx, my, mz = staged[ST_MX], staged[ST_MY], staged[ST_MZ]
     fh, pch, param = staged[ST_F_HI], staged[ST_PC_HI], staged[ST_PARAM]
@@ -347,8 +328,6 @@ def set_up_finish(flow, mo, quaternion, momentum, ic, staged, integrals):
         mk, pk = elliptic_constants(mo)
         # m_c = 0: F = atanh(sin am) in Carlson's form, ±inf past ±π/2 (ellipf_k's cases)
         arg0 = ellipf_k(amplitude_from_momentum(mx, my, mz, mo, ic), mk)
-    m0x, m0y, m0z = momentum[0], momentum[1], momentum[2]
-    g0, qn = _node_of_state(quaternion, m0x, m0y, m0z, flow[FL_FLIP_X], flow[FL_FLIP_Y], flow[FL_FLIP_Z], mx, my)
     flow[FL_QN_W], flow[FL_QN_X], flow[FL_QN_Y], flow[FL_QN_Z] = qn
     flow[FL_ARG0] = arg0
     flow[FL_PERIODIC] = 1.0 if periodic else 0.0
@@ -416,52 +395,6 @@ def _amplitude_of_momentum(mx, my, mz, mode, ic):
         j = math.copysign(1.0, s)
         s, c = -s, -c
     return j, s, c
-
-
-@jit
-def _rotate(w, x, y, z, vx, vy, vz):
-    """M(q) v for a unit quaternion q = (w, x, y, z): the body vector v in the inertial frame."""
-    tx = 2.0 * (y * vz - z * vy)
-    ty = 2.0 * (z * vx - x * vz)
-    tz = 2.0 * (x * vy - y * vx)
-    return (vx + w * tx + (y * tz - z * ty), vy + w * ty + (z * tx - x * tz),
-            vz + w * tz + (x * ty - y * tx))
-
-
-@jit(inline=INLINE)
-def _node_of_state(quaternion, m0x, m0y, m0z, fx, fy, fz, mx, my):
-    """(g0, node quaternion) of a state: :func:`.canonical.node_angles_of` from the quaternion.
-
-    l is the body-frame longitude of the momentum, (sin l, cos l) = (M_x, M_y)/|M_⊥| (working frame;
-    at J = 0 the elements' convention l = π/2 of :func:`.canonical.body_from_sncndn`). The inertial
-    momentum is M(q) M0 (the flip is its own inverse), the node's h enters only through
-    (sin h, cos h) = (i_0, −i_1)/|i_⊥|, and the first row of R3(g) = Wᵀ R Nᵀ needs the inertial
-    image of W's first column (cos l, −sin l, 0) in the working frame. No matrix, no atan2 for h,
-    no sn, cn, dn at arg0 (≈ 150 ns of the set-up).
-    """
-    # sums of squares, not hypot (≈ 15 ns each): momenta below 1e150 cannot overflow them
-    perp2 = mx * mx + my * my
-    if perp2 > 0.0:
-        inv = 1.0 / math.sqrt(perp2)
-        sin_l, cos_l = mx * inv, my * inv
-    else:  # J = 0 (SAM with M_x = M_y = 0)
-        sin_l, cos_l = 1.0, 0.0
-    w, x, y, z = quaternion[0], quaternion[1], quaternion[2], quaternion[3]
-    i0, i1, big_h = _rotate(w, x, y, z, m0x, m0y, m0z)
-    r0, r1, r2 = _rotate(w, x, y, z, fx * cos_l, -fy * sin_l, 0.0)
-    inv_g = 1.0 / math.sqrt(m0x * m0x + m0y * m0y + m0z * m0z)
-    across = math.sqrt(i0 * i0 + i1 * i1)
-    sin_i, cos_i = across * inv_g, big_h * inv_g
-    if across > 0.0:
-        inv = 1.0 / across
-        sh, ch = i0 * inv, -i1 * inv
-    else:  # I = 0: h = atan2(i0, −i1) of the signed zeros, as node_angles_of takes it
-        h = math.atan2(i0, -i1)
-        sh, ch = math.sin(h), math.cos(h)
-    r3g_00 = r0 * ch + r1 * sh
-    r3g_01 = cos_i * (r1 * ch - r0 * sh) + sin_i * r2
-    return math.atan2(r3g_01, r3g_00), node_quaternion(cos_i, sin_i, sh, ch)
-
 
 
 @jit

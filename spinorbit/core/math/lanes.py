@@ -337,6 +337,21 @@ def select_tuple(typingctx, mask, new, old):
     return result_type(mask, new, old), codegen
 
 
+def choose(condition, if_true, if_false):
+    """``if_true if condition else if_false`` for a bool, :func:`select` for a ``LaneMask`` (compiled code
+    only): one spelling of a two-way choice in kernels compiled for floats and for Lanes."""
+    raise NotImplementedError("choose is for compiled code")
+
+
+@overload(choose)
+def _overload_choose(condition, if_true, if_false):
+    if isinstance(condition, types.Boolean):
+        return lambda condition, if_true, if_false: if_true if condition else if_false
+    if condition == mask_type:
+        return lambda condition, if_true, if_false: select(condition, if_true, if_false)
+    return None
+
+
 def constant_like(template, value):
     """``value`` in the form of ``template``: a double, or ``Lanes`` with it in every lane (compiled code only)."""
     raise NotImplementedError("constant_like is for compiled code")

@@ -145,7 +145,8 @@ def _floor_kernels():
         MO_MODE, MO_SIZE, MODE_SAM, amplitude_from_momentum, flip_signs, motion_from_momentum_into)
     from spinorbit.core.free_motion.flow import flow_state, propagate_many_into
     from spinorbit.core.free_motion.flow_blocks import (
-        BLOCK, INTEGRALS_SIZE, STAGE_SIZE, finish_lane, integrals_of_block, set_up_block_start)
+        BLOCK, INTEGRALS_SIZE, MOTION_SIZE, NODE_SIZE, STAGE_SIZE, finish_lane, integrals_of_block, nodes_of_block,
+        set_up_block_start)
     from spinorbit.core.free_motion.flow_constants import FLOW_SIZE, flow_constants_buffers
     from spinorbit.core.free_motion.phase_constants import moment_constants, phase_constants_dd, phase_constants_lanes
     from spinorbit.core.jit import jit
@@ -199,15 +200,17 @@ def _floor_kernels():
     def set_up_blocks(quaternions, momenta, a, b, c):
         flows, mos = np.empty((BLOCK, FLOW_SIZE)), np.empty((BLOCK, MO_SIZE))
         stages, integrals = np.empty((STAGE_SIZE, BLOCK)), np.empty((INTEGRALS_SIZE, BLOCK))
-        motions = np.empty((4, BLOCK))
+        motions, nodes = np.empty((MOTION_SIZE, BLOCK)), np.empty((NODE_SIZE, BLOCK))
         ic, inertia_dd = moment_constants(a, b, c)
         acc = 0.0
         for first in range(0, quaternions.shape[0] - BLOCK + 1, BLOCK):
             periodic = set_up_block_start(flows, mos, stages, motions, quaternions, momenta, first, a, b, c, ic,
                                           inertia_dd)
             integrals_of_block(stages, integrals, periodic)
+            nodes_of_block(flows, stages, nodes, quaternions, momenta, first)
             for lane in range(BLOCK):
-                finish_lane(flows, mos, stages, integrals, lane, quaternions[first + lane], momenta[first + lane], ic)
+                finish_lane(flows, mos, stages, integrals, nodes, lane, quaternions[first + lane],
+                            momenta[first + lane], ic)
                 acc += flows[lane, 0] + flows[lane, 5] + flows[lane, 10]
         return acc
 
@@ -350,11 +353,13 @@ def floor_text(floor, one_time_rate):
               f"The goal's budget is {budget:.0f} ns per state; the whole call measures {call:.0f} ns, {kernel:.0f} ns "
               f"of it in the kernel (the first row), the rest the Python wrapper's checks and the allocation of "
               f"the outputs. In lanes the set-up costs "
-              f"{set_up_lanes:.0f} ns against {set_up_scalar:.0f} ns state by state: the phase constants, the two "
-              f"R_F and the AGM, whose divisions and square roots bound the scalar set-up, issue eight at a time "
-              f"(the same results bit for bit, `tests/test_lanes.py`). What stays scalar has branches by the "
-              f"state (the motion's mode and flip, the nome series' length, the node frame's atan2) or a "
-              f"library call per state (sin, cos, exp, atan2)."]
+              f"{set_up_lanes:.0f} ns against {set_up_scalar:.0f} ns state by state: the motion constants, the "
+              f"phase constants, the two R_F, the AGM and the node frame's arithmetic, whose divisions and square "
+              f"roots bound the scalar set-up, issue eight at a time (the same results bit for bit, "
+              f"`tests/test_lanes.py`); the motion constants and the node frame run in lanes only inside the "
+              f"block set-up (each lane's mode, flip and atan2 chosen alone), so their lane cells are in the "
+              f"set-up row. What stays scalar has branches by the state (the mode and flip, the nome series' "
+              f"length) or a library call per state (sin, cos, exp, atan2)."]
     return lines
 
 

@@ -44,8 +44,8 @@ phase treatment), unless ``closed_forms=False``.
 
 Where it lives: the constants of one motion are set up once per state by
 :func:`.flow_constants.flow_constants` (module :mod:`.flow_constants`, which owns the ``FL_*``
-layout); this module evaluates them at each time (:func:`evaluate_flow`) and runs the loops over
-states and times.
+layout; eight states of one body at once: :mod:`.flow_blocks`); this module evaluates them at each
+time (:func:`evaluate_flow`) and runs the loops over states and times.
 
 Output convention: quaternions scalar first, body → inertial (``docs/conventions.md``), and body
 angular momenta, in the user's principal-axis body frame.
@@ -287,8 +287,8 @@ def propagate_many_into(quaternions, momenta, moments, times, q_out, m_out, clos
         for block in range(count + 1):
             first, last = (pending[block], pending[block] + BLOCK) if block < count else (whole, stop)
             for i in range(first, last):
-                propagate_state_into(quaternions, momenta, times, q_out, m_out, i, a, b, c, closed_forms, flows[0],
-                                 mos[0], ic, inertia_dd)
+                propagate_state_into(quaternions, momenta, times, q_out, m_out, i, a, b, c, closed_forms,
+                                     flows[0], mos[0], ic, inertia_dd)
         start = stop
 
 

@@ -75,8 +75,9 @@ def _is_operand(t):
     return t == lanes_type or isinstance(t, (types.Float, types.Integer))
 
 
-def _lanes_binary(instruction):
-    """An intrinsic applying one LLVM floating-point instruction lane by lane (numbers broadcast)."""
+def _lanes_binary(emit, result_type):
+    """An intrinsic applying ``emit(builder, x, y)`` to two operands lane by lane (numbers broadcast),
+    returning ``result_type`` (Lanes for arithmetic, LaneMask for comparisons)."""
 
     @intrinsic
     def kernel(typingctx, a, b):
@@ -86,17 +87,12 @@ def _lanes_binary(instruction):
         def codegen(context, builder, signature, args):
             x = _as_vector(context, builder, args[0], signature.args[0])
             y = _as_vector(context, builder, args[1], signature.args[1])
-            return getattr(builder, instruction)(x, y)
+            return emit(builder, x, y)
 
-        return lanes_type(a, b), codegen
+        return result_type(a, b), codegen
 
     return kernel
 
-
-_add = _lanes_binary("fadd")
-_sub = _lanes_binary("fsub")
-_mul = _lanes_binary("fmul")
-_div = _lanes_binary("fdiv")
 
 def _register_binary(python_operator, kernel):
     """``python_operator`` on (Lanes or number, Lanes or number), at least one Lanes, by ``kernel``."""
@@ -109,31 +105,18 @@ def _register_binary(python_operator, kernel):
     overload(python_operator)(implementation)
 
 
-for _operator, _kernel in ((operator.add, _add), (operator.sub, _sub), (operator.mul, _mul),
-                           (operator.truediv, _div), (operator.iadd, _add), (operator.isub, _sub),
-                           (operator.imul, _mul), (operator.itruediv, _div)):
-    _register_binary(_operator, _kernel)
+for _instruction, _operators in (("fadd", (operator.add, operator.iadd)), ("fsub", (operator.sub, operator.isub)),
+                                 ("fmul", (operator.mul, operator.imul)),
+                                 ("fdiv", (operator.truediv, operator.itruediv))):
+    _kernel = _lanes_binary(lambda builder, x, y, name=_instruction: getattr(builder, name)(x, y), lanes_type)
+    for _operator in _operators:
+        _register_binary(_operator, _kernel)
 
-
-def _lanes_compare(predicate):
-    @intrinsic
-    def kernel(typingctx, a, b):
-        if not (_is_operand(a) and _is_operand(b) and lanes_type in (a, b)):
-            return None
-
-        def codegen(context, builder, signature, args):
-            x = _as_vector(context, builder, args[0], signature.args[0])
-            y = _as_vector(context, builder, args[1], signature.args[1])
-            return builder.fcmp_ordered(predicate, x, y)
-
-        return mask_type(a, b), codegen
-
-    return kernel
-
-
+# ordered comparisons: false in a lane where either operand is NaN, as the scalar comparison is
 for _operator, _predicate in ((operator.lt, "<"), (operator.le, "<="), (operator.gt, ">"),
                               (operator.ge, ">="), (operator.eq, "==")):
-    _register_binary(_operator, _lanes_compare(_predicate))
+    _register_binary(_operator, _lanes_binary(
+        lambda builder, x, y, predicate=_predicate: builder.fcmp_ordered(predicate, x, y), mask_type))
 
 
 @intrinsic

@@ -148,7 +148,7 @@ __all__ = [
     "FL_G_RATE_LO", "FL_KAPPA_HI", "FL_KAPPA_LO", "FL_M0_X", "FL_M0_Y", "FL_M0_Z", "FL_MODE",
     "FL_PERIODIC", "FL_PERIOD_HI", "FL_PERIOD_LO", "FL_QN_W", "FL_QN_X", "FL_QN_Y", "FL_QN_Z",
     "FL_RATE_HI", "FL_RATE_LO", "evaluate_flow", "evaluate_into", "flow_constants", "flow_state", "propagate_many_into",
-    "propagate_state_into", "torque_free_attitudes", "torque_free_states", "torque_free_states_many",
+    "propagate_state_into", "propagate_states_into", "torque_free_attitudes", "torque_free_states", "torque_free_states_many",
     "uniform_rotation",
 ]
 
@@ -249,9 +249,9 @@ def propagate_many_into(quaternions, momenta, moments, times, q_out, m_out, clos
     of the elliptic flow at parameter 0; False forces the elliptic flow (tests, benchmarks).
 
     Consecutive states of one body form a run; within it, blocks of eight rotating states of a
-    triaxial body are set up together (:mod:`.flow_blocks`, the same results bit for bit), and the
-    other states one by one in a loop of their own (in the blocks' loop their code cost every block
-    ≈ 10 % of its time: ``docs/design.md``).
+    triaxial body are set up together (:mod:`.flow_blocks`, the same results bit for bit). The other
+    states go to :func:`propagate_states_into`, one call per stretch between blocks: in the blocks'
+    loop their code cost every block ≈ 10 % of its time and doubled the kernel's compile.
     """
     flows = np.empty((BLOCK, FLOW_SIZE))  # buffers for every state's constants (an allocation each cost ≈ 25 ns)
     mos = np.empty((BLOCK, MO_SIZE))
@@ -260,47 +260,63 @@ def propagate_many_into(quaternions, momenta, moments, times, q_out, m_out, clos
     motions = np.empty((MOTION_SIZE, BLOCK))
     nodes = np.empty((NODE_SIZE, BLOCK))
     n = quaternions.shape[0]
-    pending = np.empty(n // BLOCK + 1, dtype=np.int64)  # first states of the blocks left to the single loop
+    pending = 0  # states pending … first of a block are left to propagate_states_into, in one call per stretch
     start = 0
     while start < n:
         a, b, c = moments[start, 0], moments[start, 1], moments[start, 2]
         stop = start + 1
         while stop < n and moments[stop, 0] == a and moments[stop, 1] == b and moments[stop, 2] == c:
             stop += 1
-        ic, inertia_dd = moment_constants(a, b, c)
-        elliptic = not closed_forms or symmetry_axis(a, b, c) == NO_SYMMETRY_AXIS
         whole = start + (stop - start) // BLOCK * BLOCK
-        count = 0
-        for first in range(start, whole, BLOCK):
-            if not (elliptic and _block_rotates(momenta, first)):
-                pending[count] = first
-                count += 1
-                continue
-            all_periodic = set_up_block_start(flows, mos, stages, motions, quaternions, momenta, first, a, b, c, ic,
-                                              inertia_dd)
-            integrals_of_block(stages, integrals, all_periodic)
-            nodes_of_block(flows, stages, nodes, quaternions, momenta, first)
-            for lane in range(BLOCK):
-                i = first + lane
-                mk, pk = finish_lane(flows, mos, stages, integrals, nodes, lane, quaternions[i], momenta[i], ic)
-                evaluate_into(times, flows[lane], mos[lane], mk, pk, q_out, m_out, i)
-        for block in range(count + 1):
-            first, last = (pending[block], pending[block] + BLOCK) if block < count else (whole, stop)
-            for i in range(first, last):
-                propagate_state_into(quaternions, momenta, times, q_out, m_out, i, a, b, c, closed_forms,
-                                     flows[0], mos[0], ic, inertia_dd)
+        if whole > start and (not closed_forms or symmetry_axis(a, b, c) == NO_SYMMETRY_AXIS):
+            ic, inertia_dd = moment_constants(a, b, c)
+            for first in range(start, whole, BLOCK):
+                if not _block_rotates(momenta, first):
+                    continue
+                if pending < first:
+                    propagate_states_into(quaternions, momenta, moments, times, q_out, m_out, closed_forms, pending,
+                                          first)
+                all_periodic = set_up_block_start(flows, mos, stages, motions, quaternions, momenta, first, a, b, c,
+                                                  ic, inertia_dd)
+                integrals_of_block(stages, integrals, all_periodic)
+                nodes_of_block(flows, stages, nodes, quaternions, momenta, first)
+                for lane in range(BLOCK):
+                    i = first + lane
+                    mk, pk = finish_lane(flows, mos, stages, integrals, nodes, lane, quaternions[i], momenta[i], ic)
+                    evaluate_into(times, flows[lane], mos[lane], mk, pk, q_out, m_out, i)
+                pending = first + BLOCK
         start = stop
+    if pending < n:
+        propagate_states_into(quaternions, momenta, moments, times, q_out, m_out, closed_forms, pending, n)
 
 
 @jit
+def propagate_states_into(quaternions, momenta, moments, times, q_out, m_out, closed_forms, first, last):
+    """Kernel: states first … last − 1 at every time into q_out, m_out, each by itself
+    (:func:`propagate_state_into`; the arguments as :func:`propagate_many_into`'s).
+
+    The per-body constants are formed again only where the moments change from one state to the next.
+    """
+    flow, mo = np.empty(FLOW_SIZE), np.empty(MO_SIZE)
+    ic, inertia_dd = moment_constants(moments[first, 0], moments[first, 1], moments[first, 2])
+    body = first
+    for i in range(first, last):
+        a, b, c = moments[i, 0], moments[i, 1], moments[i, 2]
+        if a != moments[body, 0] or b != moments[body, 1] or c != moments[body, 2]:
+            ic, inertia_dd = moment_constants(a, b, c)
+            body = i
+        propagate_state_into(quaternions, momenta, times, q_out, m_out, i, a, b, c, closed_forms, flow, mo, ic,
+                             inertia_dd)
+
+
+@jit(inline=INLINE)
 def propagate_state_into(quaternions, momenta, times, q_out, m_out, i, a, b, c, closed_forms, flow, mo, ic, inertia_dd):
     """Kernel: state i (moments a ≤ b ≤ c) at every time into q_out[i], m_out[i], by itself: no
     rotation, the regular precession, or the elliptic flow.
 
     ``flow``, ``mo``: (FLOW_SIZE,) and (MO_SIZE,) buffers; ``ic, inertia_dd``: the body's
-    :func:`.phase_constants.moment_constants`. A compiled function of its own, called where a state
-    does not fill a block: inlined, its copy of the set-up and the evaluation doubled the compile time
-    of :func:`propagate_many_into` (12 → 30 s on a fresh cache, against 24 s called).
+    :func:`.phase_constants.moment_constants`. For loops over states that each have their own body
+    or times (:func:`propagate_states_into`, :func:`.members.free_flow_each`).
     """
     if momenta[i, 0] == 0.0 and momenta[i, 1] == 0.0 and momenta[i, 2] == 0.0:
         for k in range(times.shape[0]):  # no rotation at all

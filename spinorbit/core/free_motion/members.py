@@ -5,8 +5,8 @@ An ensemble of torque-free members (``spinorbit.ensemble.free``) differs from
 output times (members need not share an epoch), and the outcome also needs the constants of each
 motion (mode, E/E0, P_ψ, P_φ, sidereal period, :func:`.summary.motion_summary`). One compiled loop
 each, with no Python per member: :func:`motion_summary_each` for the constants of the member's
-initial momentum, :func:`free_flow_each` for the flow, the set-up and evaluation of
-:func:`.flow.propagate_state_into` on the member's row (the same as every other caller of the flow).
+initial momentum, :func:`free_flow_each` for the flow, which is :func:`.flow.propagate_state_into`
+on the member's row (the same set-up and evaluation as every other caller of the flow).
 
 A member's numbers depend on its own inputs only (nothing is shared across the loop), so a member
 evaluated alone and in any batch gives the same bits (``tests/test_ensemble_free.py``).
@@ -15,9 +15,7 @@ evaluated alone and in any batch gives the same bits (``tests/test_ensemble_free
 import numpy as np
 
 from spinorbit.core.elements.canonical import MO_SIZE
-from spinorbit.core.free_motion.flow import FLOW_SIZE, evaluate_into, propagate_state_into
-from spinorbit.core.free_motion.flow_constants import flow_constants_buffers
-from spinorbit.core.free_motion.regular_precession import NO_SYMMETRY_AXIS, symmetry_axis
+from spinorbit.core.free_motion.flow import FLOW_SIZE, propagate_state_into
 from spinorbit.core.free_motion.phase_constants import moment_constants
 from spinorbit.core.free_motion.summary import motion_summary
 from spinorbit.core.jit import jit
@@ -54,13 +52,7 @@ def free_flow_each(quaternions, momenta, moments, elapsed, q_out, m_out):
     for i in range(quaternions.shape[0]):
         a, b, c = moments[i, 0], moments[i, 1], moments[i, 2]
         ic, inertia_dd = moment_constants(a, b, c)
-        rotating = momenta[i, 0] != 0.0 or momenta[i, 1] != 0.0 or momenta[i, 2] != 0.0
-        if rotating and symmetry_axis(a, b, c) == NO_SYMMETRY_AXIS:  # the elliptic flow, inline (a call ≈ 0.1 µs)
-            mk, pk = flow_constants_buffers(flow, mo, quaternions[i], momenta[i], a, b, c, ic, inertia_dd)
-            evaluate_into(elapsed[i], flow, mo, mk, pk, q_out, m_out, i)
-        else:
-            propagate_state_into(quaternions, momenta, elapsed[i], q_out, m_out, i, a, b, c, True, flow, mo, ic,
-                                 inertia_dd)
+        propagate_state_into(quaternions, momenta, elapsed[i], q_out, m_out, i, a, b, c, True, flow, mo, ic, inertia_dd)
 
 
 def free_members(quaternions, momenta, moments, elapsed=None):

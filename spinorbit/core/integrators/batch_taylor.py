@@ -62,11 +62,11 @@ from spinorbit.core.integrators.taylor import (
     validate_tolerance,
 )
 from spinorbit.core.integrators.taylor_recurrences import (
-    horner,
     orbit_radius,
     scaled_norm,
     seed_perturbers,
     series_array,
+    state_at,
     taylor_coefficients_into,
 )
 from spinorbit.core.jit import jit
@@ -105,8 +105,8 @@ def batch_taylor_kernel(y0s, t0s, t_ends, models, tols, order_factor, max_steps,
     for m in range(n_members):
         n_pert_max = max(n_pert_max, int(models[m, MODEL_PERTURBERS]))
         order_max = max(order_max, taylor_order(tols[m], order_factor))
-    rows = series_array(n_pert_max, order_max).shape[0]
-    s = np.zeros((lanes, rows, order_max + 1))  # each lane's series array, contiguous for the scalar functions
+    columns = series_array(n_pert_max, order_max).shape[1]
+    s = np.zeros((lanes, order_max + 1, columns))  # each lane's series array, contiguous for the scalar functions
     y = np.zeros((lanes, n))
     orbit_orders = np.zeros((lanes, max(n_pert_max, 1)), dtype=np.int64)
     member = np.full(lanes, -1, dtype=np.int64)
@@ -170,7 +170,7 @@ def _lane_step(lane, m, model, s, y, orbit_orders, order, n_pert, t, t_end, dire
     loop for the single output time t_end, on that lane's slices (same calls, same order, same bits)."""
     n = STATE_SIZE
     for i in range(n):
-        s[i, 0] = y[i]
+        s[0, i] = y[i]
     exact = steps[lane] % KEPLER_RESEED_INTERVAL == 0
     t_stop = seed_perturbers(t[lane], model, s, n_pert, t_end[lane], direction[lane], h_last[lane], orbit_orders,
                              exact)
@@ -196,7 +196,7 @@ def _lane_step(lane, m, model, s, y, orbit_orders, order, n_pert, t, t_end, dire
     if direction[lane] * (t_end[lane] - t_new) <= 0.0:
         # The last step: the scalar kernel's output at t_end (Horner at t_end − t, q renormalised), which is
         # also the state it checks for finiteness (t_new = t_end, so h = t_end − t).
-        horner(s, n, order, t_end[lane] - t[lane], ys[m])
+        state_at(s, order, t_end[lane] - t[lane], ys[m])
         normalize_quaternion_part(ys[m])
         for i in range(n):
             if not math.isfinite(ys[m, i]):
@@ -208,7 +208,7 @@ def _lane_step(lane, m, model, s, y, orbit_orders, order, n_pert, t, t_end, dire
         stats[m, STAT_STATUS] = STATUS_SUCCESS
         active[lane] = False
         return
-    horner(s, n, order, h, y)
+    state_at(s, order, h, y)
     normalize_quaternion_part(y)
     for i in range(n):
         if not math.isfinite(y[i]):

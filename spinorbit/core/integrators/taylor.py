@@ -48,19 +48,18 @@ from spinorbit.core.integrators.dop853 import (
 )
 from spinorbit.core.integrators.quaternion import integrate_quaternion, normalize_quaternion_part
 from spinorbit.core.integrators.taylor_recurrences import (
-    horner,
+    MAX_ORDER,
     orbit_radius,
     scaled_norm,
     seed_perturbers,
     series_array,
+    state_at,
     taylor_coefficients_into,
 )
 from spinorbit.core.integrators.taylor_recurrences import taylor_series  # noqa: F401 (part of this integrator's API)
 from spinorbit.core.jit import jit
 from spinorbit.core.model.gravity_field import BODY_NMAX, FIG_THERMAL
 
-#: Highest Taylor order (tol ≥ 1e-16 with order_factor ≤ 2 needs ≤ 40).
-MAX_ORDER = 48
 #: Largest growth of the step from one step to the next: bounds the step for which the orbit series'
 #: order m is chosen (see the module docstring).
 STEP_GROWTH = 1.5
@@ -184,7 +183,7 @@ def integrate_taylor_kernel(y0, t0, t_out, model, tol, order_factor, max_steps):
             stats[STAT_STATUS] = STATUS_MAX_STEPS
             return ys, stats
         for i in range(n):
-            s[i, 0] = y[i]
+            s[0, i] = y[i]
         exact = steps % KEPLER_RESEED_INTERVAL == 0
         t_stop = seed_perturbers(t, model, s, n_pert, t_end, direction, h_last, orbit_orders, exact)
         w_norm = math.sqrt(y[4] * y[4] + y[5] * y[5] + y[6] * y[6])
@@ -206,10 +205,10 @@ def integrate_taylor_kernel(y0, t0, t_out, model, tol, order_factor, max_steps):
         for p in range(n_pert):
             stats[STAT_ORBIT_ORDER_SUM] += orbit_orders[p]
         while i_out < n_out and direction * (t_out[i_out] - t_new) <= 0.0:
-            horner(s, n, order, t_out[i_out] - t, ys[i_out])
+            state_at(s, order, t_out[i_out] - t, ys[i_out])
             normalize_quaternion_part(ys[i_out])
             i_out += 1
-        horner(s, n, order, h, y)
+        state_at(s, order, h, y)
         normalize_quaternion_part(y)
         for i in range(n):
             if not math.isfinite(y[i]):
@@ -238,10 +237,10 @@ def integrate_taylor_fixed_kernel(y0, t0, t1, n_steps, model, order):
     for step in range(n_steps):
         t = t0 + step * h
         for i in range(STATE_SIZE):
-            s[i, 0] = y[i]
+            s[0, i] = y[i]
         seed_perturbers(t, model, s, n_pert, t1, 1.0 if h > 0.0 else -1.0, h, orbit_orders, True)
         taylor_coefficients_into(t, model, s, n_pert, order, 0.0, 0.0, orbit_orders)
-        horner(s, STATE_SIZE, order, h, y)
+        state_at(s, order, h, y)
         normalize_quaternion_part(y)
     return y
 

@@ -18,9 +18,24 @@ random states and perturbers. Three exact rewritings are used, the first valid o
 - (I r) × r components (C − B) r_y r_z etc. (the A r_x r_x terms cancel exactly);
 - **Torque.** |r|⁻⁵ r_y r_z = ρ_y ρ_z of ρ = |r|⁻⁵ᐟ² r rotated to the body frame (rotation is linear):
   the |r|⁻⁵ᐟ² enters in the perturber's orbit series, which stop after a few orders (below), and the
-  torque at the attitude's orders is the rotation and the pair products only, without the three
-  products with a |r|⁻⁵ series of the formulation N = 3μ|r|⁻⁵ (…) (4–9 % less CPU per coefficient
-  call in scenes (a)–(c); same physics, only the rounding differs: |r|⁻⁵ is split in two factors).
+  torque at the attitude's orders is the rotation and the pair products only.
+
+**Four components in one register.** The series array is order-major: row k holds every quantity's
+order-k coefficient, each quaternion or 3-vector in four consecutive doubles (a 3-vector's fourth is
+zero), so one order of one quantity is one :mod:`~spinorbit.core.math.lanes` ``Quad``. A Cauchy
+product of two 3-vectors component by component, or of a quaternion with one broadcast component, is
+one fused multiply-add per term instead of three or four. Products that mix components (cross
+products, Euler's ω_y ω_z, …) load copies stored in the order they need: ω as (ω_y, ω_z, ω_x) and
+(ω_z, ω_x, ω_y), u = (q₁, q₂, q₃) and ρ and ρ_body likewise. A quaternion product is summed as the
+Cauchy products of the whole quaternion with each broadcast component, and permuted with signs once
+per order (a permutation is linear, so it commutes with the sum): q ⊗ (0, ω) = Σ_a P_a(q) ω_a for
+the kinematics, and u × c − q₀ c = −vec((0, c) ⊗ q) for the rotation of ρ to the body frame. The
+rewriting is measured in ``docs/performance.md`` (*Where the Taylor floor is*).
+
+**Latency.** Each order needs the last one, so the step is one chain of dependent orders. Every Cauchy
+sum therefore adds the terms with the newest coefficients (j = 0 and j = k) last: the rest of the sum
+can run while the previous quantity of the chain is still being computed. Long sums run as two
+partial sums (terms j and k − j side by side), so a chain of dependent multiply-adds is half as long.
 
 **Perturbers over a step.** A Keplerian perturber's relative position is carried as extra state
 of the Taylor system, r̈ = −μ_orbit r / |r|³, advanced by its own Taylor polynomial and *re-seeded
@@ -47,7 +62,16 @@ import math
 import numpy as np
 
 from spinorbit.core.dynamics.equations import MODEL_PERTURBERS, STATE_SIZE
-from spinorbit.core.jit import FUSED_MULTIPLY_ADD, jit
+from spinorbit.core.jit import FUSED_MULTIPLY_ADD, INLINE, jit
+from spinorbit.core.math.ddouble import fma
+from spinorbit.core.math.lanes import (
+    load_broadcast_quad,
+    load_quad,
+    quad,
+    quad_lane,
+    quad_shuffle,
+    store_quad,
+)
 from spinorbit.core.model.gravity_field import BODY_A, BODY_B, BODY_C
 from spinorbit.core.model.perturbers import (
     K_A,
@@ -67,115 +91,317 @@ from spinorbit.core.model.perturbers import (
     kepler_perifocal,
 )
 
-# Rows of the series array: the attitude state, the summed torque, then one block per perturber.
-_Q0, _W0, _N0 = 0, 4, 7
-_HEAD_ROWS = 10
-# Perturber block: position, velocity, |r|², |r|^-5/2, |r|^-3, ρ = |r|^-5/2 r, c = u × ρ, ρ_body.
-_X, _V, _R2, _S52, _S3, _RHO, _C, _B = 0, 3, 6, 7, 8, 9, 12, 15
-_BLOCK_ROWS = 18
+#: Highest Taylor order the series array is made for (tol ≥ 1e-16 with order_factor ≤ 2 needs ≤ 40).
+MAX_ORDER = 48
+# 1/(k + 1) for every order: a division would sit on the chain of dependent orders.
+_RECIPROCALS = 1.0 / np.arange(1, MAX_ORDER + 2, dtype=np.float64)
+
+# Columns of the series array, four per quantity. The state first, in the order of y (q, ω), then the
+# copies the products load, then the summed torque; then one block per perturber.
+_Q, _W, _W_YZX, _W_ZXY, _U_YZX, _U_ZXY, _N = 0, 4, 8, 12, 16, 20, 24
+_HEAD_COLUMNS = 28
+# Perturber block: position, velocity, the scalars (|r|², |r|⁻⁵ᐟ², |r|⁻³), ρ = |r|⁻⁵ᐟ² r with its two
+# rotated copies, c = u × ρ, and ρ_body with its two rotated copies.
+_X, _V, _SCALARS, _RHO, _C, _B = 0, 4, 8, 12, 24, 28
+_R2, _S52, _S3 = _SCALARS, _SCALARS + 1, _SCALARS + 2
+_BLOCK_COLUMNS = 40
+_YZX, _ZXY = 4, 8  # offsets of a 3-vector's rotated copies from the vector itself
+
+_yzx = quad_shuffle((1, 2, 0, 4))  # (x, y, z, ·) → (y, z, x, 0)
+_zxy = quad_shuffle((2, 0, 1, 4))
+_u_yzx = quad_shuffle((2, 3, 1, 4))  # (q0, q1, q2, q3) → (q2, q3, q1, 0): u = (q1, q2, q3) rotated
+_u_zxy = quad_shuffle((3, 1, 2, 4))
+_lane_x, _lane_y, _lane_z = quad_shuffle((0, 0, 0, 0)), quad_shuffle((1, 1, 1, 1)), quad_shuffle((2, 2, 2, 2))
+# q ⊗ (0, ω) = P_x(q) ω_x + P_y(q) ω_y + P_z(q) ω_z with P_x(q) = (−q1, q0, q3, −q2),
+# P_y(q) = (−q2, −q3, q0, q1), P_z(q) = (−q3, q2, −q1, q0): a permutation, then signs.
+_p_x = quad_shuffle((1, 0, 3, 2))
+_p_y = quad_shuffle((2, 3, 0, 1))
+_p_z = quad_shuffle((3, 2, 1, 0))
+# u × c − q₀ c = −vec((0, c) ⊗ q) = −Σ_a c_a vec(e_a ⊗ q), vec(e_x ⊗ q) = (q0, −q3, q2),
+# vec(e_y ⊗ q) = (q3, q0, −q1), vec(e_z ⊗ q) = (−q2, q1, q0): a permutation, then signs.
+_e_x = quad_shuffle((0, 3, 2, 4))
+_e_y = quad_shuffle((3, 0, 1, 4))
+_e_z = quad_shuffle((2, 1, 0, 4))
+
 
 @jit
 def series_array(n_pert, order):
-    """Zeroed series array for n_pert perturbers up to ``order``: rows 0..6 are the state (q, ω)."""
-    return np.zeros((_HEAD_ROWS + n_pert * _BLOCK_ROWS, order + 1))
+    """Zeroed series array for n_pert perturbers up to ``order``: row k holds the order-k coefficients,
+    its first 7 columns the state (q, ω) in the order of y."""
+    return np.zeros((order + 1, _HEAD_COLUMNS + n_pert * _BLOCK_COLUMNS))
 
 
-@jit(inline="always")
-def _cauchy(s, a, b, k):
-    """k-th coefficient of the product of the series in rows a and b: Σ_j s[a, j] s[b, k − j]."""
-    acc = 0.0
-    for j in range(k + 1):
-        acc += s[a, j] * s[b, k - j]
-    return acc
+@jit(inline=INLINE)
+def _store_rotated(f, at, vector):
+    """A 3-vector at column offset ``at`` of the flat series, with its (y, z, x) and (z, x, y) copies."""
+    store_quad(f, at, vector)
+    store_quad(f, at + _YZX, _yzx(vector))
+    store_quad(f, at + _ZXY, _zxy(vector))
 
 
-@jit(inline="always")
-def _cauchy_vector(s, a, b, a_stride, k):
-    """k-th coefficients of the three products of rows (a + i·a_stride) and (b + i), i = 0, 1, 2, in one loop.
+@jit(inline=INLINE)
+def _store_attitude(f, row, q, w):
+    """q and ω of one order at flat offset ``row``, with the copies the products load."""
+    store_quad(f, row + _Q, q)
+    store_quad(f, row + _U_YZX, _u_yzx(q))
+    store_quad(f, row + _U_ZXY, _u_zxy(q))
+    _store_rotated(f, row + _W, w)
 
-    a_stride 0: a scalar series times a 3-vector; 1: the componentwise products of two 3-vectors. The
-    same sums as three :func:`_cauchy` calls (same order, same bits), with three independent chains of
-    fused multiply-adds per iteration instead of one (a single Cauchy sum is bound by their latency).
+
+@jit(inline=INLINE)
+def _inner_sum(f, ncol, a, b, k, first):
+    """Σ_{j=first}^{k−1} A^[j] ⊙ B^[k−j] of the quads at columns a and b (component by component), in two
+    partial sums. The terms with j = 0 and j = k, which hold the newest coefficients, are the caller's
+    (module docstring, *Latency*)."""
+    inner = quad(0.0, 0.0, 0.0, 0.0)
+    other = quad(0.0, 0.0, 0.0, 0.0)
+    pairs = max(k - first, 0) // 2
+    for i in range(pairs):
+        j = first + 2 * i
+        inner = fma(load_quad(f, j * ncol + a), load_quad(f, (k - j) * ncol + b), inner)
+        other = fma(load_quad(f, (j + 1) * ncol + a), load_quad(f, (k - j - 1) * ncol + b), other)
+    for j in range(first + 2 * pairs, k):
+        inner = fma(load_quad(f, j * ncol + a), load_quad(f, (k - j) * ncol + b), inner)
+    return inner + other
+
+
+@jit(inline=INLINE)
+def _quaternion_times_components(f, ncol, column, k):
+    """Σ_{j=1}^{k−1} q^[j] v_a^[k−j] for a = x, y, z of the 3-vector at ``column``: the quaternion times one
+    broadcast component, three sums (each in two partial sums)."""
+    zero = quad(0.0, 0.0, 0.0, 0.0)
+    x, y, z, x2, y2, z2 = zero, zero, zero, zero, zero, zero
+    pairs = max(k - 1, 0) // 2
+    for i in range(pairs):
+        j = 1 + 2 * i
+        q, v = load_quad(f, j * ncol + _Q), (k - j) * ncol + column
+        x = fma(q, load_broadcast_quad(f, v), x)
+        y = fma(q, load_broadcast_quad(f, v + 1), y)
+        z = fma(q, load_broadcast_quad(f, v + 2), z)
+        q, v = load_quad(f, (j + 1) * ncol + _Q), (k - j - 1) * ncol + column
+        x2 = fma(q, load_broadcast_quad(f, v), x2)
+        y2 = fma(q, load_broadcast_quad(f, v + 1), y2)
+        z2 = fma(q, load_broadcast_quad(f, v + 2), z2)
+    for j in range(1 + 2 * pairs, k):
+        q, v = load_quad(f, j * ncol + _Q), (k - j) * ncol + column
+        x = fma(q, load_broadcast_quad(f, v), x)
+        y = fma(q, load_broadcast_quad(f, v + 1), y)
+        z = fma(q, load_broadcast_quad(f, v + 2), z)
+    return x + x2, y + y2, z + z2
+
+
+@jit(inline=INLINE)
+def _with_newest(f, column, k, q, v, x, y, z):
+    """The sums of :func:`_quaternion_times_components` completed with their j = 0 and j = k terms: the
+    newest v^[k] and q^[k] come in registers (``v``, ``q``), not from memory. (One exit and no branch
+    around the array reads: numba then drops the reference counting of ``f`` in the inlined code.)"""
+    later = 1.0 if k > 0 else 0.0  # at k = 0 the two terms are one
+    q0 = load_quad(f, _Q) * later
+    x = fma(q, load_broadcast_quad(f, column) * later, fma(q0, _lane_x(v), x))
+    y = fma(q, load_broadcast_quad(f, column + 1) * later, fma(q0, _lane_y(v), y))
+    z = fma(q, load_broadcast_quad(f, column + 2) * later, fma(q0, _lane_z(v), z))
+    first = 1.0 - later
+    return fma(q * first, _lane_x(v), x), fma(q * first, _lane_y(v), y), fma(q * first, _lane_z(v), z)
+
+
+@jit(inline=INLINE)
+def _rotated_pairs(f, ncol, column, k, v):
+    """Order k of (v_y v_z, v_z v_x, v_x v_y) for the 3-vector at ``column`` (rotated copies stored), its
+    newest order ``v`` in a register."""
+    later = 1.0 if k > 0 else 0.0
+    total = _inner_sum(f, ncol, column + _YZX, column + _ZXY, k, 1)
+    total = fma(load_quad(f, column + _YZX) * later, _zxy(v), total)
+    total = fma(_yzx(v) * later, load_quad(f, column + _ZXY), total)
+    return fma(_yzx(v) * (1.0 - later), _zxy(v), total)
+
+
+@jit(inline=INLINE)
+def _perturber_pairs(f, ncol, b, k, m, q):
+    """Order k of (ρ_y ρ_z, ρ_z ρ_x, ρ_x ρ_y) of perturber block b's body-frame ρ, storing c and ρ_body.
+
+    c = u × ρ (ρ truncated at order m, so the sum is short), then ρ_body = ρ + 2 (u × c − q₀ c) as
+    ρ − 2 vec((0, c) ⊗ q); q^[k] comes in a register.
     """
-    x = 0.0
-    y = 0.0
-    z = 0.0
-    for j in range(k + 1):
-        x += s[a, j] * s[b, k - j]
-        y += s[a + a_stride, j] * s[b + 1, k - j]
-        z += s[a + 2 * a_stride, j] * s[b + 2, k - j]
-    return x, y, z
+    lo = max(0, k - m)  # ρ is zero above order m
+    cross = (_inner_sum(f, ncol, _U_YZX, b + _RHO + _ZXY, k, max(lo, 1))
+             - _inner_sum(f, ncol, _U_ZXY, b + _RHO + _YZX, k, max(lo, 1)))
+    if lo == 0 and k > 0:
+        cross = fma(load_quad(f, _U_YZX), load_quad(f, k * ncol + b + _RHO + _ZXY), cross)
+        cross = fma(-load_quad(f, _U_ZXY), load_quad(f, k * ncol + b + _RHO + _YZX), cross)
+    cross = fma(_u_yzx(q), load_quad(f, b + _RHO + _ZXY), cross)
+    cross = fma(-_u_zxy(q), load_quad(f, b + _RHO + _YZX), cross)
+    store_quad(f, k * ncol + b + _C, cross)
+    x, y, z = _quaternion_times_components(f, ncol, b + _C, k)
+    x, y, z = _with_newest(f, b + _C, k, q, cross, x, y, z)
+    product = quad(1.0, -1.0, 1.0, 0.0) * _e_x(x) + quad(1.0, 1.0, -1.0, 0.0) * _e_y(y) \
+        + quad(-1.0, 1.0, 1.0, 0.0) * _e_z(z)
+    body = load_quad(f, k * ncol + b + _RHO) - 2.0 * product if k <= m else -2.0 * product
+    _store_rotated(f, k * ncol + b + _B, body)
+    return _rotated_pairs(f, ncol, b + _B, k, body)
 
 
-@jit(inline="always")
-def _set_vector(s, row, k, x, y, z):
-    """The order-k coefficients of the 3-vector series in rows row, row + 1, row + 2."""
-    s[row, k] = x
-    s[row + 1, k] = y
-    s[row + 2, k] = z
+@jit(inline=INLINE)
+def _dot(a, b):
+    """a · b of two 3-vector quads (fourth lanes zero)."""
+    product = a * b
+    return quad_lane(product, 0) + quad_lane(product, 1) + quad_lane(product, 2)
 
 
-@jit(inline="always")
-def _cauchy_cross(s, a, b, k, lo):
-    """k-th coefficient of the cross product of the 3-row series at rows a and b: Σ_{j=lo}^{k} a^[j] × b^[k−j].
+@jit(inline=INLINE)
+def _orbit_series_into(f, ncol, b, kind, order, mu_orbit, h_bound, orbit_tol_sq):
+    """A perturber's orbit columns (r, |r|², |r|⁻⁵ᐟ², ρ = |r|⁻⁵ᐟ² r) to its truncation order m, which it returns.
 
-    ``lo`` > 0 skips the terms where b^[k−j] is known to be zero (a truncated orbit series).
+    Independent of the attitude, so computed before it. A Kepler perturber's two-body motion
+    r'' = −μ_orbit r |r|⁻³ fills r and v up to m (module docstring, *Truncated orbit series*); a
+    sampled one's r rows are given (cubic), m = order; a fixed one has m = 0. ρ carries the torque's
+    |r|⁻⁵ as the square of its |r|⁻⁵ᐟ², so that the torque needs no product with a |r|⁻⁵ series at
+    the attitude's orders (module docstring, *Torque*). The powers u = |r|^α follow
+    k |r|²^[0] u^[k] = Σ_{j<k} (α(k − j) − j) |r|²^[k−j] u^[j]; each order's newest r and v stay in
+    registers, and every sum adds its newest terms last (module docstring, *Latency*).
     """
-    x = 0.0
-    y = 0.0
-    z = 0.0
-    for j in range(lo, k + 1):
-        ax, ay, az = s[a, j], s[a + 1, j], s[a + 2, j]
-        bx, by, bz = s[b, k - j], s[b + 1, k - j], s[b + 2, k - j]
-        x += ay * bz - az * by
-        y += az * bx - ax * bz
-        z += ax * by - ay * bx
-    return x, y, z
+    m = 0 if kind == KIND_FIXED else order
+    kepler = kind == KIND_KEPLER
+    r0 = load_quad(f, b + _X)
+    r2_0 = _dot(r0, r0)
+    inv_r2 = 1.0 / r2_0
+    inv_v2 = 1.0 / _dot(load_quad(f, b + _V), load_quad(f, b + _V))
+    root = math.sqrt(r2_0)
+    s52_0 = 1.0 / (r2_0 * math.sqrt(root))  # |r|⁻⁵ᐟ² and |r|⁻³ without a power function
+    s3_0 = 1.0 / (r2_0 * root)
+    f[b + _R2], f[b + _S52], f[b + _S3] = r2_0, s52_0, s3_0
+    r, v = r0, load_quad(f, b + _V)
+    s52, s3 = s52_0, s3_0
+    h_pow_sq = 1.0  # h_bound^(2k), by one product per order (no power function in the loop)
+    for k in range(order):
+        if k > m:
+            break
+        row = k * ncol + b
+        if not kepler:
+            r = load_quad(f, row + _X)  # given (sampled) or constant (fixed)
+        rho = quad(0.0, 0.0, 0.0, 0.0)
+        acceleration = quad(0.0, 0.0, 0.0, 0.0)
+        if k > 0:
+            r2 = 2.0 * _dot(r0, r) + _dot(_inner_sum(f, ncol, b + _X, b + _X, k, 1), quad(1.0, 1.0, 1.0, 0.0))
+            power52 = 0.0
+            power3 = 0.0
+            for j in range(1, k):
+                r2_j = f[(k - j) * ncol + b + _R2]
+                power52 += (-1.25 * (k - j) - j) * r2_j * f[j * ncol + b + _S52]
+                power3 += (-1.5 * (k - j) - j) * r2_j * f[j * ncol + b + _S3]
+                r_j = load_quad(f, (k - j) * ncol + b + _X)
+                rho = fma(load_broadcast_quad(f, j * ncol + b + _S52), r_j, rho)
+                acceleration = fma(load_broadcast_quad(f, j * ncol + b + _S3), r_j, acceleration)
+            inverse_k_a0 = inv_r2 * _RECIPROCALS[k - 1]
+            s52 = (power52 - 1.25 * k * r2 * s52_0) * inverse_k_a0
+            s3 = (power3 - 1.5 * k * r2 * s3_0) * inverse_k_a0
+            f[row + _R2], f[row + _S52], f[row + _S3] = r2, s52, s3
+            rho = fma(quad(s52_0, s52_0, s52_0, s52_0), r, rho)
+            acceleration = fma(quad(s3_0, s3_0, s3_0, s3_0), r, acceleration)
+        rho = fma(quad(s52, s52, s52, s52), r0, rho)
+        _store_rotated(f, row + _RHO, rho)
+        if kepler and k < m:
+            acceleration = fma(quad(s3, s3, s3, s3), r0, acceleration)
+            inverse = _RECIPROCALS[k]
+            r_next = v * inverse
+            v_next = acceleration * (-mu_orbit * inverse)
+            store_quad(f, row + ncol + _X, r_next)
+            store_quad(f, row + ncol + _V, v_next)
+            h_pow_sq_next = h_pow_sq * h_bound * h_bound
+            if k >= 1 and _orbit_term_sq(r, v, inv_r2, inv_v2) * h_pow_sq < orbit_tol_sq \
+                    and _orbit_term_sq(r_next, v_next, inv_r2, inv_v2) * h_pow_sq_next < orbit_tol_sq:
+                m = k + 1
+            r, v = r_next, v_next
+            h_pow_sq = h_pow_sq_next
+    return m
 
 
-@jit(inline="always")
-def _power(s, u, a, alpha, k):
-    """k-th coefficient (k ≥ 1) of u = a^alpha from u's lower ones: k a₀ u_k = Σ (α(k−j) − j) a_{k−j} u_j."""
-    acc = 0.0
-    for j in range(k):
-        acc += (alpha * (k - j) - j) * s[a, k - j] * s[u, j]
-    return acc / (k * s[a, 0])
+@jit(fastmath=FUSED_MULTIPLY_ADD)
+def taylor_coefficients_into(t, model, s, n_pert, order, h_bound, orbit_tol, orbit_orders):
+    """Fill the series array s (≥ order+1 rows, :func:`series_array`) with the Taylor coefficients at t.
+
+    On entry s[0, 0:7] holds the state (unit q, ω) and the perturbers' order-0 columns are seeded
+    (:func:`seed_perturbers`). Attitude and torque get orders 0..order. A Keplerian perturber's orbit
+    series (position, |r|², |r|⁻⁵ᐟ², ρ) stops at the first order m after which two consecutive terms,
+    at the largest step ``h_bound``, are below ``orbit_tol`` relative to |r| and |v|: the Sun's orbit
+    varies ~300× slower than the attitude, so m ≈ 5 instead of p (module docstring).
+    ``orbit_orders[p]`` receives m (``order`` for a sampled perturber, 0 for a fixed one); 0 < orbit_tol.
+
+    The orbit series do not depend on the attitude, so they are computed first, each to its own m
+    (:func:`_orbit_series_into`); then order by order the torque and the attitude.
+    """
+    ncol = s.shape[1]
+    f = s.reshape(-1)
+    a_mom, b_mom, c_mom = model[BODY_A], model[BODY_B], model[BODY_C]
+    inverse_moments = quad(1.0 / a_mom, 1.0 / b_mom, 1.0 / c_mom, 0.0)
+    euler_factors = quad(b_mom - c_mom, c_mom - a_mom, a_mom - b_mom, 0.0)
+    torque_factors = quad(c_mom - b_mom, a_mom - c_mom, b_mom - a_mom, 0.0)
+    signs_x, signs_y, signs_z = quad(-1.0, 1.0, 1.0, -1.0), quad(-1.0, -1.0, 1.0, 1.0), quad(-1.0, 1.0, -1.0, 1.0)
+    zero = quad(0.0, 0.0, 0.0, 0.0)
+    _store_attitude(f, 0, load_quad(f, _Q), quad(f[_W], f[_W + 1], f[_W + 2], 0.0))
+    orbit_tol_sq = orbit_tol * orbit_tol
+    for p in range(n_pert):
+        row = MODEL_PERTURBERS + 1 + p * PERTURBER_ROW
+        kind = int(model[row])
+        orbit_orders[p] = _orbit_series_into(f, ncol, _HEAD_COLUMNS + p * _BLOCK_COLUMNS, kind, order,
+                                             model[row + 2 + K_MU], h_bound, orbit_tol_sq)
+    q = load_quad(f, _Q)
+    w = quad(f[_W], f[_W + 1], f[_W + 2], 0.0)
+    for k in range(order):
+        # --- torque N^[k] = Σ 3μ ((C − B) ρ_y ρ_z, (A − C) ρ_z ρ_x, (B − A) ρ_x ρ_y) of each ρ_body
+        torque = zero
+        for p in range(n_pert):
+            mu = model[MODEL_PERTURBERS + 1 + p * PERTURBER_ROW + 1]
+            pairs = _perturber_pairs(f, ncol, _HEAD_COLUMNS + p * _BLOCK_COLUMNS, k, orbit_orders[p], q)
+            torque = fma(torque_factors * (3.0 * mu), pairs, torque)
+        store_quad(f, k * ncol + _N, torque)
+        # --- Euler: A ω̇x = (B − C) ωy ωz + Nx, cyclic; and q̇ = ½ q ⊗ (0, ω) = ½ Σ_a P_a(q ω_a)
+        sx, sy, sz = _quaternion_times_components(f, ncol, _W, k)
+        sx, sy, sz = _with_newest(f, _W, k, q, w, sx, sy, sz)
+        inverse = _RECIPROCALS[k]
+        w_next = fma(euler_factors, _rotated_pairs(f, ncol, _W, k, w), torque) * inverse_moments * inverse
+        q_next = (signs_x * _p_x(sx) + signs_y * _p_y(sy) + signs_z * _p_z(sz)) * (0.5 * inverse)
+        _store_attitude(f, (k + 1) * ncol, q_next, w_next)
+        q, w = q_next, w_next
 
 
 @jit
 def seed_perturbers(t, model, s, n_pert, t_stop, direction, h_last, orbit_orders, kepler_exact):
-    """Order-0 rows of each perturber at time t (all rows of a sampled one); returns the step limit.
+    """Order-0 columns of each perturber at time t (all orders of a sampled one); returns the step limit.
 
     Sampled perturbers write their whole (cubic) series and limit the step to the boundary of their
     Hermite interval in the direction of integration; Kepler and fixed ones impose no limit
     (``t_stop`` returned unchanged). With ``kepler_exact`` False a Kepler perturber is advanced by its
     own Taylor polynomial of the last step (length h_last, orders ≤ orbit_orders[p]) instead of a
-    Kepler solve (module docstring: KEPLER_RESEED_INTERVAL).
+    Kepler solve (module docstring: KEPLER_RESEED_INTERVAL). A Kepler perturber's higher orders need no
+    clearing: the recurrences write every order they read.
     """
+    ncol = s.shape[1]
+    flat = s.reshape(-1)
     for p in range(n_pert):
         row = MODEL_PERTURBERS + 1 + p * PERTURBER_ROW
         kind = int(model[row])
         off = row + 2
-        base = _HEAD_ROWS + p * _BLOCK_ROWS
+        base = _HEAD_COLUMNS + p * _BLOCK_COLUMNS
         if kind == KIND_KEPLER and not kepler_exact:
             m = orbit_orders[p]
-            for i in range(6):
-                acc = s[base + i, m]
-                for k in range(m - 1, -1, -1):
-                    acc = acc * h_last + s[base + i, k]
-                s[base + i, 0] = acc
-                for k in range(1, m + 1):
-                    s[base + i, k] = 0.0
+            position = load_quad(flat, m * ncol + base + _X)
+            velocity = load_quad(flat, m * ncol + base + _V)
+            for k in range(m - 1, -1, -1):
+                position = fma(position, h_last, load_quad(flat, k * ncol + base + _X))
+                velocity = fma(velocity, h_last, load_quad(flat, k * ncol + base + _V))
+            store_quad(flat, base + _X, position)
+            store_quad(flat, base + _V, velocity)
             continue
-        for i in range(6):
-            for k in range(s.shape[1]):
-                s[base + i, k] = 0.0
+        if kind != KIND_KEPLER:
+            for k in range(s.shape[0]):
+                for i in range(8):
+                    s[k, base + _X + i] = 0.0
         if kind == KIND_KEPLER:
             px, py, vx, vy = kepler_perifocal(t, model[off + K_A], model[off + K_E], model[off + K_M0],
                                                model[off + K_T0], model[off + K_MEAN_MOTION], model[off + K_ROOT])
             for i in range(3):
-                s[base + _X + i, 0] = model[off + K_P + i] * px + model[off + K_Q + i] * py
-                s[base + _V + i, 0] = model[off + K_P + i] * vx + model[off + K_Q + i] * vy
+                s[0, base + _X + i] = model[off + K_P + i] * px + model[off + K_Q + i] * py
+                s[0, base + _V + i] = model[off + K_P + i] * vx + model[off + K_Q + i] * vy
         elif kind == KIND_SAMPLED:
             first, count, xv_first = int(model[off]), int(model[off + 1]), int(model[off + 2])
             lo = find_interval(t, model, first, count)
@@ -190,182 +416,33 @@ def seed_perturbers(t, model, s, n_pert, t_stop, direction, h_last, orbit_orders
                 # Hermite cubic in x ∈ [0, 1]: p(x) = c0 + c1 x + c2 x² + c3 x³, re-expanded about x.
                 p0, p1, d0, d1 = model[i0 + i], model[i1 + i], h * model[i0 + 3 + i], h * model[i1 + 3 + i]
                 c1, c2, c3 = d0, 3.0 * (p1 - p0) - 2.0 * d0 - d1, 2.0 * (p0 - p1) + d0 + d1
-                s[base + _X + i, 0] = p0 + x * (c1 + x * (c2 + x * c3))
-                s[base + _X + i, 1] = (c1 + x * (2.0 * c2 + x * 3.0 * c3)) / h
-                s[base + _X + i, 2] = (c2 + 3.0 * c3 * x) / (h * h)
-                s[base + _X + i, 3] = c3 / (h * h * h)
+                s[0, base + _X + i] = p0 + x * (c1 + x * (c2 + x * c3))
+                s[1, base + _X + i] = (c1 + x * (2.0 * c2 + x * 3.0 * c3)) / h
+                s[2, base + _X + i] = (c2 + 3.0 * c3 * x) / (h * h)
+                s[3, base + _X + i] = c3 / (h * h * h)
             end = model[lo + 1] if direction > 0.0 else t_lo
             if direction * (end - t) > 0.0 and direction * (end - t_stop) < 0.0:
                 t_stop = end
         else:  # KIND_FIXED
             for i in range(3):
-                s[base + _X + i, 0] = model[off + i]
+                s[0, base + _X + i] = model[off + i]
     return t_stop
 
 
-@jit(inline="always")
-def _orbit_series_into(s, b, kind, order, mu_orbit, h_bound, orbit_tol_sq):
-    """A perturber's orbit rows (r, |r|², |r|⁻⁵ᐟ², ρ = |r|⁻⁵ᐟ² r) to its truncation order m, which it returns.
+@jit(inline=INLINE)
+def _orbit_term_sq(r, v, inv_r2, inv_v2):
+    """The largest of (r_i^[k])²/|r|² and (v_i^[k])²/|v|² over the components i of one order's position and
+    velocity: its k-th coefficient, relative, squared.
 
-    Independent of the attitude, so computed before it. A Kepler perturber's two-body motion
-    r'' = −μ_orbit r |r|⁻³ fills r and v up to m (module docstring, *Truncated orbit series*); a
-    sampled one's r rows are given (cubic), m = order; a fixed one has m = 0. ρ carries the torque's
-    |r|⁻⁵ as the square of its |r|⁻⁵ᐟ², so that the torque needs no product with a |r|⁻⁵ series at
-    the attitude's orders (module docstring, *Torque*).
-    """
-    m = 0 if kind == KIND_FIXED else order
-    r2 = s[b + _X, 0] * s[b + _X, 0] + s[b + _X + 1, 0] * s[b + _X + 1, 0] + s[b + _X + 2, 0] * s[b + _X + 2, 0]
-    inv_r2 = 1.0 / r2
-    inv_v2 = 1.0 / (s[b + _V, 0] ** 2 + s[b + _V + 1, 0] ** 2 + s[b + _V + 2, 0] ** 2)
-    h_pow_sq = 1.0  # h_bound^(2k), by one product per order (no power function in the loop)
-    for k in range(order):
-        if k > m:
-            break
-        h_pow_sq_next = h_pow_sq * h_bound * h_bound
-        x2, y2, z2 = _cauchy_vector(s, b + _X, b + _X, 1, k)
-        s[b + _R2, k] = x2 + y2 + z2
-        if k == 0:
-            s[b + _S52, 0] = 1.0 / (r2 * math.sqrt(math.sqrt(r2)))  # |r|⁻⁵ᐟ² without a power function
-        else:
-            s[b + _S52, k] = _power(s, b + _S52, b + _R2, -1.25, k)
-        rx, ry, rz = _cauchy_vector(s, b + _S52, b + _X, 0, k)
-        _set_vector(s, b + _RHO, k, rx, ry, rz)
-        if kind == KIND_KEPLER and k < m:
-            if k == 0:
-                s[b + _S3, 0] = 1.0 / (r2 * math.sqrt(r2))
-            else:
-                s[b + _S3, k] = _power(s, b + _S3, b + _R2, -1.5, k)
-            inv = 1.0 / (k + 1)
-            ax, ay, az = _cauchy_vector(s, b + _S3, b + _X, 0, k)
-            for i in range(3):
-                s[b + _X + i, k + 1] = s[b + _V + i, k] * inv
-            _set_vector(s, b + _V, k + 1, -mu_orbit * ax * inv, -mu_orbit * ay * inv, -mu_orbit * az * inv)
-            if k >= 1 and _orbit_term_sq(s, b, k, inv_r2, inv_v2) * h_pow_sq < orbit_tol_sq \
-                    and _orbit_term_sq(s, b, k + 1, inv_r2, inv_v2) * h_pow_sq_next < orbit_tol_sq:
-                m = k + 1
-        h_pow_sq = h_pow_sq_next
-    return m
-
-
-@jit(fastmath=FUSED_MULTIPLY_ADD)
-def taylor_coefficients_into(t, model, s, n_pert, order, h_bound, orbit_tol, orbit_orders):
-    """Fill the series array s (rows × ≥ order+1) with the Taylor coefficients at t.
-
-    On entry s[0:7, 0] holds the state (unit q) and the perturber rows are seeded
-    (:func:`seed_perturbers`). Attitude and torque rows get orders 0..order. A Keplerian
-    perturber's orbit series (position, |r|², |r|⁻⁵ᐟ², ρ) stops at the first order m after which two
-    consecutive terms, at the largest step ``h_bound``, are below ``orbit_tol`` relative to |r| and |v|:
-    the Sun's orbit varies ~300× slower than the attitude, so m ≈ 5 instead of p (module docstring).
-    ``orbit_orders[p]`` receives m (``order`` for a sampled perturber, 0 for a fixed one); 0 < orbit_tol.
-
-    The orbit series do not depend on the attitude, so they are computed first, each to its own m
-    (:func:`_orbit_series_into`); then order by order the torque and the attitude. Fused multiply-adds
-    (``jit.FUSED_MULTIPLY_ADD``): the step is Cauchy products.
-    """
-    a_mom, b_mom, c_mom = model[BODY_A], model[BODY_B], model[BODY_C]
-    orbit_tol_sq = orbit_tol * orbit_tol
-    for p in range(n_pert):
-        row = MODEL_PERTURBERS + 1 + p * PERTURBER_ROW
-        kind = int(model[row])
-        orbit_orders[p] = _orbit_series_into(s, _HEAD_ROWS + p * _BLOCK_ROWS, kind, order, model[row + 2 + K_MU],
-                                             h_bound, orbit_tol_sq)
-    for k in range(order):
-        # --- torque N^[k]
-        nx = 0.0
-        ny = 0.0
-        nz = 0.0
-        for p in range(n_pert):
-            mu = model[MODEL_PERTURBERS + 1 + p * PERTURBER_ROW + 1]
-            b = _HEAD_ROWS + p * _BLOCK_ROWS
-            m = orbit_orders[p]
-            lo = max(0, k - m)  # ρ is zero above order m
-            # c = u × ρ, u = (q1, q2, q3)
-            cx, cy, cz = _cauchy_cross(s, _Q0 + 1, b + _RHO, k, lo)
-            _set_vector(s, b + _C, k, cx, cy, cz)
-            # ρ_body = ρ + 2 (u × c − q0 c)
-            bx = 0.0
-            by = 0.0
-            bz = 0.0
-            for j in range(k + 1):
-                q0, q1, q2, q3 = s[_Q0, j], s[_Q0 + 1, j], s[_Q0 + 2, j], s[_Q0 + 3, j]
-                cx, cy, cz = s[b + _C, k - j], s[b + _C + 1, k - j], s[b + _C + 2, k - j]
-                bx += q2 * cz - q3 * cy - q0 * cx
-                by += q3 * cx - q1 * cz - q0 * cy
-                bz += q1 * cy - q2 * cx - q0 * cz
-            xk = s[b + _RHO, k] if k <= m else 0.0
-            yk = s[b + _RHO + 1, k] if k <= m else 0.0
-            zk = s[b + _RHO + 2, k] if k <= m else 0.0
-            _set_vector(s, b + _B, k, xk + 2.0 * bx, yk + 2.0 * by, zk + 2.0 * bz)
-            # Pair products (y z, z x, x y) of ρ_body = |r|⁻⁵ (y z, z x, x y) of r_body, then
-            # N = 3μ ((C − B) yz, (A − C) zx, (B − A) xy)
-            # Two partial sums (j < k/2 and the rest, paired as j, k − j): each sum's chain of dependent
-            # fused multiply-adds is half as long (the loop was bound by their latency, 3 per iteration).
-            sx, sy, sz = 0.0, 0.0, 0.0
-            tx, ty, tz = 0.0, 0.0, 0.0
-            half = (k + 1) // 2
-            for j in range(half):
-                i = k - j
-                sx += s[b + _B + 1, j] * s[b + _B + 2, i]
-                sy += s[b + _B + 2, j] * s[b + _B, i]
-                sz += s[b + _B, j] * s[b + _B + 1, i]
-                tx += s[b + _B + 1, i] * s[b + _B + 2, j]
-                ty += s[b + _B + 2, i] * s[b + _B, j]
-                tz += s[b + _B, i] * s[b + _B + 1, j]
-            if 2 * half < k + 1:
-                sx += s[b + _B + 1, half] * s[b + _B + 2, half]
-                sy += s[b + _B + 2, half] * s[b + _B, half]
-                sz += s[b + _B, half] * s[b + _B + 1, half]
-            sx += tx
-            sy += ty
-            sz += tz
-            three_mu = 3.0 * mu
-            nx += three_mu * (c_mom - b_mom) * sx
-            ny += three_mu * (a_mom - c_mom) * sy
-            nz += three_mu * (b_mom - a_mom) * sz
-        _set_vector(s, _N0, k, nx, ny, nz)
-        # --- Euler: A ω̇x = (B − C) ωy ωz + Nx, cyclic; and q̇ = ½ q ⊗ (0, ω)
-        wyz = 0.0
-        wzx = 0.0
-        wxy = 0.0
-        q0w = 0.0
-        q1w = 0.0
-        q2w = 0.0
-        q3w = 0.0
-        for j in range(k + 1):
-            q0, q1, q2, q3 = s[_Q0, j], s[_Q0 + 1, j], s[_Q0 + 2, j], s[_Q0 + 3, j]
-            wxj, wyj, wzj = s[_W0, j], s[_W0 + 1, j], s[_W0 + 2, j]
-            wx, wy, wz = s[_W0, k - j], s[_W0 + 1, k - j], s[_W0 + 2, k - j]
-            wyz += wyj * wz
-            wzx += wzj * wx
-            wxy += wxj * wy
-            q0w += -q1 * wx - q2 * wy - q3 * wz
-            q1w += q0 * wx + q2 * wz - q3 * wy
-            q2w += q0 * wy - q1 * wz + q3 * wx
-            q3w += q0 * wz + q1 * wy - q2 * wx
-        inv = 1.0 / (k + 1)
-        s[_W0, k + 1] = ((b_mom - c_mom) * wyz + nx) / a_mom * inv
-        s[_W0 + 1, k + 1] = ((c_mom - a_mom) * wzx + ny) / b_mom * inv
-        s[_W0 + 2, k + 1] = ((a_mom - b_mom) * wxy + nz) / c_mom * inv
-        half = 0.5 * inv
-        s[_Q0, k + 1] = half * q0w
-        s[_Q0 + 1, k + 1] = half * q1w
-        s[_Q0 + 2, k + 1] = half * q2w
-        s[_Q0 + 3, k + 1] = half * q3w
-
-
-@jit(inline="always")
-def _orbit_term_sq(s, b, k, inv_r2, inv_v2):
-    """max(|r^[k]|²/|r|², |v^[k]|²/|v|²) of the perturber block at row b: its k-th coefficient, relative, squared.
-
-    ``inv_r2``, ``inv_v2``: 1/|r|², 1/|v|² of the block's order-0 rows, computed once per step.
+    ``inv_r2``, ``inv_v2``: 1/|r|², 1/|v|² of the order-0 position and velocity, computed once per step.
 
     Squared, so that the truncation test (times h^2k against orbit_tol²) needs no square root and
     no power function (the square roots and h**k were ~15 % of a Taylor step in scenes (a)–(c)).
     """
-    term = 0.0
-    for i in range(3):
-        term = max(term, s[b + _X + i, k] ** 2 * inv_r2, s[b + _V + i, k] ** 2 * inv_v2)
-    return term
+    scaled = r * r * inv_r2
+    speeds = v * v * inv_v2
+    return max(quad_lane(scaled, 0), quad_lane(scaled, 1), quad_lane(scaled, 2),
+               quad_lane(speeds, 0), quad_lane(speeds, 1), quad_lane(speeds, 2))
 
 
 @jit
@@ -373,9 +450,9 @@ def scaled_norm(s, k, w_scale):
     """Max over the scaled components of the order-k coefficients (see the module docstring)."""
     norm = 0.0
     for i in range(4):
-        norm = max(norm, abs(s[_Q0 + i, k]))
+        norm = max(norm, abs(s[k, _Q + i]))
     for i in range(3):
-        norm = max(norm, abs(s[_W0 + i, k]) / w_scale)
+        norm = max(norm, abs(s[k, _W + i]) / w_scale)
     return norm
 
 
@@ -391,23 +468,40 @@ def orbit_radius(s, n_pert, orbit_orders, order):
         m = orbit_orders[p]
         if m < 2 or m < order:
             continue
-        b = _HEAD_ROWS + p * _BLOCK_ROWS
-        r = math.sqrt(s[b + _X, 0] ** 2 + s[b + _X + 1, 0] ** 2 + s[b + _X + 2, 0] ** 2)
-        v = math.sqrt(s[b + _V, 0] ** 2 + s[b + _V + 1, 0] ** 2 + s[b + _V + 2, 0] ** 2)
+        b = _HEAD_COLUMNS + p * _BLOCK_COLUMNS
+        r = math.sqrt(s[0, b + _X] ** 2 + s[0, b + _X + 1] ** 2 + s[0, b + _X + 2] ** 2)
+        v = math.sqrt(s[0, b + _V] ** 2 + s[0, b + _V + 1] ** 2 + s[0, b + _V + 2] ** 2)
         if v == 0.0:
             continue
         for k in (m - 1, m):
             nk = 0.0
             for i in range(3):
-                nk = max(nk, abs(s[b + _X + i, k]) / r, abs(s[b + _V + i, k]) / v)
+                nk = max(nk, abs(s[k, b + _X + i]) / r, abs(s[k, b + _V + i]) / v)
             if nk > 0.0:
                 rho = min(rho, nk ** (-1.0 / k))
     return rho
 
 
 @jit(fastmath=FUSED_MULTIPLY_ADD)
+def state_at(s, order, dt, out):
+    """out[0:7] = the state's Taylor polynomial at t + dt: Σ_k s[k, 0:7] dt^k (q and ω as two Horner chains)."""
+    ncol = s.shape[1]
+    f = s.reshape(-1)
+    q = load_quad(f, order * ncol + _Q)
+    w = load_quad(f, order * ncol + _W)
+    for k in range(order - 1, -1, -1):
+        q = fma(q, dt, load_quad(f, k * ncol + _Q))
+        w = fma(w, dt, load_quad(f, k * ncol + _W))
+    for i in range(4):
+        out[i] = quad_lane(q, i)
+    for i in range(3):
+        out[4 + i] = quad_lane(w, i)
+
+
+@jit(fastmath=FUSED_MULTIPLY_ADD)
 def horner(s, rows, order, dt, out):
-    """out[i] = Σ_k s[i, k] dt^k for i < rows (the Taylor polynomial at t + dt); ``out`` is not a view of s.
+    """out[i] = Σ_k s[i, k] dt^k for i < rows of a row-major series (the variational equations' own
+    series: row i, order k); ``out`` is not a view of s.
 
     Four rows' Horner sums in one loop: each is a chain of ``order`` dependent multiply-adds, and four
     independent chains side by side take about the time of one (one row after the other, the chains
@@ -443,17 +537,20 @@ def taylor_series(t, y, model, order):
     n_pert = int(model[MODEL_PERTURBERS])
     s = series_array(n_pert, order)
     for i in range(STATE_SIZE):
-        s[i, 0] = y[i]
+        s[0, i] = y[i]
     norm = math.sqrt(y[0] ** 2 + y[1] ** 2 + y[2] ** 2 + y[3] ** 2)
     for i in range(4):
-        s[i, 0] /= norm
+        s[0, i] /= norm
     seed_perturbers(t, model, s, n_pert, np.inf, 1.0, 0.0, np.zeros(max(n_pert, 1), dtype=np.int64), True)
     taylor_coefficients_into(t, model, s, n_pert, order, 0.0, 0.0, np.zeros(max(n_pert, 1), dtype=np.int64))
-    return s[:STATE_SIZE].copy()
+    return s[:, :STATE_SIZE].T.copy()
 
 
-#: Public names of the series array's layout, for modules that read the rows this one fills (the Taylor
-#: variational equations need each perturber's body-frame ρ = |r|⁻⁵ᐟ² r_body).
-SERIES_HEAD_ROWS = _HEAD_ROWS
-PERTURBER_BLOCK_ROWS = _BLOCK_ROWS
+#: Layout of the series array, for modules that read the columns this one fills: the state's ω starts
+#: at OMEGA_COLUMN (q in columns 0–3, as in y), perturber p's block at SERIES_HEAD_COLUMNS +
+#: p·PERTURBER_BLOCK_COLUMNS, and its body-frame ρ = |r|⁻⁵ᐟ² r_body (x, y, z) at SCALED_BODY_POSITION_OFFSET
+#: in the block (the Taylor variational equations build the tidal tensor from it).
+OMEGA_COLUMN = _W
+SERIES_HEAD_COLUMNS = _HEAD_COLUMNS
+PERTURBER_BLOCK_COLUMNS = _BLOCK_COLUMNS
 SCALED_BODY_POSITION_OFFSET = _B

@@ -65,14 +65,16 @@ from spinorbit.core.integrators.taylor import (
     taylor_order,
 )
 from spinorbit.core.integrators.taylor_recurrences import (
-    PERTURBER_BLOCK_ROWS,
+    OMEGA_COLUMN,
+    PERTURBER_BLOCK_COLUMNS,
     SCALED_BODY_POSITION_OFFSET,
-    SERIES_HEAD_ROWS,
+    SERIES_HEAD_COLUMNS,
     horner,
     orbit_radius,
     scaled_norm,
     seed_perturbers,
     series_array,
+    state_at,
     taylor_coefficients_into,
 )
 from spinorbit.core.integrators.variational import (
@@ -91,7 +93,7 @@ VARIATIONAL_SIZE = V_PSI + LOCAL_SIZE * PARAMETER_SIZE
 #: Rows of the tidal tensor's series, and the pairs of body-frame coordinates each one multiplies.
 T_XX, T_YY, T_ZZ, T_YZ, T_ZX, T_XY = 0, 1, 2, 3, 4, 5
 TIDAL_PAIRS = ((0, 0), (1, 1), (2, 2), (1, 2), (2, 0), (0, 1))
-_W0 = 4  # ω's first row in the state's series
+_W0 = OMEGA_COLUMN  # ω's first column in the state's series
 
 
 @jit
@@ -106,13 +108,13 @@ def tidal_series_into(model, s, n_pert, order, tidal):
             tidal[c, k] = 0.0
     for p in range(n_pert):
         three_mu = 3.0 * model[MODEL_PERTURBERS + 1 + p * PERTURBER_ROW + 1]
-        rb = SERIES_HEAD_ROWS + p * PERTURBER_BLOCK_ROWS + SCALED_BODY_POSITION_OFFSET
+        rb = SERIES_HEAD_COLUMNS + p * PERTURBER_BLOCK_COLUMNS + SCALED_BODY_POSITION_OFFSET
         for c in range(6):
             a, b = TIDAL_PAIRS[c]
             for k in range(order):
                 acc = 0.0
                 for j in range(k + 1):
-                    acc += s[rb + a, j] * s[rb + b, k - j]
+                    acc += s[j, rb + a] * s[k - j, rb + b]
                 tidal[c, k] += three_mu * acc
 
 
@@ -136,7 +138,7 @@ def variational_series_into(model, s, tidal, v, order):
             dby = 0.0
             dbz = 0.0
             for j in range(k + 1):
-                wx, wy, wz = s[_W0, j], s[_W0 + 1, j], s[_W0 + 2, j]
+                wx, wy, wz = s[j, _W0], s[j, _W0 + 1], s[j, _W0 + 2]
                 txx, tyy, tzz = tidal[T_XX, j], tidal[T_YY, j], tidal[T_ZZ, j]
                 tyz, tzx, txy = tidal[T_YZ, j], tidal[T_ZX, j], tidal[T_XY, j]
                 ax, ay, az = v[r0, k - j], v[r1, k - j], v[r2, k - j]
@@ -157,9 +159,9 @@ def variational_series_into(model, s, tidal, v, order):
                 ey = -tidal[T_ZX, k]
                 ez = -tidal[T_XY, k]
                 for j in range(k + 1):
-                    ex += s[_W0 + 1, j] * s[_W0 + 2, k - j]
-                    ey += s[_W0 + 2, j] * s[_W0, k - j]
-                    ez += s[_W0, j] * s[_W0 + 1, k - j]
+                    ex += s[j, _W0 + 1] * s[k - j, _W0 + 2]
+                    ey += s[j, _W0 + 2] * s[k - j, _W0]
+                    ez += s[j, _W0] * s[k - j, _W0 + 1]
                 if c == 0:
                     dbx += -c_mom * (b_mom - c_mom) * ex / (a_mom * a_mom)
                     dby += -c_mom * ey / b_mom
@@ -233,7 +235,7 @@ def integrate_taylor_variational_kernel(y0, t0, t_out, model, tol, max_steps):
             stats[STAT_STATUS] = STATUS_MAX_STEPS
             return ys, vs, stats
         for i in range(n):
-            s[i, 0] = y[i]
+            s[0, i] = y[i]
         for i in range(VARIATIONAL_SIZE):
             v[i, 0] = var[i]
         exact = steps % KEPLER_RESEED_INTERVAL == 0
@@ -261,11 +263,11 @@ def integrate_taylor_variational_kernel(y0, t0, t_out, model, tol, max_steps):
         stats[STAT_STEPS] += 1
         stats[STAT_ORDER_SUM] += order
         while i_out < n_out and direction * (t_out[i_out] - t_new) <= 0.0:
-            horner(s, n, order, t_out[i_out] - t, ys[i_out])
+            state_at(s, order, t_out[i_out] - t, ys[i_out])
             normalize_quaternion_part(ys[i_out])
             horner(v, VARIATIONAL_SIZE, order, t_out[i_out] - t, vs[i_out])
             i_out += 1
-        horner(s, n, order, h, y)
+        state_at(s, order, h, y)
         normalize_quaternion_part(y)
         horner(v, VARIATIONAL_SIZE, order, h, var)
         for i in range(n):

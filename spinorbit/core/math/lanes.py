@@ -1,4 +1,5 @@
-"""Eight doubles in one SIMD register: a numba type for running scalar kernels on eight states at once.
+"""Doubles in one SIMD register: numba types for running scalar kernels on eight states at once, and for
+the 3-vector and quaternion arithmetic of one state four components at a time.
 
 ``Lanes`` is an LLVM ``<8 x double>`` and ``LaneMask`` an ``<8 x i1>``. Arithmetic (+, −, ×, /, unary
 −, ``abs``, ``math.sqrt``, :func:`spinorbit.core.math.ddouble.fma`) and comparisons act lane by lane,
@@ -12,6 +13,13 @@ branches, the lane form keeps each lane's own path with :func:`select` and loops
 Why: the set-up of one torque-free state is bound by the divider and the square root (the AGM and
 Carlson's duplication), which a scalar loop uses one double at a time; ``<8 x double>`` issues eight
 (``docs/design.md``, "Eight states in one register").
+
+``Quad`` is an LLVM ``<4 x double>`` with the same arithmetic (and :func:`~spinorbit.core.math.ddouble.fma`),
+plus what component-wise vector code needs: :func:`quad` (four doubles packed), :func:`quad_lane` (one
+out), :func:`quad_shuffle` (a permutation fixed at compile time, with zeros), :func:`load_quad`,
+:func:`store_quad` and :func:`load_broadcast_quad` (one double of an array in every lane). A quaternion
+fills one, a 3-vector three of its lanes; the Taylor recurrences
+(:mod:`spinorbit.core.integrators.taylor_recurrences`) run their Cauchy products on them.
 """
 
 import math
@@ -23,13 +31,15 @@ from numba.core import cgutils
 from numba.extending import intrinsic, models, overload, register_model
 
 WIDTH = 8
+QUAD_WIDTH = 4
 
 
 class LanesType(types.Type):
-    """numba type of eight doubles in one vector register."""
+    """numba type of ``width`` doubles in one vector register (``Lanes``: 8, ``Quad``: 4)."""
 
-    def __init__(self):
-        super().__init__(name="Lanes")
+    def __init__(self, width, name):
+        self.width = width
+        super().__init__(name=name)
 
 
 class LaneMaskType(types.Type):
@@ -39,16 +49,18 @@ class LaneMaskType(types.Type):
         super().__init__(name="LaneMask")
 
 
-lanes_type = LanesType()
+lanes_type = LanesType(WIDTH, "Lanes")
+quad_type = LanesType(QUAD_WIDTH, "Quad")
 mask_type = LaneMaskType()
 _VECTOR = ir.VectorType(ir.DoubleType(), WIDTH)
+_QUAD = ir.VectorType(ir.DoubleType(), QUAD_WIDTH)
 _MASK = ir.VectorType(ir.IntType(1), WIDTH)
 
 
 @register_model(LanesType)
 class _LanesModel(models.PrimitiveModel):
     def __init__(self, dmm, fe_type):
-        super().__init__(dmm, fe_type, _VECTOR)
+        super().__init__(dmm, fe_type, ir.VectorType(ir.DoubleType(), fe_type.width))
 
 
 @register_model(LaneMaskType)
@@ -57,48 +69,65 @@ class _MaskModel(models.PrimitiveModel):
         super().__init__(dmm, fe_type, _MASK)
 
 
-def _as_vector(context, builder, value, value_type):
-    """The LLVM vector of a Lanes value, or of a number broadcast to every lane."""
-    if value_type == lanes_type:
+def _vector_type_of(*operand_types):
+    """The one vector type among the operands (None if there is none, or two of different widths)."""
+    vectors = {t for t in operand_types if isinstance(t, LanesType)}
+    return vectors.pop() if len(vectors) == 1 else None
+
+
+def _as_vector(context, builder, value, value_type, width=WIDTH):
+    """The LLVM vector of a Lanes or Quad value, or of a number broadcast to ``width`` lanes."""
+    if isinstance(value_type, LanesType):
         return value
     scalar = context.cast(builder, value, value_type, types.float64)
-    return _splat(builder, scalar)
+    return _splat(builder, scalar, width)
 
 
-def _splat(builder, scalar):
-    vector = ir.Constant(_VECTOR, ir.Undefined)
+def _splat(builder, scalar, width=WIDTH):
+    vector = ir.Constant(ir.VectorType(ir.DoubleType(), width), ir.Undefined)
     vector = builder.insert_element(vector, scalar, ir.Constant(ir.IntType(32), 0))
-    return builder.shuffle_vector(vector, vector, ir.Constant(ir.VectorType(ir.IntType(32), WIDTH), [0] * WIDTH))
+    return builder.shuffle_vector(vector, vector, ir.Constant(ir.VectorType(ir.IntType(32), width), [0] * width))
 
 
 def _is_operand(t):
+    return isinstance(t, (LanesType, types.Float, types.Integer))
+
+
+def _is_lanes_operand(t):
+    """Lanes or a number: an operand of the eight-lane selections."""
     return t == lanes_type or isinstance(t, (types.Float, types.Integer))
 
 
-def _lanes_binary(emit, result_type):
+def _are_operands(*operand_types):
+    """All numbers or vectors, with exactly one vector type among them."""
+    return all(_is_operand(t) for t in operand_types) and _vector_type_of(*operand_types) is not None
+
+
+def _lanes_binary(emit, comparison):
     """An intrinsic applying ``emit(builder, x, y)`` to two operands lane by lane (numbers broadcast),
-    returning ``result_type`` (Lanes for arithmetic, LaneMask for comparisons)."""
+    returning their vector type (arithmetic) or LaneMask (``comparison``, eight lanes only)."""
 
     @intrinsic
     def kernel(typingctx, a, b):
-        if not (_is_operand(a) and _is_operand(b) and lanes_type in (a, b)):
+        vector_type = _vector_type_of(a, b)
+        if not _are_operands(a, b) or (comparison and vector_type != lanes_type):
             return None
 
         def codegen(context, builder, signature, args):
-            x = _as_vector(context, builder, args[0], signature.args[0])
-            y = _as_vector(context, builder, args[1], signature.args[1])
+            x = _as_vector(context, builder, args[0], signature.args[0], vector_type.width)
+            y = _as_vector(context, builder, args[1], signature.args[1], vector_type.width)
             return emit(builder, x, y)
 
-        return result_type(a, b), codegen
+        return (mask_type if comparison else vector_type)(a, b), codegen
 
     return kernel
 
 
 def _register_binary(python_operator, kernel):
-    """``python_operator`` on (Lanes or number, Lanes or number), at least one Lanes, by ``kernel``."""
+    """``python_operator`` on (vector or number, vector or number), one vector type, by ``kernel``."""
 
     def implementation(a, b):
-        if _is_operand(a) and _is_operand(b) and lanes_type in (a, b):
+        if _are_operands(a, b):
             return lambda a, b: kernel(a, b)
         return None
 
@@ -108,7 +137,7 @@ def _register_binary(python_operator, kernel):
 for _instruction, _operators in (("fadd", (operator.add, operator.iadd)), ("fsub", (operator.sub, operator.isub)),
                                  ("fmul", (operator.mul, operator.imul)),
                                  ("fdiv", (operator.truediv, operator.itruediv))):
-    _kernel = _lanes_binary(lambda builder, x, y, name=_instruction: getattr(builder, name)(x, y), lanes_type)
+    _kernel = _lanes_binary(lambda builder, x, y, name=_instruction: getattr(builder, name)(x, y), False)
     for _operator in _operators:
         _register_binary(_operator, _kernel)
 
@@ -116,7 +145,7 @@ for _instruction, _operators in (("fadd", (operator.add, operator.iadd)), ("fsub
 for _operator, _predicate in ((operator.lt, "<"), (operator.le, "<="), (operator.gt, ">"),
                               (operator.ge, ">="), (operator.eq, "==")):
     _register_binary(_operator, _lanes_binary(
-        lambda builder, x, y, predicate=_predicate: builder.fcmp_ordered(predicate, x, y), mask_type))
+        lambda builder, x, y, predicate=_predicate: builder.fcmp_ordered(predicate, x, y), True))
 
 
 @intrinsic
@@ -162,17 +191,18 @@ def _overload_invert(a):
 
 
 def _vector_intrinsic(builder, name, *values):
-    """Call the LLVM intrinsic ``name`` on <8 x double> operands (llvmlite names no vector overloads)."""
-    signature = ir.FunctionType(_VECTOR, [_VECTOR] * len(values))
-    function = cgutils.get_or_insert_function(builder.module, signature, f"{name}.v{WIDTH}f64")
+    """Call the LLVM intrinsic ``name`` on <W x double> operands (llvmlite names no vector overloads)."""
+    vector = values[0].type
+    signature = ir.FunctionType(vector, [vector] * len(values))
+    function = cgutils.get_or_insert_function(builder.module, signature, f"{name}.v{vector.count}f64")
     return builder.call(function, list(values))
 
 
 @intrinsic
 def _neg(typingctx, a):
-    if a != lanes_type:
+    if not isinstance(a, LanesType):
         return None
-    return lanes_type(a), lambda context, builder, signature, args: builder.fneg(args[0])
+    return a(a), lambda context, builder, signature, args: builder.fneg(args[0])
 
 
 @intrinsic
@@ -191,7 +221,7 @@ def _sqrt(typingctx, a):
 
 @overload(operator.neg)
 def _overload_neg(a):
-    if a == lanes_type:
+    if isinstance(a, LanesType):
         return lambda a: _neg(a)
     return None
 
@@ -212,22 +242,23 @@ def _overload_sqrt(a):
 
 def fma_typing(a, b, c):
     """(signature, codegen) of a·b + c rounded once in every lane (``llvm.fma``, numbers broadcast)
-    when an operand is ``Lanes``, else None: :func:`spinorbit.core.math.ddouble.fma` takes this branch,
-    so the one fma of the package serves both forms."""
-    if not all(_is_operand(t) for t in (a, b, c)) or lanes_type not in (a, b, c):
+    when an operand is ``Lanes`` or ``Quad``, else None: :func:`spinorbit.core.math.ddouble.fma` takes
+    this branch, so the one fma of the package serves every form."""
+    if not _are_operands(a, b, c):
         return None
+    vector_type = _vector_type_of(a, b, c)
 
     def codegen(context, builder, signature, args):
-        values = [_as_vector(context, builder, v, t) for v, t in zip(args, signature.args)]
+        values = [_as_vector(context, builder, v, t, vector_type.width) for v, t in zip(args, signature.args)]
         return _vector_intrinsic(builder, "llvm.fma", *values)
 
-    return lanes_type(a, b, c), codegen
+    return vector_type(a, b, c), codegen
 
 
 @intrinsic
 def select(typingctx, mask, a, b):
     """Lane by lane: a where ``mask`` holds, else b (numbers broadcast)."""
-    if mask != mask_type or not (_is_operand(a) and _is_operand(b)):
+    if mask != mask_type or not (_is_lanes_operand(a) and _is_lanes_operand(b)):
         return None
 
     def codegen(context, builder, signature, args):
@@ -261,7 +292,7 @@ def broadcast(typingctx, value):
 
 
 def _is_vector_array(t):
-    """A one-dimensional C-contiguous float64 array: eight consecutive doubles are one vector."""
+    """A one-dimensional C-contiguous float64 array: consecutive doubles are one vector."""
     return isinstance(t, types.Array) and t.dtype == types.float64 and t.ndim == 1 and t.layout == "C"
 
 
@@ -305,7 +336,7 @@ def select_tuple(typingctx, mask, new, old):
     """Lane by lane, element by element: ``new`` where ``mask`` holds, else ``old`` (tuples of equal
     length whose elements are Lanes or numbers; numbers broadcast); a tuple of Lanes."""
     if not (mask == mask_type and isinstance(new, types.BaseTuple) and isinstance(old, types.BaseTuple)
-            and len(new) == len(old) and all(_is_operand(t) for t in (*new, *old))):
+            and len(new) == len(old) and all(_is_lanes_operand(t) for t in (*new, *old))):
         return None
     result_type = types.UniTuple(lanes_type, len(new))
 
@@ -380,3 +411,97 @@ def lane_of(typingctx, values, lane):
         return result
 
     return result_type(values, lane), codegen
+
+
+# ---------------------------------------------------------------------------------------------
+# Quad: four doubles, for one state's quaternions and 3-vectors (a 3-vector's fourth lane is zero).
+
+
+@intrinsic
+def quad(typingctx, a, b, c, d):
+    """The four numbers (a, b, c, d) as one Quad."""
+    if not all(isinstance(t, (types.Float, types.Integer)) for t in (a, b, c, d)):
+        return None
+
+    def codegen(context, builder, signature, args):
+        vector = ir.Constant(_QUAD, ir.Undefined)
+        for i, (value, value_type) in enumerate(zip(args, signature.args)):
+            scalar = context.cast(builder, value, value_type, types.float64)
+            vector = builder.insert_element(vector, scalar, ir.Constant(ir.IntType(32), i))
+        return vector
+
+    return quad_type(a, b, c, d), codegen
+
+
+@intrinsic
+def quad_lane(typingctx, value, lane):
+    """One lane of a Quad, as a double."""
+    if value != quad_type or not isinstance(lane, types.Integer):
+        return None
+    return types.float64(value, lane), lambda context, builder, signature, args: builder.extract_element(*args)
+
+
+def quad_shuffle(indices):
+    """An intrinsic returning its Quad argument with lane i taken from lane ``indices[i]`` (0–3), or 0.0
+    where ``indices[i]`` is 4: a permutation fixed when the kernel compiles (one shuffle instruction)."""
+    if len(indices) != QUAD_WIDTH or not all(i in range(QUAD_WIDTH + 1) for i in indices):
+        raise ValueError(f"indices: expected four lanes in 0..4, got {indices!r}.")
+    mask = ir.Constant(ir.VectorType(ir.IntType(32), QUAD_WIDTH), list(indices))
+
+    @intrinsic
+    def shuffle(typingctx, value):
+        if value != quad_type:
+            return None
+
+        def codegen(context, builder, signature, args):
+            return builder.shuffle_vector(args[0], ir.Constant(_QUAD, [0.0] * QUAD_WIDTH), mask)
+
+        return quad_type(value), codegen
+
+    return shuffle
+
+
+def _element_pointer(context, builder, array_type, array, index):
+    ary = context.make_array(array_type)(context, builder, array)
+    return builder.gep(ary.data, [index])
+
+
+@intrinsic
+def load_quad(typingctx, array, start):
+    """array[start:start + 4] of a C-contiguous float64 array (the caller keeps it in bounds)."""
+    if not (_is_vector_array(array) and isinstance(start, types.Integer)):
+        return None
+
+    def codegen(context, builder, signature, args):
+        pointer = _element_pointer(context, builder, signature.args[0], *args)
+        return builder.load(builder.bitcast(pointer, _QUAD.as_pointer()), align=8)
+
+    return quad_type(array, start), codegen
+
+
+@intrinsic
+def load_broadcast_quad(typingctx, array, index):
+    """array[index] in every lane (C-contiguous float64; the caller keeps ``index`` in bounds: no
+    wrap-around of negative indices, which would cost a branch in an inner loop)."""
+    if not (_is_vector_array(array) and isinstance(index, types.Integer)):
+        return None
+
+    def codegen(context, builder, signature, args):
+        pointer = _element_pointer(context, builder, signature.args[0], *args)
+        return _splat(builder, builder.load(pointer, align=8), QUAD_WIDTH)
+
+    return quad_type(array, index), codegen
+
+
+@intrinsic
+def store_quad(typingctx, array, start, value):
+    """array[start:start + 4] = value (C-contiguous float64; the caller keeps it in bounds)."""
+    if not (_is_vector_array(array) and isinstance(start, types.Integer) and value == quad_type):
+        return None
+
+    def codegen(context, builder, signature, args):
+        pointer = _element_pointer(context, builder, signature.args[0], args[0], args[1])
+        builder.store(args[2], builder.bitcast(pointer, _QUAD.as_pointer()), align=8)
+        return context.get_dummy_value()
+
+    return types.none(array, start, value), codegen

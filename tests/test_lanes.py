@@ -19,7 +19,20 @@ from spinorbit.core.jit import jit
 from spinorbit.core.math.carlson import rf, rf_pair_lanes
 from spinorbit.core.math.complete_agm import complete_k_pi_dd, complete_k_pi_lanes
 from spinorbit.core.math.ddouble import dd_sqrt, dd_sqrt_lanes, fma, parity
-from spinorbit.core.math.lanes import WIDTH, lane_of, load_lanes, select, store_lanes
+from spinorbit.core.math.lanes import (
+    QUAD_WIDTH,
+    WIDTH,
+    lane_of,
+    load_broadcast_quad,
+    load_lanes,
+    load_quad,
+    quad,
+    quad_lane,
+    quad_shuffle,
+    select,
+    store_lanes,
+    store_quad,
+)
 
 EDGES = np.array([0.0, -0.0, 1.0, -1.0, 0.5, 3.0, 1e-310, 1e300, math.inf, -math.inf, math.nan, 2.0**-52])
 
@@ -65,6 +78,59 @@ def test_lane_arithmetic_is_the_scalar_arithmetic():
     np.testing.assert_array_equal(lanes, scalar)
     # signed zeros too (assert_array_equal takes -0.0 == 0.0)
     np.testing.assert_array_equal(np.signbit(lanes), np.signbit(scalar))
+
+
+_REVERSED_WITH_ZERO = quad_shuffle((3, 2, 1, 4))
+
+
+@jit(cache=False)
+def _arithmetic_quads(x, y, z, out):
+    for start in range(0, x.shape[0], QUAD_WIDTH):
+        a, b, c = load_quad(x, start), load_quad(y, start), load_quad(z, start)
+        store_quad(out[0], start, a + b)
+        store_quad(out[1], start, a - b)
+        store_quad(out[2], start, a * b)
+        store_quad(out[3], start, a / b)
+        store_quad(out[4], start, fma(a, b, c))
+        store_quad(out[5], start, -a * 2.5 + b / 3.0)
+        store_quad(out[6], start, _REVERSED_WITH_ZERO(a))
+        store_quad(out[7], start, fma(load_broadcast_quad(y, start + 1), a, c))
+        packed = quad(quad_lane(a, 0), quad_lane(b, 1), quad_lane(c, 2), quad_lane(a, 3))
+        store_quad(out[8], start, packed)
+
+
+@jit(cache=False)
+def _arithmetic_quads_scalar(x, y, z, out):
+    for start in range(0, x.shape[0], QUAD_WIDTH):
+        for lane in range(QUAD_WIDTH):
+            i = start + lane
+            a, b, c = x[i], y[i], z[i]
+            out[0, i], out[1, i], out[2, i], out[3, i] = a + b, a - b, a * b, a / b
+            out[4, i], out[5, i] = fma(a, b, c), -a * 2.5 + b / 3.0
+            out[6, i] = x[start + 3 - lane] if lane < 3 else 0.0
+            out[7, i] = fma(y[start + 1], a, c)
+            out[8, i] = (x[i], y[i], z[i], x[i])[lane]
+
+
+def test_quad_arithmetic_is_the_scalar_arithmetic():
+    """Quad (four doubles): arithmetic, fma, shuffles with zeros, lanes, loads, stores and broadcasts per lane."""
+    rng = np.random.default_rng(2)
+    n = 4 * 400
+    with np.errstate(all="ignore"):
+        x, y, z = (rng.choice(EDGES, n) * np.where(rng.random(n) < 0.5, 1.0, rng.lognormal(0.0, 30.0, n))
+                   for _ in range(3))
+    quads, scalar = np.full((9, n), 7.0), np.full((9, n), -7.0)
+    _arithmetic_quads(x, y, z, quads)
+    _arithmetic_quads_scalar(x, y, z, scalar)
+    np.testing.assert_array_equal(quads, scalar)
+    np.testing.assert_array_equal(np.signbit(quads), np.signbit(scalar))
+
+
+def test_a_quad_shuffle_takes_only_lanes_or_zero():
+    with pytest.raises(ValueError, match="four lanes in 0..4"):
+        quad_shuffle((0, 1, 2))
+    with pytest.raises(ValueError, match="four lanes in 0..4"):
+        quad_shuffle((0, 1, 2, 5))
 
 
 @jit(cache=False)

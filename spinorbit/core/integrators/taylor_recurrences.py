@@ -150,52 +150,58 @@ def _store_attitude(f, row, q, w):
 
 @jit(inline=INLINE)
 def _inner_sum(f, ncol, a, b, k, first):
-    """Σ_{j=first}^{k−1} A^[j] ⊙ B^[k−j] of the quads at columns a and b (component by component), in two
-    partial sums. The terms with j = 0 and j = k, which hold the newest coefficients, are the caller's
-    (module docstring, *Latency*)."""
-    inner = quad(0.0, 0.0, 0.0, 0.0)
-    other = quad(0.0, 0.0, 0.0, 0.0)
-    pairs = max(k - first, 0) // 2
-    for i in range(pairs):
-        j = first + 2 * i
-        inner = fma(load_quad(f, j * ncol + a), load_quad(f, (k - j) * ncol + b), inner)
-        other = fma(load_quad(f, (j + 1) * ncol + a), load_quad(f, (k - j - 1) * ncol + b), other)
-    for j in range(first + 2 * pairs, k):
-        inner = fma(load_quad(f, j * ncol + a), load_quad(f, (k - j) * ncol + b), inner)
-    return inner + other
+    """Σ_{j=first}^{k−1} A^[j] ⊙ B^[k−j] of the quads at columns a and b (component by component). The terms
+    with j = 0 and j = k, which hold the newest coefficients, are the caller's (module docstring, *Latency*)."""
+    total = quad(0.0, 0.0, 0.0, 0.0)
+    for j in range(first, k):
+        total = fma(load_quad(f, j * ncol + a), load_quad(f, (k - j) * ncol + b), total)
+    return total
 
 
 @jit(inline=INLINE)
-def _quaternion_times_components(f, ncol, column, k):
-    """Σ_{j=1}^{k−1} q^[j] v_a^[k−j] for a = x, y, z of the 3-vector at ``column``: the quaternion times one
-    broadcast component, three sums (each in two partial sums)."""
+def _attitude_inner(f, ncol, k):
+    """The terms j = 1 … k − 1 of q ω_x, q ω_y, q ω_z (the quaternion times one broadcast component of ω)
+    and of Euler's (ω_y ω_z, ω_z ω_x, ω_x ω_y), in one pass: all the attitude's products of order k but
+    those with the newest coefficients."""
     zero = quad(0.0, 0.0, 0.0, 0.0)
-    x, y, z, x2, y2, z2 = zero, zero, zero, zero, zero, zero
-    pairs = max(k - 1, 0) // 2
-    for i in range(pairs):
-        j = 1 + 2 * i
-        q, v = load_quad(f, j * ncol + _Q), (k - j) * ncol + column
-        x = fma(q, load_broadcast_quad(f, v), x)
-        y = fma(q, load_broadcast_quad(f, v + 1), y)
-        z = fma(q, load_broadcast_quad(f, v + 2), z)
-        q, v = load_quad(f, (j + 1) * ncol + _Q), (k - j - 1) * ncol + column
-        x2 = fma(q, load_broadcast_quad(f, v), x2)
-        y2 = fma(q, load_broadcast_quad(f, v + 1), y2)
-        z2 = fma(q, load_broadcast_quad(f, v + 2), z2)
-    for j in range(1 + 2 * pairs, k):
-        q, v = load_quad(f, j * ncol + _Q), (k - j) * ncol + column
-        x = fma(q, load_broadcast_quad(f, v), x)
-        y = fma(q, load_broadcast_quad(f, v + 1), y)
-        z = fma(q, load_broadcast_quad(f, v + 2), z)
-    return x + x2, y + y2, z + z2
+    x, y, z, euler = zero, zero, zero, zero
+    for j in range(1, k):
+        row, other = j * ncol, (k - j) * ncol
+        q = load_quad(f, row + _Q)
+        x = fma(q, load_broadcast_quad(f, other + _W), x)
+        y = fma(q, load_broadcast_quad(f, other + _W + 1), y)
+        z = fma(q, load_broadcast_quad(f, other + _W + 2), z)
+        euler = fma(load_quad(f, row + _W_YZX), load_quad(f, other + _W_ZXY), euler)
+    return x, y, z, euler
+
+
+@jit(inline=INLINE)
+def _perturber_inner(f, ncol, b, k, first_cross):
+    """The terms j = 1 … k − 1 of perturber block b's q c_a (a = x, y, z) and of the pair products of
+    ρ_body, and the terms j = first_cross … k − 1 of u × ρ, in one pass (ρ^[k−j] is zero before
+    first_cross = k − m)."""
+    zero = quad(0.0, 0.0, 0.0, 0.0)
+    x, y, z, pairs, cross, cross_back = zero, zero, zero, zero, zero, zero
+    for j in range(1, k):
+        row, other = j * ncol, (k - j) * ncol
+        q = load_quad(f, row + _Q)
+        x = fma(q, load_broadcast_quad(f, other + b + _C), x)
+        y = fma(q, load_broadcast_quad(f, other + b + _C + 1), y)
+        z = fma(q, load_broadcast_quad(f, other + b + _C + 2), z)
+        pairs = fma(load_quad(f, row + b + _B + _YZX), load_quad(f, other + b + _B + _ZXY), pairs)
+        if j >= first_cross:
+            cross = fma(load_quad(f, row + _U_YZX), load_quad(f, other + b + _RHO + _ZXY), cross)
+            cross_back = fma(load_quad(f, row + _U_ZXY), load_quad(f, other + b + _RHO + _YZX), cross_back)
+    return x, y, z, pairs, cross - cross_back
 
 
 @jit(inline=INLINE)
 def _with_newest(f, column, k, q, v, x, y, z):
-    """The sums of :func:`_quaternion_times_components` completed with their j = 0 and j = k terms: the
-    newest v^[k] and q^[k] come in registers (``v``, ``q``), not from memory. (One exit and no branch
-    around the array reads: numba then drops the reference counting of ``f`` in the inlined code.)"""
-    later = 1.0 if k > 0 else 0.0  # at k = 0 the two terms are one
+    """q v_a sums (a = x, y, z, the 3-vector v at ``column``) completed with their j = 0 and j = k terms:
+    the newest v^[k] and q^[k] come in registers (``v``, ``q``), not from memory. (Weights instead of a
+    branch for k = 0, where the two terms are one: with one exit and no branch around the array reads
+    numba drops the reference counting of ``f`` in the inlined code.)"""
+    later = 1.0 if k > 0 else 0.0
     q0 = load_quad(f, _Q) * later
     x = fma(q, load_broadcast_quad(f, column) * later, fma(q0, _lane_x(v), x))
     y = fma(q, load_broadcast_quad(f, column + 1) * later, fma(q0, _lane_y(v), y))
@@ -205,11 +211,10 @@ def _with_newest(f, column, k, q, v, x, y, z):
 
 
 @jit(inline=INLINE)
-def _rotated_pairs(f, ncol, column, k, v):
-    """Order k of (v_y v_z, v_z v_x, v_x v_y) for the 3-vector at ``column`` (rotated copies stored), its
-    newest order ``v`` in a register."""
+def _pairs_with_newest(f, column, k, v, total):
+    """(v_y v_z, v_z v_x, v_x v_y) sums of the 3-vector at ``column`` (rotated copies stored) completed with
+    their j = 0 and j = k terms, the newest order ``v`` in a register (weights as in :func:`_with_newest`)."""
     later = 1.0 if k > 0 else 0.0
-    total = _inner_sum(f, ncol, column + _YZX, column + _ZXY, k, 1)
     total = fma(load_quad(f, column + _YZX) * later, _zxy(v), total)
     total = fma(_yzx(v) * later, load_quad(f, column + _ZXY), total)
     return fma(_yzx(v) * (1.0 - later), _zxy(v), total)
@@ -223,21 +228,19 @@ def _perturber_pairs(f, ncol, b, k, m, q):
     ρ − 2 vec((0, c) ⊗ q); q^[k] comes in a register.
     """
     lo = max(0, k - m)  # ρ is zero above order m
-    cross = (_inner_sum(f, ncol, _U_YZX, b + _RHO + _ZXY, k, max(lo, 1))
-             - _inner_sum(f, ncol, _U_ZXY, b + _RHO + _YZX, k, max(lo, 1)))
+    x, y, z, pairs, cross = _perturber_inner(f, ncol, b, k, lo)
     if lo == 0 and k > 0:
         cross = fma(load_quad(f, _U_YZX), load_quad(f, k * ncol + b + _RHO + _ZXY), cross)
         cross = fma(-load_quad(f, _U_ZXY), load_quad(f, k * ncol + b + _RHO + _YZX), cross)
     cross = fma(_u_yzx(q), load_quad(f, b + _RHO + _ZXY), cross)
     cross = fma(-_u_zxy(q), load_quad(f, b + _RHO + _YZX), cross)
     store_quad(f, k * ncol + b + _C, cross)
-    x, y, z = _quaternion_times_components(f, ncol, b + _C, k)
     x, y, z = _with_newest(f, b + _C, k, q, cross, x, y, z)
     product = quad(1.0, -1.0, 1.0, 0.0) * _e_x(x) + quad(1.0, 1.0, -1.0, 0.0) * _e_y(y) \
         + quad(-1.0, 1.0, 1.0, 0.0) * _e_z(z)
     body = load_quad(f, k * ncol + b + _RHO) - 2.0 * product if k <= m else -2.0 * product
     _store_rotated(f, k * ncol + b + _B, body)
-    return _rotated_pairs(f, ncol, b + _B, k, body)
+    return _pairs_with_newest(f, b + _B, k, body, pairs)
 
 
 @jit(inline=INLINE)
@@ -355,10 +358,10 @@ def taylor_coefficients_into(t, model, s, n_pert, order, h_bound, orbit_tol, orb
             torque = fma(torque_factors * (3.0 * mu), pairs, torque)
         store_quad(f, k * ncol + _N, torque)
         # --- Euler: A ω̇x = (B − C) ωy ωz + Nx, cyclic; and q̇ = ½ q ⊗ (0, ω) = ½ Σ_a P_a(q ω_a)
-        sx, sy, sz = _quaternion_times_components(f, ncol, _W, k)
+        sx, sy, sz, euler = _attitude_inner(f, ncol, k)
         sx, sy, sz = _with_newest(f, _W, k, q, w, sx, sy, sz)
         inverse = _RECIPROCALS[k]
-        w_next = fma(euler_factors, _rotated_pairs(f, ncol, _W, k, w), torque) * inverse_moments * inverse
+        w_next = fma(euler_factors, _pairs_with_newest(f, _W, k, w, euler), torque) * inverse_moments * inverse
         q_next = (signs_x * _p_x(sx) + signs_y * _p_y(sy) + signs_z * _p_z(sz)) * (0.5 * inverse)
         _store_attitude(f, (k + 1) * ncol, q_next, w_next)
         q, w = q_next, w_next

@@ -38,6 +38,8 @@ import numpy as np
 from _report import interleaved_timings, machine_line, write_section
 
 from spinorbit.core.jit import jit
+from spinorbit.core.math.ddouble import fma
+from spinorbit.core.math.lanes import lane_of, load_lanes, load_quad, quad_lane
 
 MEMBERS = 64
 REPEATS = 5
@@ -46,8 +48,7 @@ TAYLOR_LANES = (1, 8)
 REFERENCE_TOL = 1e-15
 HEYOKA_TOLS = (1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12)
 TAYLOR_TOLS = (1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12)
-CAUCHY_WIDTHS = (4, 8, 16)
-CAUCHY_SWEEPS = 20000
+PEAK_ROUNDS = 2_000_000
 
 
 def attitude_error(q, reference):
@@ -88,115 +89,55 @@ def heyoka_batch_run(ek, earth, sun, tol, states, pars, t0, t_end, lanes=None, c
     return run, lanes
 
 
-# ----------------------------------------------------------------------- the layout of the Cauchy sums
-# Three Cauchy sums per order of a sweep (the shape of the recurrences' products, not the recurrences),
-# the same sums in the same order per lane in three layouts: per lane with scalar accumulators
-# (s[lane, row, order], as integrate_taylor_batch runs them), with the lane index innermost
-# (s[row, order, lane], for LLVM's loop vectoriser), and in LLVM vector registers of the lane width
-# (an intrinsic that emits <W x double> arithmetic, as heyoka's batch mode generates it).
-
-@jit
-def _cauchy_per_lane(s, acc, order):
-    for lane in range(s.shape[0]):
-        for k in range(order):
-            a0 = 0.0
-            a1 = 0.0
-            a2 = 0.0
-            for j in range(k + 1):
-                a0 += s[lane, 4, j] * s[lane, 5, k - j]
-                a1 += s[lane, 5, j] * s[lane, 6, k - j]
-                a2 += s[lane, 6, j] * s[lane, 4, k - j]
-            acc[0, lane] += a0
-            acc[1, lane] += a1
-            acc[2, lane] += a2
-
-
-@jit
-def _cauchy_lanes_innermost(s, acc, order):
-    lanes = s.shape[2]
-    sums = np.empty((3, lanes))
-    for k in range(order):
-        sums[:, :] = 0.0
-        for j in range(k + 1):
-            for lane in range(lanes):
-                sums[0, lane] += s[4, j, lane] * s[5, k - j, lane]
-                sums[1, lane] += s[5, j, lane] * s[6, k - j, lane]
-                sums[2, lane] += s[6, j, lane] * s[4, k - j, lane]
-        for lane in range(lanes):
-            acc[0, lane] += sums[0, lane]
-            acc[1, lane] += sums[1, lane]
-            acc[2, lane] += sums[2, lane]
-
-
-def _vector_sums(width):
-    """A numba intrinsic adding the order-k sums of s[row, order, lane] (lane width ``width``) to acc[3, lane],
-    with the accumulators held in LLVM vector registers <width x double> (mul, then add: no FMA contraction)."""
-    from llvmlite import ir
-    from numba.core import cgutils, types
-    from numba.extending import intrinsic
-
-    @intrinsic
-    def sums_into(typingctx, s, acc, k):
-        def codegen(context, builder, signature, args):
-            series = context.make_array(signature.args[0])(context, builder, args[0])
-            target = context.make_array(signature.args[1])(context, builder, args[1])
-            k_value = args[2]
-            orders = cgutils.unpack_tuple(builder, series.shape)[1]
-            i64 = ir.IntType(64)
-            vector = ir.VectorType(ir.DoubleType(), width)
-
-            def load(row, j):
-                offset = builder.mul(builder.add(builder.mul(ir.Constant(i64, row), orders), j), ir.Constant(i64, width))
-                return builder.load(builder.bitcast(builder.gep(series.data, [offset]), vector.as_pointer()), align=8)
-
-            sums = [cgutils.alloca_once_value(builder, ir.Constant(vector, [0.0] * width)) for _ in range(3)]
-            with cgutils.for_range(builder, builder.add(k_value, ir.Constant(i64, 1))) as loop:
-                j, kj = loop.index, builder.sub(k_value, loop.index)
-                for total, (a, b) in zip(sums, ((4, 5), (5, 6), (6, 4))):
-                    builder.store(builder.fadd(builder.load(total), builder.fmul(load(a, j), load(b, kj))), total)
-            for row, total in enumerate(sums):
-                pointer = builder.bitcast(builder.gep(target.data, [ir.Constant(i64, row * width)]), vector.as_pointer())
-                builder.store(builder.fadd(builder.load(pointer, align=8), builder.load(total)), pointer, align=8)
-            return context.get_dummy_value()
-
-        return types.void(s, acc, k), codegen
-
-    @jit(cache=False)  # one specialisation per width (a closure): nothing to cache across runs
-    def sweep(s, acc, order):
-        for k in range(order):
-            sums_into(s, acc, k)
-
-    return sweep
-
-
-@jit
-def _repeat(kernel, s, acc, order, times):
+@jit(cache=False)
+def _multiply_add_chains(x, m, c, times):
+    """``times`` rounds of 12 independent chains of multiply-adds a ← a·m + c on values held in registers
+    (m and c doubles, Quads or Lanes; x gives the chains' start values in their type)."""
+    a0, a1, a2, a3, a4, a5 = x * 1.0, x * 0.9, x * 0.8, x * 0.7, x * 0.6, x * 0.5
+    a6, a7, a8, a9, a10, a11 = x * 0.4, x * 0.3, x * 0.2, x * 0.1, x * 0.05, x * 0.01
     for _ in range(times):
-        kernel(s, acc, order)
+        a0, a1, a2, a3, a4, a5 = fma(a0, m, c), fma(a1, m, c), fma(a2, m, c), fma(a3, m, c), fma(a4, m, c), fma(a5, m, c)
+        a6, a7, a8, a9, a10, a11 = (fma(a6, m, c), fma(a7, m, c), fma(a8, m, c), fma(a9, m, c), fma(a10, m, c),
+                                    fma(a11, m, c))
+    return ((a0 + a1) + (a2 + a3)) + ((a4 + a5) + (a6 + a7)) + ((a8 + a9) + (a10 + a11))
 
 
-def cauchy_layouts(order, widths=CAUCHY_WIDTHS, repeats=REPEATS, times=CAUCHY_SWEEPS):
-    """{width: (ns per lane and order sweep: per lane, lane index innermost, LLVM vectors), …}: medians of
-    interleaved CPU timings; the three layouts' sums are checked equal, bit for bit."""
-    rng = np.random.default_rng(1)
-    out = {}
-    for width in widths:
-        inner = rng.random((7, order + 1, width))
-        per_lane = np.ascontiguousarray(np.transpose(inner, (2, 0, 1)))
-        vector_sweep = _vector_sums(width)
-        kernels = ((_cauchy_per_lane, per_lane), (_cauchy_lanes_innermost, inner), (vector_sweep, inner))
-        sums = []
-        for kernel, series in kernels:
-            acc = np.zeros((3, width))
-            kernel(series, acc, order)
-            sums.append(acc)
-        assert all(np.array_equal(sums[0], other) for other in sums[1:]), "the layouts' sums differ"
-        acc = np.zeros((3, width))
-        functions = [lambda kernel=kernel, series=series: _repeat(kernel, series, acc, order, times)
-                     for kernel, series in kernels]
-        timings, _ = interleaved_timings(functions, repeats, clock=time.process_time, warm_up=True)
-        out[width] = tuple(timing.median / times / width * 1e9 for timing in timings)
-    return out
+@jit(cache=False)
+def _chains_quad(values, times):
+    out = _multiply_add_chains(load_quad(values, 0), load_quad(values, 8), load_quad(values, 16), times)
+    return quad_lane(out, 0)
+
+
+@jit(cache=False)
+def _chains_lanes(values, times):
+    out = _multiply_add_chains(load_lanes(values, 0), load_lanes(values, 8), load_lanes(values, 16), times)
+    return lane_of((out,), 0)[0]
+
+
+def peak_rates(repeats=REPEATS, times=PEAK_ROUNDS):
+    """This machine's multiply-adds per ns (doubles, medians of interleaved repeats) when nothing but
+    multiply-adds in registers limits them: 12 independent chains (more than the units' latency × throughput
+    needs) of four-wide (Quad) and of eight-wide (Lanes) instructions. {"quad": …, "lanes": …}."""
+    values = np.array([1.0] * 8 + [0.999999] * 8 + [1e-7] * 8)
+    runs = {"quad": (_chains_quad, 4), "lanes": (_chains_lanes, 8)}
+    for kernel, _ in runs.values():
+        kernel(values, 10)
+    timings, _ = interleaved_timings([lambda kernel=kernel: kernel(values, times) for kernel, _ in runs.values()],
+                                     repeats, clock=time.process_time)
+    return {name: 12 * times * width / (timing.median * 1e9) for (name, (_, width)), timing in zip(runs.items(), timings)}
+
+
+def cauchy_quad_multiply_adds(order, orbit_orders):
+    """The four-wide multiply-adds of one step's Cauchy sums in the recurrences (what any implementation of
+    them must issue, without the orbit series and the driver): per order k ≤ order − 1, k + 1 terms of the
+    attitude's four products and of each perturber's four, and min(k, m) + 1 terms of its cross product u × ρ
+    (two, on the orbit series' length m)."""
+    total = 0
+    for k in range(order):
+        total += 4 * (k + 1)
+        for m in orbit_orders:
+            total += 4 * (k + 1) + 2 * (min(k, m) + 1)
+    return total
 
 
 def loosest(tols, error_of, target):
@@ -309,7 +250,7 @@ def measure(members, repeats, lanes_list, taylor_lanes=TAYLOR_LANES):
     timings, _ = interleaved_timings(functions, repeats, clock=time.process_time, warm_up=True)
     free_taylor_timing = timings.pop()
     free_timing = timings.pop()
-    layouts = cauchy_layouts(taylor_counts["order"], repeats=repeats)
+    peak = peak_rates(repeats)
     load.append(os.getloadavg())
     return dict(members=members, repeats=repeats, rtol=rtol, tol=tol, hy_lanes=hy_lanes_list, identical=identical,
                 spin_error=spin_error, heyoka_error=heyoka_error, timings=dict(zip(engines, timings)), load=load,
@@ -317,7 +258,7 @@ def measure(members, repeats, lanes_list, taylor_lanes=TAYLOR_LANES):
                 free_per_rhs=free_timing.median / members / free_calls["rhs"], free_lanes=max(lanes_list),
                 taylor_tol=taylor_tol, taylor_error=taylor_error, taylor_identical=taylor_identical,
                 taylor=taylor_counts, heyoka=heyoka_counts, free_taylor=free_taylor_counts,
-                free_taylor_timing=free_taylor_timing, taylor_lanes=taylor_lanes, layouts=layouts)
+                free_taylor_timing=free_taylor_timing, taylor_lanes=taylor_lanes, peak=peak)
 
 
 def markdown(m):
@@ -349,6 +290,10 @@ def markdown(m):
     ns_taylor = t[best].median / n / ty["steps"] * 1e9
     ns_heyoka = t[hy_best].median / n / hy["steps"] * 1e9
     ns_free = m["free_taylor_timing"].median / n / free["steps"] * 1e9
+    budget = ns_heyoka / 2.0 * hy["steps"] / ty["steps"]
+    orbit = ty["orbit_order"] / 2.0  # mean orbit-series order of each of the two perturbers
+    quads = cauchy_quad_multiply_adds(ty["order"], (round(orbit), round(orbit)))
+    peak = m["peak"]
     lines += ["", f"Accuracy against heyoka at tol 1e-15 (end attitude): DOP853 worst {m['spin_error'].max():.2e} rad "
               f"(median {np.median(m['spin_error']):.2e}), Taylor batch worst {m['taylor_error'].max():.2e} rad "
               f"(median {np.median(m['taylor_error']):.2e}), heyoka batch worst {m['heyoka_error'].max():.2e} rad "
@@ -372,29 +317,20 @@ def markdown(m):
               f"Where the floor is: both Taylor methods take about the same steps (heyoka's order and step rule), so "
               f"the throughput is the cost per lane-step. heyoka's batch mode runs its straight-line Taylor code on "
               f"{hy_lanes} lanes in SIMD registers, {ns_heyoka:.0f} ns per lane-step; 2× its throughput would need "
-              f"{ns_heyoka / 2.0 * hy['steps'] / ty['steps']:.0f} ns per lane-step at our step count. spinorbit's lanes are "
-              f"interleaved, each lane the scalar recurrences (`docs/performance.md`'s batch prose): {ns_taylor:.0f} ns, "
-              f"and the attitude recurrences alone (no torque) already cost {ns_free:.0f} ns, "
-              f"{ns_free / (ns_heyoka / 2.0 * hy['steps'] / ty['steps']):.1f}× the budget: the goal needs the "
-              "recurrences vectorised across lanes, not a cheaper torque.",
-              "",
-              f"What the lane-innermost layout gives in numba: three Cauchy sums over an order-{ty['order']} sweep "
-              "(`cauchy_layouts` in the script: the products' shape, not the recurrences), CPU ns per lane, "
-              "medians of interleaved repeats:", "",
-              "| lanes | per lane, scalar accumulators | lane index innermost (loop vectoriser) | LLVM vector registers | "
-              "per lane / vectors |", "|---:|---:|---:|---:|---:|"]
-    lines += [f"| {w} | {a:.1f} | {b:.1f} | {c:.1f} | {a / c:.2f} |" for w, (a, b, c) in m["layouts"].items()]
-    best_width = max(m["layouts"], key=lambda w: m["layouts"][w][0] / m["layouts"][w][2])
-    gain = m["layouts"][best_width][0] / m["layouts"][best_width][2]
-    lines += ["", "The three layouts give the same sums to the bit. With the lane index innermost numba's LLVM "
-              "vectorises the lane loop but keeps the accumulators in memory across the sum (runtime alias checks, "
-              "loads and stores per term), and it loses to the scalar loop, whose accumulators stay in registers. "
-              f"Held in vector registers of the lane width (as heyoka generates them), the same sums run {gain:.1f}× "
-              f"faster per lane than the scalar loop ({best_width} lanes). That is the gain a lane-vectorised "
-              "recurrence could hope for on its Cauchy products; at best (the whole torqued step sped up as its "
-              f"Cauchy sums) that is {ns_taylor / gain:.0f} ns per lane-step, still {ns_taylor / gain / ns_heyoka:.1f}× heyoka's "
-              f"{ns_heyoka:.0f} ns and {ns_taylor / gain / (ns_heyoka / 2.0 * hy['steps'] / ty['steps']):.1f}× the "
-              "budget of the 2× goal."]
+              f"{budget:.0f} ns per lane-step at our step count. spinorbit's lanes are interleaved, each lane the "
+              f"recurrences that multiply four doubles per instruction (`Quad`, `docs/design.md`): {ns_taylor:.0f} ns "
+              f"per lane-step, and the attitude recurrences alone (no torque) {ns_free:.0f} ns. This machine's "
+              f"multiply-add rate when nothing else limits it (`peak_rates`: 12 independent chains in registers) is "
+              f"{peak['quad']:.1f} doubles per ns in four-wide instructions and {peak['lanes']:.1f} in eight-wide ones, "
+              "so members in the lanes of eight-wide vectors " + ("would add little arithmetic to what the four-wide "
+              "recurrences can issue" if peak["lanes"] < 1.25 * peak["quad"] else "could issue more arithmetic") +
+              f". The Cauchy sums of one step at order {ty['order']} with the mean orbit-series orders are "
+              f"{quads} four-wide multiply-adds (`cauchy_quad_multiply_adds`: the products alone, without the orbit "
+              f"series, the newest terms' bookkeeping, the stores and the driver): {4 * quads / peak['quad']:.0f} ns "
+              f"at the peak rate, {4 * quads / peak['quad'] / budget:.0%} of the goal's budget, leaving "
+              f"{budget - 4 * quads / peak['quad']:.0f} ns for everything else of the step. The present step issues "
+              f"them at {4 * quads / ns_taylor / peak['quad']:.0%} of the peak rate on average.",
+              ]
     return "\n".join(lines)
 
 

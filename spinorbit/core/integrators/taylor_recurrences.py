@@ -33,9 +33,11 @@ the kinematics, and u × c − q₀ c = −vec((0, c) ⊗ q) for the rotation of
 rewriting is measured in ``docs/performance.md`` (*Where the Taylor floor is*).
 
 **Latency.** Each order needs the last one, so the step is one chain of dependent orders. Every Cauchy
-sum therefore adds the terms with the newest coefficients (j = 0 and j = k) last: the rest of the sum
-can run while the previous quantity of the chain is still being computed. Long sums run as two
-partial sums (terms j and k − j side by side), so a chain of dependent multiply-adds is half as long.
+sum therefore adds the terms with the newest coefficients (j = 0 and j = k) last, from registers: the
+rest of the sum can run while the previous quantity of the chain is still being computed. Those other
+terms of all of an order's products run in one pass per group (the attitude's four sums; each
+perturber's five), so that each pass has independent chains of multiply-adds and the loops' set-up,
+as long as their bodies at these orders, is paid once per group.
 
 **Perturbers over a step.** A Keplerian perturber's relative position is carried as extra state
 of the Taylor system, r̈ = −μ_orbit r / |r|³, advanced by its own Taylor polynomial and *re-seeded

@@ -296,33 +296,51 @@ def _is_vector_array(t):
     return isinstance(t, types.Array) and t.dtype == types.float64 and t.ndim == 1 and t.layout == "C"
 
 
-@intrinsic
-def load_lanes(typingctx, array, start):
-    """array[start:start + 8] of a C-contiguous float64 array (the caller keeps it in bounds)."""
-    if not (_is_vector_array(array) and isinstance(start, types.Integer)):
-        return None
+def _vector_load(vector_type, doc):
+    """An intrinsic loading ``vector_type.width`` consecutive doubles of a C-contiguous float64 array."""
 
-    def codegen(context, builder, signature, args):
-        ary = context.make_array(signature.args[0])(context, builder, args[0])
-        pointer = builder.gep(ary.data, [args[1]])
-        return builder.load(builder.bitcast(pointer, _VECTOR.as_pointer()), align=8)
+    def load(typingctx, array, start):
+        if not (_is_vector_array(array) and isinstance(start, types.Integer)):
+            return None
 
-    return lanes_type(array, start), codegen
+        def codegen(context, builder, signature, args):
+            pointer = _element_pointer(context, builder, signature.args[0], *args)
+            vector = ir.VectorType(ir.DoubleType(), vector_type.width)
+            return builder.load(builder.bitcast(pointer, vector.as_pointer()), align=8)
+
+        return vector_type(array, start), codegen
+
+    load.__doc__ = doc
+    return intrinsic(load)
 
 
-@intrinsic
-def store_lanes(typingctx, array, start, value):
-    """array[start:start + 8] = value (C-contiguous float64; the caller keeps it in bounds)."""
-    if not (_is_vector_array(array) and isinstance(start, types.Integer) and value == lanes_type):
-        return None
+def _vector_store(vector_type, doc):
+    """An intrinsic storing a ``vector_type`` value into consecutive doubles of a C-contiguous float64 array."""
 
-    def codegen(context, builder, signature, args):
-        ary = context.make_array(signature.args[0])(context, builder, args[0])
-        pointer = builder.gep(ary.data, [args[1]])
-        builder.store(args[2], builder.bitcast(pointer, _VECTOR.as_pointer()), align=8)
-        return context.get_dummy_value()
+    def store(typingctx, array, start, value):
+        if not (_is_vector_array(array) and isinstance(start, types.Integer) and value == vector_type):
+            return None
 
-    return types.none(array, start, value), codegen
+        def codegen(context, builder, signature, args):
+            pointer = _element_pointer(context, builder, signature.args[0], args[0], args[1])
+            builder.store(args[2], builder.bitcast(pointer, args[2].type.as_pointer()), align=8)
+            return context.get_dummy_value()
+
+        return types.none(array, start, value), codegen
+
+    store.__doc__ = doc
+    return intrinsic(store)
+
+
+def _element_pointer(context, builder, array_type, array, index):
+    ary = context.make_array(array_type)(context, builder, array)
+    return builder.gep(ary.data, [index])
+
+
+load_lanes = _vector_load(lanes_type, "array[start:start + 8] of a C-contiguous float64 array (the caller keeps "
+                                      "it in bounds).")
+store_lanes = _vector_store(lanes_type, "array[start:start + 8] = value (C-contiguous float64; the caller keeps "
+                                        "it in bounds).")
 
 
 @intrinsic
@@ -461,22 +479,10 @@ def quad_shuffle(indices):
     return shuffle
 
 
-def _element_pointer(context, builder, array_type, array, index):
-    ary = context.make_array(array_type)(context, builder, array)
-    return builder.gep(ary.data, [index])
-
-
-@intrinsic
-def load_quad(typingctx, array, start):
-    """array[start:start + 4] of a C-contiguous float64 array (the caller keeps it in bounds)."""
-    if not (_is_vector_array(array) and isinstance(start, types.Integer)):
-        return None
-
-    def codegen(context, builder, signature, args):
-        pointer = _element_pointer(context, builder, signature.args[0], *args)
-        return builder.load(builder.bitcast(pointer, _QUAD.as_pointer()), align=8)
-
-    return quad_type(array, start), codegen
+load_quad = _vector_load(quad_type, "array[start:start + 4] of a C-contiguous float64 array (the caller keeps "
+                                    "it in bounds).")
+store_quad = _vector_store(quad_type, "array[start:start + 4] = value (C-contiguous float64; the caller keeps it "
+                                      "in bounds).")
 
 
 @intrinsic
@@ -491,17 +497,3 @@ def load_broadcast_quad(typingctx, array, index):
         return _splat(builder, builder.load(pointer, align=8), QUAD_WIDTH)
 
     return quad_type(array, index), codegen
-
-
-@intrinsic
-def store_quad(typingctx, array, start, value):
-    """array[start:start + 4] = value (C-contiguous float64; the caller keeps it in bounds)."""
-    if not (_is_vector_array(array) and isinstance(start, types.Integer) and value == quad_type):
-        return None
-
-    def codegen(context, builder, signature, args):
-        pointer = _element_pointer(context, builder, signature.args[0], args[0], args[1])
-        builder.store(args[2], builder.bitcast(pointer, _QUAD.as_pointer()), align=8)
-        return context.get_dummy_value()
-
-    return types.none(array, start, value), codegen

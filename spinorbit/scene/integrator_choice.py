@@ -27,8 +27,9 @@ __all__ = ["SAMPLE_REFINEMENT", "SINGULAR_MARGIN", "TAYLOR_KNOT_SHARE", "TAYLOR_
 #: 1 − μ) and sin J below this many times the element integrator's own stop thresholds.
 SINGULAR_MARGIN = 100.0
 #: Taylor while the sampled perturbers' knots inside the span are at most this many times the steps the
-#: rotation needs: where the two integrators alone break even (bench_scene_skips, docs/performance.md).
-TAYLOR_KNOT_SHARE = 1.0
+#: rotation needs: just below where the two integrators alone break even (bench_scene_skips,
+#: docs/performance.md: between the moonlet rows of 1 and 2.5 knots per rotation step).
+TAYLOR_KNOT_SHARE = 2.0
 #: The rotation steps are counted by a Taylor run of the free motion over at most this many rotations
 #: (2π/|ω|), scaled to the span: a few hundred steps.
 TAYLOR_PROBE_ROTATIONS = 20.0

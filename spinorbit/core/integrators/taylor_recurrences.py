@@ -267,14 +267,15 @@ def _orbit_series_into(f, ncol, b, kind, order, mu_orbit, h_bound, orbit_tol_sq)
     m = 0 if kind == KIND_FIXED else order
     kepler = kind == KIND_KEPLER
     r0 = load_quad(f, b + _X)
+    v = load_quad(f, b + _V)
     r2_0 = _dot(r0, r0)
     inv_r2 = 1.0 / r2_0
-    inv_v2 = 1.0 / _dot(load_quad(f, b + _V), load_quad(f, b + _V))
+    inv_v2 = 1.0 / _dot(v, v)
     root = math.sqrt(r2_0)
     s52_0 = 1.0 / (r2_0 * math.sqrt(root))  # |r|⁻⁵ᐟ² and |r|⁻³ without a power function
     s3_0 = 1.0 / (r2_0 * root)
     f[b + _R2], f[b + _S52], f[b + _S3] = r2_0, s52_0, s3_0
-    r, v = r0, load_quad(f, b + _V)
+    r = r0
     s52, s3 = s52_0, s3_0
     h_pow_sq = 1.0  # h_bound^(2k), by one product per order (no power function in the loop)
     for k in range(order):
@@ -342,15 +343,15 @@ def taylor_coefficients_into(t, model, s, n_pert, order, h_bound, orbit_tol, orb
     torque_factors = quad(c_mom - b_mom, a_mom - c_mom, b_mom - a_mom, 0.0)
     signs_x, signs_y, signs_z = quad(-1.0, 1.0, 1.0, -1.0), quad(-1.0, -1.0, 1.0, 1.0), quad(-1.0, 1.0, -1.0, 1.0)
     zero = quad(0.0, 0.0, 0.0, 0.0)
-    _store_attitude(f, 0, load_quad(f, _Q), quad(f[_W], f[_W + 1], f[_W + 2], 0.0))
+    q = load_quad(f, _Q)
+    w = quad(f[_W], f[_W + 1], f[_W + 2], 0.0)  # fourth lane zero: callers write only y's seven columns
+    _store_attitude(f, 0, q, w)
     orbit_tol_sq = orbit_tol * orbit_tol
     for p in range(n_pert):
         row = MODEL_PERTURBERS + 1 + p * PERTURBER_ROW
         kind = int(model[row])
         orbit_orders[p] = _orbit_series_into(f, ncol, _HEAD_COLUMNS + p * _BLOCK_COLUMNS, kind, order,
                                              model[row + 2 + K_MU], h_bound, orbit_tol_sq)
-    q = load_quad(f, _Q)
-    w = quad(f[_W], f[_W + 1], f[_W + 2], 0.0)
     for k in range(order):
         # --- torque N^[k] = Σ 3μ ((C − B) ρ_y ρ_z, (A − C) ρ_z ρ_x, (B − A) ρ_x ρ_y) of each ρ_body
         torque = zero

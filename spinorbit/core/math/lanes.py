@@ -14,8 +14,9 @@ Why: the set-up of one torque-free state is bound by the divider and the square 
 Carlson's duplication), which a scalar loop uses one double at a time; ``<8 x double>`` issues eight
 (``docs/design.md``, "Eight states in one register").
 
-``Quad`` is an LLVM ``<4 x double>`` with the same arithmetic (and :func:`~spinorbit.core.math.ddouble.fma`),
-plus what component-wise vector code needs: :func:`quad` (four doubles packed), :func:`quad_lane` (one
+``Quad`` is an LLVM ``<4 x double>`` with +, −, ×, /, unary − and :func:`~spinorbit.core.math.ddouble.fma`
+(not ``abs``, ``math.sqrt`` or comparisons, which no Quad kernel needs), plus what component-wise
+vector code needs: :func:`quad` (four doubles packed), :func:`quad_lane` (one
 out), :func:`quad_shuffle` (a permutation fixed at compile time, with zeros), :func:`load_quad`,
 :func:`store_quad` and :func:`load_broadcast_quad` (one double of an array in every lane). A quaternion
 fills one, a 3-vector three of its lanes; the Taylor recurrences

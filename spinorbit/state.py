@@ -2,7 +2,8 @@
 
 Attitudes are given and returned in the user's body axes (see :class:`spinorbit.RigidBody`); the
 core works in principal axes A ≤ B ≤ C. Spins are Quantities (rad/s, deg/day, …); a plain float is
-read as rad/day, the core's unit. Conventions: ``docs/conventions.md``.
+read as rad/day, the core's unit. A state made from a published form (:meth:`RotationState.from_pole`,
+:meth:`RotationState.from_tumbling`) knows its epoch. Conventions: ``docs/conventions.md``.
 """
 
 from __future__ import annotations
@@ -12,8 +13,10 @@ from dataclasses import dataclass
 
 import numpy as np
 from astropy import units as u
+from astropy.time import Time
 
 from spinorbit import pole as _pole
+from spinorbit import spin_forms as _spin_forms
 from spinorbit.body import RigidBody
 from spinorbit.quantities import value_in
 from spinorbit.core.elements import andoyer as _andoyer
@@ -158,16 +161,24 @@ class RotationState:
         (v_inertial = M(q) v_body).
     angular_velocity : Quantity or array_like, shape (3,)
         Body angular velocity in the user's body axes (rad/day if plain floats).
+    epoch : astropy.time.Time, optional
+        The instant of this attitude and spin (scalar); None (default) when the state is not tied to
+        one. A :class:`spinorbit.Scene` takes it as its epoch.
 
     Notes
     -----
-    Use :meth:`from_matrix`, :meth:`from_euler313` or :meth:`from_angular_momentum` for other inputs.
+    Use :meth:`from_matrix`, :meth:`from_euler313` or :meth:`from_angular_momentum` for other inputs,
+    and :meth:`from_pole` or :meth:`from_tumbling` for the published forms. States are immutable:
+    :meth:`with_epoch` returns a copy tied to another epoch.
     """
 
-    def __init__(self, body: RigidBody, quaternion, angular_velocity):
+    def __init__(self, body: RigidBody, quaternion, angular_velocity, epoch=None):
         if not isinstance(body, RigidBody):
             raise TypeError(f"body must be a spinorbit.RigidBody; got {type(body).__name__}.")
+        if epoch is not None and not (isinstance(epoch, Time) and epoch.isscalar):
+            raise InvalidStateError(f"epoch expects a scalar astropy Time or None; got {epoch!r}.")
         self._body = body
+        self._epoch = epoch
         self._q = _as_quaternion(quaternion)
         self._omega = _as_angular_velocity(angular_velocity)
         with np.errstate(over="ignore"):
@@ -180,31 +191,87 @@ class RotationState:
 
     # -- constructors --------------------------------------------------------------------------
     @classmethod
-    def from_matrix(cls, body, attitude_matrix, angular_velocity):
+    def from_matrix(cls, body, attitude_matrix, angular_velocity, epoch=None):
         """From an attitude matrix R (inertial → user body axes)."""
-        return cls(body, _rotations.attitude_to_quat(_as_rotation_matrix(attitude_matrix)), angular_velocity)
+        return cls(body, _rotations.attitude_to_quat(_as_rotation_matrix(attitude_matrix)), angular_velocity, epoch)
 
     @classmethod
-    def from_euler313(cls, body, phi, theta, psi, angular_velocity):
+    def from_euler313(cls, body, phi, theta, psi, angular_velocity, epoch=None):
         """From passive 3-1-3 Euler angles (Quantities or radians): R = R3(ψ) R1(θ) R3(φ)."""
         angles = [value_in(name, a, u.rad, "30 * u.deg", plain_unit=u.rad, shape=(), finite=False)
                   for name, a in (("phi", phi), ("theta", theta), ("psi", psi))]
         if not all(math.isfinite(a) for a in angles):
             raise NonFiniteStateError(f"Euler angles must be finite; got phi, theta, psi = {angles}.")
-        return cls.from_matrix(body, _rotations.euler313_to_attitude(*angles), angular_velocity)
+        return cls.from_matrix(body, _rotations.euler313_to_attitude(*angles), angular_velocity, epoch)
 
     @classmethod
-    def from_angular_momentum(cls, body, quaternion, angular_momentum):
+    def from_angular_momentum(cls, body, quaternion, angular_momentum, epoch=None):
         """From the body angular momentum (user axes) instead of the angular velocity: ω = I⁻¹ M."""
         values = value_in("angular_momentum", angular_momentum, body.moment_unit * RAD_PER_DAY,
                           f"[0.1, 0, 0.3] * {body.moment_unit * RAD_PER_DAY!r}", plain_unit=body.moment_unit * RAD_PER_DAY,
                           finite=False)
-        return cls(body, quaternion, np.asarray(values, dtype=float) / body.moment_values)
+        return cls(body, quaternion, np.asarray(values, dtype=float) / body.moment_values, epoch)
+
+    @classmethod
+    def from_pole(cls, body, pole_lon, pole_lat, period, epoch, phase=0 * u.deg, frame="ecliptic", axes=None):
+        """A principal-axis rotator as DAMIT publishes it: pole (λ, β), sidereal period P, epoch t0, angle φ0.
+
+        r_ecl = R_z(λ) R_y(90° − β) R_z(φ0 + 2π (t − t0)/P) r_ast (Ďurech et al. 2010): the body spins at 2π/P
+        about its axis of largest moment; the state is at t0 = ``epoch`` (its :attr:`epoch`). ``pole_lon``,
+        ``pole_lat`` and ``phase`` are angles, ``period`` a time; ``frame`` "ecliptic" (J2000, IAU 2006) or
+        "icrf" (RA, Dec); ``axes`` which user axes are DAMIT's x, y, z (None: the largest moment on z).
+        Definitions: ``docs/conventions.md``, "Published spin forms"; :func:`spinorbit.spin_forms.pole_attitude`.
+        """
+        attitude, omega, _ = _spin_forms.pole_attitude(body, pole_lon, pole_lat, period, phase, frame, axes)
+        return cls.from_matrix(body, attitude, omega * RAD_PER_DAY, _spin_forms.check_epoch(epoch))
+
+    @classmethod
+    def from_tumbling(cls, body, p_psi, p_phi, momentum_lon, momentum_lat, phi0, theta0, psi0, epoch, mode=None,
+                      frame="ecliptic", axes=None, theta_tolerance=_spin_forms.THETA0_TOLERANCE):
+        """A tumbler as Pravec et al. (2005, 2014) publish it: P_ψ, P_φ, (λ_L, β_L), (φ0, θ0, ψ0) at an epoch.
+
+        r_ecl = R_z(λ_L) R_y(90° − β_L) R_z(φ) R_x(θ) R_z(ψ) r_ast (Kaasalainen 2001): z-x-z Euler angles of the
+        body axes (moments I1, I2, I3 of ``body`` on x, y, z; z the largest moment in SAM, the smallest in LAM)
+        in the frame of the angular momentum. |L| and the energy are solved from the periods (times) and the
+        moments; θ0 follows from ψ0 and is checked against ``theta0`` within ``theta_tolerance`` (None: the
+        branch θ0 < 90°). ``mode`` None reads SAM/LAM from the body's z axis; ``frame`` and ``axes`` as in
+        :meth:`from_pole`. Definitions: ``docs/conventions.md``; :func:`spinorbit.spin_forms.tumbling_attitude`.
+        """
+        attitude, omega, _, _ = _spin_forms.tumbling_attitude(
+            body, p_psi, p_phi, momentum_lon, momentum_lat, phi0, theta0, psi0, mode, frame, axes, theta_tolerance)
+        return cls.from_matrix(body, attitude, omega * RAD_PER_DAY, _spin_forms.check_epoch(epoch))
+
+    def with_epoch(self, epoch) -> "RotationState":
+        """The same attitude and spin tied to ``epoch`` (a scalar Time, or None to untie it)."""
+        return RotationState(self._body, self._q, self._omega * RAD_PER_DAY, epoch)
+
+    def pole(self, frame="ecliptic", max_wobble=_spin_forms.POLE_MAX_WOBBLE, axes=None):
+        """(λ, β, P, φ0 at :attr:`epoch`, …) of this state, the inverse of :meth:`from_pole`.
+
+        Returns a :class:`spinorbit.spin_forms.PoleSolution` (P is :attr:`sidereal_period`); raises
+        SpinFormError when the rotation axis is more than ``max_wobble`` (an angle) from the momentum.
+        """
+        return _spin_forms.PoleSolution(**_spin_forms.pole_of(self.attitude_matrix, self._omega, self._body, frame,
+                                                              max_wobble, axes), epoch=self._epoch)
+
+    def tumbling_parameters(self, frame="ecliptic", axes=None):
+        """(P_ψ, P_φ, λ_L, β_L, φ0, θ0, ψ0, I1/I3, I2/I3, mode, …) at :attr:`epoch`, the inverse of :meth:`from_tumbling`.
+
+        Returns a :class:`spinorbit.spin_forms.TumblingParameters`; raises SpinFormError for a permanent
+        rotation or the separatrix (no finite P_ψ, P_φ: :meth:`pole`).
+        """
+        return _spin_forms.TumblingParameters(**_spin_forms.tumbling_of(self.attitude_matrix, self._omega, self._body,
+                                                                        frame, axes), epoch=self._epoch)
 
     # -- what users read -----------------------------------------------------------------------
     @property
     def body(self) -> RigidBody:
         return self._body
+
+    @property
+    def epoch(self) -> Time | None:
+        """The instant of this state (astropy Time), or None when it was made without one."""
+        return self._epoch
 
     @property
     def quaternion(self) -> np.ndarray:
@@ -524,4 +591,5 @@ class RotationState:
     def __repr__(self):
         omega = ", ".join(f"{w:.6g}" for w in self._omega)
         q = ", ".join(f"{c:.6g}" for c in self._q)
-        return f"RotationState(q=({q}), ω=({omega}) rad/day)"
+        epoch = "" if self._epoch is None else f", epoch={self._epoch.tdb.isot} TDB"
+        return f"RotationState(q=({q}), ω=({omega}) rad/day{epoch})"

@@ -31,7 +31,7 @@ CORE_BASE = ("spinorbit.core.jit", "spinorbit.core.errors")
 UPPER_LAYERS = (
     ("bridge", ("spinorbit.quantities", "spinorbit.body", "spinorbit.state", "spinorbit.state_table", "spinorbit.time",
                 "spinorbit.frames", "spinorbit.ephemeris", "spinorbit.lunar_librations", "spinorbit.special",
-                "spinorbit.orbital_elements", "spinorbit.pole", "spinorbit.yarkovsky")),
+                "spinorbit.orbital_elements", "spinorbit.pole", "spinorbit.spin_forms", "spinorbit.yarkovsky")),
     ("runs", ("spinorbit.runs",)),
     ("shape", ("spinorbit.shape",)),
     ("coupling", ("spinorbit.coupling",)),

@@ -24,7 +24,8 @@ from spinorbit.state import RotationState
 from spinorbit.time import tdb_days
 
 __all__ = ["INTEGRATORS", "MASS_MISMATCH", "QUANTITIES", "EphemerisPerturber", "FixedPerturber",
-           "as_angle", "check_gm", "gm_in_orbit_model", "moments_per_mass", "resolve_perturbers",
+           "EPOCH_MATCH_TOLERANCE", "as_angle", "check_gm", "gm_in_orbit_model", "moments_per_mass", "resolve_epoch",
+           "resolve_perturbers",
            "tdb_day_array", "validate_options", "validate_perturbers", "validate_state", "validate_times"]
 
 #: Quantities a scene can ask for.
@@ -34,6 +35,10 @@ INTEGRATORS = ("auto", "quaternion", "elements", "taylor")
 #: Largest relative difference allowed between the body's mass (RigidBody.mass) and its mass in the
 #: orbit model (G is known to 2e-5 and DE421's GMs come with their own rounding).
 MASS_MISMATCH = 1e-2
+#: Largest difference (days) between a Scene's epoch and its state's own epoch that counts as the same instant: an
+#: instant on two time scales converts with ~1e-14 d of rounding (astropy's two-double Time), and a state cannot
+#: be tied to a time any finer; 1 µs is far below both and far above them.
+EPOCH_MATCH_TOLERANCE = 1e-6 / 86400.0
 #: Units and physical types of the checks, built once: composing ``u.au**3 / u.day**2`` or reading a
 #: composed unit's physical type costs ~25 µs a time, more than the rest of a perturber's check.
 _AU3_PER_DAY2 = u.au**3 / u.day**2
@@ -159,6 +164,32 @@ def tdb_day_array(time):
     if isinstance(whole, float):  # a scalar Time (tdb_days gives Python floats): the same sum, no array casts
         return np.array([whole + rest])
     return np.atleast_1d(np.asarray(whole, dtype=float) + np.asarray(rest, dtype=float))
+
+
+def resolve_epoch(state, epoch, times):
+    """The epoch of a Scene: ``epoch``, or the state's own (:attr:`RotationState.epoch`) when it has one.
+
+    Raises SceneError when neither gives one, when ``times`` is missing, or when both are given and are not the
+    same instant (within :data:`EPOCH_MATCH_TOLERANCE`): the state belongs to its epoch, and a Scene that moved
+    it to another would describe a different motion.
+    """
+    own = getattr(state, "epoch", None)
+    if times is None:
+        raise SceneError("times expects the output times (an astropy Time); got none. Scene(state, times=...) when "
+                         "the state carries its epoch, Scene(state, epoch, times) otherwise.")
+    if epoch is None:
+        if own is None:
+            raise SceneError("epoch expects the time of the state (an astropy Time): this state carries none (states "
+                             "made by from_pole, from_tumbling or with_epoch do). Give Scene(state, epoch, times).")
+        return own
+    if own is not None and isinstance(epoch, Time) and epoch.isscalar:
+        gap = float(np.sum(np.subtract(tdb_days(epoch), tdb_days(own))))
+        if not abs(gap) <= EPOCH_MATCH_TOLERANCE:
+            raise SceneError(
+                f"epoch {epoch.tdb.isot} TDB is not the state's own epoch {own.tdb.isot} TDB ({gap:+.9g} d apart): the "
+                "state belongs to its epoch. Leave epoch out (Scene(state, times=...)), or give the state at that "
+                "epoch (state.with_epoch(epoch) if its attitude and spin are meant for it).")
+    return epoch
 
 
 def validate_times(epoch, times, either_side=False):

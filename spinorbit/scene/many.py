@@ -152,4 +152,9 @@ def run_many(scenes, plans, progress):
 def common_times(scenes):
     """(epoch, times, tolerance_rad, output_days, epoch_day) of the bodies (all equal by construction)."""
     first = next(iter(scenes.values()))
+    for name, scene in scenes.items():  # states that carry their own epochs must carry the same one
+        if scene.epoch_day != first.epoch_day:
+            raise SceneError(f"the bodies' states are at different epochs ({first.epoch.tdb.isot} and "
+                             f"{scene.epoch.tdb.isot} TDB for {name!r}): a Scene of several bodies starts them at one "
+                             "epoch. Give each state at the same epoch.")
     return first.epoch, first.times, first.tolerance_rad, np.asarray(first.output_days), first.epoch_day

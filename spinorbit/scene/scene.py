@@ -136,8 +136,10 @@ class Scene:
         A sequence or a mapping ``{name: state}`` makes a scene of several bodies
         (:mod:`spinorbit.scene.many`: planned per body, sampled once per shared orbit; names from
         ``RigidBody.name`` or ``body0``, ``body1``…).
-    epoch : astropy.time.Time
-        Time of ``state`` (scalar).
+    epoch : astropy.time.Time, optional
+        Time of ``state`` (scalar). Leave it out when the state carries its own
+        (:attr:`~spinorbit.RotationState.epoch`: ``Scene(state, times=...)``); given as well, it must be
+        that same instant.
     times : astropy.time.Time
         Output times, strictly increasing; a scalar Time means "the end only". They may lie before
         ``epoch`` or on both sides of it: the state belongs to its epoch, and the run goes from there
@@ -174,7 +176,7 @@ class Scene:
         Inputs of the wrong kind, times before the epoch, perturbers without an orbit, …
     """
 
-    def __init__(self, state, epoch, times, perturbers=(), orbit=None, tolerance=1 * u.arcsec,
+    def __init__(self, state, epoch=None, times=None, perturbers=(), orbit=None, tolerance=1 * u.arcsec,
                  quantities=QUANTITIES, integrator="auto", sample_tolerance=1e-10, thermal=None,
                  thermal_route="auto"):
         self.members, self._cache = None, None  # _cache: the SharedSamples of the plan() / run() under way
@@ -192,6 +194,7 @@ class Scene:
                 many.common_times(self.members))
             return
         self.state = inputs.validate_state(state)
+        epoch = inputs.resolve_epoch(state, epoch, times)
         if thermal is not None or (orbit is not None and getattr(orbit, "kind", None) == "kepler"):
             from spinorbit.scene.thermal import validate_thermal
 

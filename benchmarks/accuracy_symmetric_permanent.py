@@ -6,7 +6,7 @@ B = C and one with A = B, M at angle P from the equal-moment plane, under the we
 of ``tests/stress/test_handover.py`` (M changes by ~1e-3 per turn) over 20 turns, it reports the
 largest attitude error (rad) of the canonical elements and of quaternion DOP853 at the same rtol,
 both against DOP853 at rtol 1e-14, with ε / sin² P next to them. This is the measurement behind
-``integrate_elements.MIN_SIN_P``; to see the elements below it, the guard on sin P is switched off
+``spinorbit.core.integrators.elements.MIN_SIN_P``; to see the elements below it, the guard on sin P is switched off
 here (the kernel runs as plain Python over the compiled RHS, with that one test removed).
 """
 

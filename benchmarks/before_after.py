@@ -5,9 +5,9 @@ root). Each round runs one worker process per checkout, alternating which goes f
 same machine load. A worker imports the package of its own checkout, reads the three work-precision
 scenes (initial state, output times, model array: built once by this checkout's
 ``benchmarks/scenes.py`` and handed to both), calls each workload once to compile (or load numba's
-cache), then times it ``--repeat`` times with ``time.process_time``. The workloads are called through
-the pre-reorganisation import paths, which both layouts answer (the new one through
-``spinorbit/old_paths.py``), so the very same calls run in both.
+cache), then times it ``--repeat`` times with ``time.process_time``. The workloads are imported from
+the modules that own them; a base checkout from before the reorganisation into concept folders has
+them at their flat paths, which the worker falls back to, so the very same calls run in both.
 
 For each workload the report gives the median CPU per call with the min–max over all rounds and
 repeats, the ratio of the medians (new / base), and the largest difference between the two
@@ -39,12 +39,20 @@ import numpy as np
 warnings.simplefilter("ignore")
 sys.path.insert(0, sys.argv[1])
 repeat = int(sys.argv[2])
-from spinorbit.core.integrate_quaternion import integrate_quaternion
-from spinorbit.core.integrate_elements import integrate_elements
-from spinorbit.core.integrate_taylor import integrate_taylor
-from spinorbit.core.integrate_handover import integrate_with_handover
-from spinorbit.core.propagate_averaged import propagate_averaged
-from spinorbit.core.torque_free import torque_free_states_many
+try:
+    from spinorbit.core.integrators.quaternion import integrate_quaternion
+    from spinorbit.core.integrators.elements import integrate_elements
+    from spinorbit.core.integrators.taylor import integrate_taylor
+    from spinorbit.core.integrators.handover import integrate_with_handover
+    from spinorbit.core.averaging.propagate import propagate_averaged
+    from spinorbit.core.free_motion.flow import torque_free_states_many
+except ModuleNotFoundError:  # a base checkout from before the concept folders (flat core)
+    from spinorbit.core.integrate_quaternion import integrate_quaternion
+    from spinorbit.core.integrate_elements import integrate_elements
+    from spinorbit.core.integrate_taylor import integrate_taylor
+    from spinorbit.core.integrate_handover import integrate_with_handover
+    from spinorbit.core.propagate_averaged import propagate_averaged
+    from spinorbit.core.torque_free import torque_free_states_many
 
 class Scene:
     def __init__(self, data, name):

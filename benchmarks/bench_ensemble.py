@@ -90,7 +90,7 @@ def measure(members):
     # run below pays it and the forked workers start as warm as this process
     build_member(apophis_member, Ensemble(apophis_member, parameters).member_parameters(0)).run()
     Ensemble(apophis_member, parameters[:1]).run(executor="serial")
-    from spinorbit.ensemble.ensemble import clear_process_samplings
+    from spinorbit.ensemble.process_memo import clear_process_samplings
 
     clear_process_samplings()  # each timed run samples the orbit once per process, as a fresh run does
     serial = Ensemble(apophis_member, parameters)
@@ -179,7 +179,8 @@ def free_scene(i):
     """Torque-free member i as a Scene (the per-member route), the same states as :func:`_free_arrays`."""
     from astropy import units as u
 
-    from spinorbit import RigidBody, RotationState, Scene
+    from spinorbit import RigidBody, RotationState
+    from spinorbit.scene import Scene
     from spinorbit.data.asteroids import APOPHIS_STATE_EPOCH
 
     moments, quaternions, omegas = _FREE_SCENE_ARRAYS
@@ -266,7 +267,8 @@ def measure_peer(members):
     import encounter_kepler as ek
     from spinorbit.ensemble import Ensemble
     from spinorbit.ensemble.apophis import apophis_parameters
-    from spinorbit.ensemble.ensemble import clear_process_samplings, run_chunk
+    from spinorbit.ensemble.ensemble import run_chunk
+    from spinorbit.ensemble.process_memo import clear_process_samplings
     from spinorbit.state_table import QUATERNION_COLUMNS
 
     load = [os.getloadavg()[0]]
@@ -493,7 +495,7 @@ def measure_efficiency(members=EFFICIENCY_MEMBERS, repeats=EFFICIENCY_REPEATS):
     import encounter_kepler as ek
     from spinorbit.ensemble import Ensemble
     from spinorbit.ensemble.apophis import apophis_parameters
-    from spinorbit.ensemble.ensemble import clear_process_samplings
+    from spinorbit.ensemble.process_memo import clear_process_samplings
 
     load = [os.getloadavg()[0]]
     earth, sun = ek.encounter_orbits()

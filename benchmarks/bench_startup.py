@@ -6,7 +6,7 @@ outside with ``time.perf_counter`` (wall) and ``RUSAGE_CHILDREN`` (CPU, user + s
 run interleaved, round after round, so that all of them see the same load of the shared machine; the
 report gives the median and the min–max of the rounds.
 
-- ``import spinorbit.core``, ``import spinorbit``, ``from spinorbit import Scene``;
+- ``import spinorbit.core``, ``import spinorbit``, ``from spinorbit.scene import Scene``;
 - ``spinorbit moon`` (default options: the "de421" model, one year from J2000, daily comparisons),
   warm: numba's cache filled by an untimed first run;
 - the same command cold, as after a fresh install: ``NUMBA_CACHE_DIR`` and ``SPINORBIT_CACHE_DIR``
@@ -46,7 +46,7 @@ COMMANDS = {
     "python -c pass (interpreter floor)": ["-c", "pass"],
     "import spinorbit.core": ["-c", "import spinorbit.core"],
     "import spinorbit": ["-c", "import spinorbit"],
-    "from spinorbit import Scene": ["-c", "from spinorbit import Scene"],
+    "from spinorbit.scene import Scene": ["-c", "from spinorbit.scene import Scene"],
     "spinorbit moon (warm)": ["-m", "spinorbit", "moon"],
 }
 

@@ -4,7 +4,7 @@ Apophis after its 2029 encounter: the spin over the unknown phase and the moment
 
 The published spin state of (99942) Apophis (Pravec et al. 2014) fixes its periods and pole but
 not its rotation phase in 2029, and its moments of inertia are uncertain. The post-encounter spin is
-therefore a distribution, not one number. Here it is an :class:`~spinorbit.Ensemble` of Scenes
+therefore a distribution, not one number. Here it is an :class:`~spinorbit.ensemble.Ensemble` of Scenes
 (``docs/ensembles.md``). The phase is drawn uniformly on the torus of the free motion: the time
 along it as a fraction of P_ψ, and the angle of the body about its angular momentum. The moment
 ratios are drawn uniformly between the two published solutions, 0.61 : 0.965 : 1 (Pravec et al.
@@ -35,7 +35,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from astropy import units as u
 
-from spinorbit import Ensemble
+from spinorbit.ensemble import Ensemble
 from spinorbit.ensemble.apophis import apophis_member, apophis_parameters
 
 # gallery-arguments: 96

@@ -4,20 +4,16 @@ The front door. Public names are listed here; everything else is an implementati
 
 - :class:`RigidBody` — principal moments and the axes that go with them.
 - :class:`RotationState` — attitude and spin; mode, periods, canonical elements, exact free motion.
-- :class:`Scene` — a run described declaratively (body, perturbers, orbit, times, tolerance); its
-  ``plan()`` says how it will run and why, ``run()`` does it (:mod:`spinorbit.scene.scene`).
-- :class:`Ensemble` — many Scenes from a table of parameters, on any executor, one outcome table
-  (:mod:`spinorbit.ensemble`).
+- :mod:`spinorbit.scene` — :class:`~spinorbit.scene.Scene`, a run described declaratively (body,
+  perturbers, orbit, times, tolerance); its ``plan()`` says how it will run and why, ``run()`` does it.
+- :mod:`spinorbit.ensemble` — :class:`~spinorbit.ensemble.Ensemble`, many Scenes from a table of
+  parameters, on any executor, one outcome table.
 - :mod:`spinorbit.special` — elliptic functions and integrals for every parameter m ≥ 0.
 - :mod:`spinorbit.core` — the plain-float core (paper-named maps ``andoyer_to_canonical`` and
   ``canonical_to_andoyer``).
 """
 
 __version__ = "0.1.0.dev0"
-
-from spinorbit import old_paths
-
-old_paths.install()  # old import paths keep working for one release (docs/architecture.md)
 
 # The front door is lazy (PEP 562): importing ``spinorbit.core`` — e.g. inside a REBOUND callback or a
 # numba-only worker — must not pull in astropy through this package's __init__.
@@ -28,9 +24,6 @@ _PUBLIC = {
     "CanonicalElements": ".state",
     "InvalidStateError": ".state",
     "SingularElementsError": ".core.errors",
-    "Scene": ".scene",
-    "Orbit": ".scene",
-    "Ensemble": ".ensemble",
     "SpinorbitError": ".core.errors",
     "NonFiniteError": ".core.errors",
 }

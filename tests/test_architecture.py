@@ -8,8 +8,9 @@ new module is checked the day it is added:
   order (units bridge, long-run infrastructure, coupling, scene planning, data, command line);
 - no import circles between modules;
 - no module imports another module's private name (``from x import _y``);
-- only the REBOUND door (``spinorbit.coupling.rebound``) imports rebound or ctypes;
-- old import paths answer with a DeprecationWarning and the very object of the new path.
+- only the REBOUND door (``spinorbit.coupling.rebound``) imports rebound or ctypes.
+
+One public path per name (no old import paths) is checked in ``tests/test_public_paths.py``.
 """
 
 import ast
@@ -42,8 +43,8 @@ UPPER_LAYERS = (
     ("ensemble", ("spinorbit.ensemble",)),
     ("command line", ("spinorbit.cli", "spinorbit.commands", "spinorbit.__main__")),
 )
-#: Modules every layer may import: the front door's lazy table and the old-path shims.
-ANYWHERE = ("spinorbit", "spinorbit.old_paths")
+#: Modules every layer may import: the front door's lazy table.
+ANYWHERE = ("spinorbit",)
 
 
 
@@ -225,52 +226,6 @@ def test_no_module_is_too_long():
         if lines > 650 and "one concept" not in docstring:
             long.append(f"{module}: {lines} lines")
     assert long == [], "modules over the size rule without a reason in their docstring:\n" + "\n".join(long)
-
-
-def test_old_paths_warn_and_give_the_new_objects():
-    code = (
-        "import importlib, warnings\n"
-        "from spinorbit.old_paths import MOVED_MODULES, MOVED_NAMES\n"
-        "bad = []\n"
-        "for old, new in MOVED_MODULES.items():\n"
-        "    with warnings.catch_warnings(record=True) as caught:\n"
-        "        warnings.simplefilter('always')\n"
-        "        module = importlib.import_module(old)\n"
-        "    if not any(issubclass(w.category, DeprecationWarning) and old in str(w.message) for w in caught):\n"
-        "        bad.append(old + ': no DeprecationWarning')\n"
-        "    if len(new) == 1 and module is not importlib.import_module(new[0]):\n"
-        "        bad.append(old + ': not the new module')\n"
-        "print(len(MOVED_MODULES)); print('\\n'.join(bad))\n"
-    )
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    count, *bad = result.stdout.strip().split("\n")
-    assert int(count) > 0
-    assert [b for b in bad if b] == []
-
-
-@pytest.mark.parametrize(
-    ("old", "name", "new"),
-    [
-        ("spinorbit.core.dynamics", "make_model", "spinorbit.core.dynamics.equations"),
-        ("spinorbit.core.integrate_quaternion", "integrate_quaternion", "spinorbit.core.integrators.quaternion"),
-        ("spinorbit.checkpoint", "Checkpoint", "spinorbit.runs.checkpoint"),
-    ],
-)
-def test_an_old_name_is_the_new_object(old, name, new):
-    code = (
-        "import importlib, warnings\n"
-        "warnings.simplefilter('error')\n"
-        f"new = getattr(importlib.import_module({new!r}), {name!r})\n"
-        "try:\n"
-        f"    exec('from {old} import {name} as old')\n"
-        "except DeprecationWarning as warning:\n"
-        "    print('warned:', warning)\n"
-        "warnings.simplefilter('ignore')\n"
-        f"exec('from {old} import {name} as old')\n"
-        "print(old is new)\n"
-    )
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert "warned:" in result.stdout and result.stdout.strip().endswith("True"), result.stdout + result.stderr
 
 
 def test_core_entry_points_resolve():

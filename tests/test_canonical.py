@@ -13,7 +13,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from spinorbit.core import SingularElementsError, andoyer_to_canonical, canonical_to_andoyer
+from spinorbit import SingularElementsError
+from spinorbit.core import andoyer_to_canonical, canonical_to_andoyer
 from spinorbit.core.elements import canonical as cn
 from spinorbit.core.math import rotations as rot
 

@@ -13,13 +13,14 @@ import pytest
 from astropy import units as u
 from astropy.time import Time
 
-from spinorbit import RigidBody, RotationState, Scene
+from spinorbit import RigidBody, RotationState
+from spinorbit.scene import Scene
 from spinorbit.ensemble import Ensemble, EnsembleError, EnsembleInterrupted, Normal, SamplerError, Uniform
 from spinorbit.ensemble import member_seed, sample_parameters
 from spinorbit.ensemble import state_at_phase
 from spinorbit.ensemble.store import ChunkStore
 from spinorbit.runs.checkpoint import CheckpointError
-from spinorbit.ensemble.ensemble import clear_process_samplings
+from spinorbit.ensemble.process_memo import clear_process_samplings
 from spinorbit.scene import EphemerisPerturber, FixedPerturber
 
 BODY = RigidBody([0.61, 0.965, 1.0])

@@ -9,7 +9,8 @@ import pytest
 from astropy import units as u
 from astropy.time import Time
 
-from spinorbit import RigidBody, RotationState, Scene
+from spinorbit import RigidBody, RotationState
+from spinorbit.scene import Scene
 from spinorbit.ensemble import Ensemble, EnsembleError, free_members_table, state_at_phase
 
 EPOCH = Time("2029-04-08T00:00:00", scale="tdb")

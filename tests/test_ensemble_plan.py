@@ -10,10 +10,12 @@ import numpy as np
 from astropy import units as u
 from astropy.time import Time
 
-from spinorbit import RigidBody, RotationState, Scene
+from spinorbit import RigidBody, RotationState
+from spinorbit.scene import Scene
 from spinorbit.coupling.one_way import propagate_one_way
 from spinorbit.ensemble import state_at_phase
-from spinorbit.ensemble.ensemble import clear_process_samplings, run_chunk
+from spinorbit.ensemble.ensemble import run_chunk
+from spinorbit.ensemble.process_memo import clear_process_samplings
 from spinorbit.scene import EphemerisPerturber, sampling
 from spinorbit.scene.routes import attitude_angles
 from spinorbit.scene.tolerances import check_tolerance

@@ -12,8 +12,8 @@ from astropy import units as u
 from astropy.table import Table
 from astropy.time import Time
 
-from spinorbit import RigidBody, RotationState, Scene
-from spinorbit.scene import FixedPerturber, Orbit
+from spinorbit import RigidBody, RotationState
+from spinorbit.scene import FixedPerturber, Orbit, Scene
 from spinorbit.state_table import MOTION_COLUMNS, OMEGA_COLUMNS, POLE_COLUMNS, QUATERNION_COLUMNS
 
 ROOT = Path(__file__).resolve().parents[1]

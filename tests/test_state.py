@@ -7,7 +7,7 @@ import pytest
 from astropy import units as u
 
 from spinorbit.body import InvalidBodyError, RigidBody
-from spinorbit.core import SingularElementsError
+from spinorbit import SingularElementsError
 from spinorbit.state import InvalidStateError, RotationState
 
 # Takahashi, Busch & Scheeres 2013 (AJ 146, 95), Table 2: torque-free from their state gives

@@ -23,10 +23,11 @@ The stable entry points, importable from here (scripts written against them keep
   and :func:`mean_elements_stm`, :func:`osculating_elements_stm` (the averaged propagator's mean and
   osculating elements);
 - the full two-body problem of a binary asteroid: :func:`make_binary_model` (the mutual potential's
-  model array) and :func:`propagate_binary` (relative orbit and both attitudes, DOP853);
-- the errors :class:`SpinorbitError`, :class:`SingularElementsError` and :class:`NonFiniteError`.
+  model array) and :func:`propagate_binary` (relative orbit and both attitudes, DOP853).
 
-They load on first use (PEP 562), so importing one integrator does not import the others.
+They load on first use (PEP 562), so importing one integrator does not import the others. The errors
+the core raises are defined in :mod:`spinorbit.core.errors` and exported by the front door
+(``from spinorbit import SingularElementsError``; that import loads no astropy either).
 """
 
 import importlib
@@ -56,9 +57,6 @@ _ENTRY_POINTS = {
     "osculating_elements_stm": "spinorbit.core.averaging.mean_variational",
     "make_binary_model": "spinorbit.core.binary.equations",
     "propagate_binary": "spinorbit.core.binary.propagate",
-    "SpinorbitError": "spinorbit.core.errors",
-    "SingularElementsError": "spinorbit.core.errors",
-    "NonFiniteError": "spinorbit.core.errors",
 }
 
 __all__ = list(_ENTRY_POINTS)

@@ -26,7 +26,6 @@ from astropy.table import QTable
 
 from spinorbit.core.dynamics.equations import make_model
 from spinorbit.core.integrators.quaternion import integrate_quaternion
-from spinorbit import old_paths
 from spinorbit.state import RotationState
 from spinorbit.state_table import from_principal, schema_meta, table_columns, time_column, unit_quaternions
 from spinorbit.time import tdb_days
@@ -34,13 +33,6 @@ from spinorbit.time import tdb_days
 __all__ = ["DEFAULT_RTOL", "INTEGRATORS", "closest_approaches", "heliocentric_normals", "integrate_one_way",
            "one_way_days", "one_way_quaternions", "one_way_table", "propagate_one_way"]
 
-
-def __getattr__(name):
-    # The sampler (and SimulationSnapshot) lived here before the split: forwarded, with a warning.
-    # Dunder look-ups (the import system asks for __path__) are not forwarded: this is a module.
-    if name.startswith("__"):
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return old_paths.forward_attribute(__name__, name)
 
 #: Default relative tolerance of the rotation integrator (local error per DOP853 step).
 DEFAULT_RTOL = 1e-10

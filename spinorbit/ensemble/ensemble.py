@@ -45,8 +45,7 @@ from spinorbit.ensemble.process_memo import clear_process_samplings, leader_plan
 from spinorbit.ensemble.samplers import SEED_COLUMNS, sample_parameters
 from spinorbit.ensemble.store import ChunkStore
 
-__all__ = ["ROUTES", "Ensemble", "EnsembleError", "EnsembleInterrupted", "clear_process_samplings", "run_chunk",
-           "torque_free"]
+__all__ = ["ROUTES", "Ensemble", "run_chunk", "torque_free"]
 
 #: Most members in a default chunk; the default is ceil(n / 32) up to this (chunks few enough to
 #: spread over many workers, large enough that a chunk's shared sampling pays).
@@ -100,7 +99,7 @@ def build_member(make_scene, parameters):
 
     scene = make_scene(**parameters)
     if not isinstance(scene, Scene) or scene.members is not None:
-        raise EnsembleError(f"make_scene expects to return a single-body spinorbit.Scene; it returned "
+        raise EnsembleError(f"make_scene expects to return a single-body spinorbit.scene.Scene; it returned "
                             f"{type(scene).__name__}{' of several bodies' if isinstance(scene, Scene) else ''}.")
     return scene
 

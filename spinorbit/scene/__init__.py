@@ -58,9 +58,3 @@ __all__ = [
     "ThermalInputError",
     "ThermalModel",
 ]
-
-
-def __getattr__(name):
-    from spinorbit import old_paths
-
-    return old_paths.forward_attribute(__name__, name)

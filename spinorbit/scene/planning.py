@@ -136,7 +136,7 @@ def plan_scene(scene, skip=True):
 
 
 def shape_decision(scene, skip=True):
-    """Which form of the exact free flow the torque-free route runs (the dispatch of ``core.torque_free``).
+    """Which form of the exact free flow the torque-free route runs (the dispatch of ``core.free_motion.flow``).
 
     ``skip=False`` (the reference plan) runs the elliptic flow for every body, so that the closed
     form's saving and agreement can be measured against it.

@@ -23,8 +23,8 @@ from spinorbit import RigidBody, RotationState
 from spinorbit import time as so_time
 from spinorbit.body import InvalidBodyError
 from spinorbit.runs.checkpoint import Checkpoint, CheckpointError, CheckpointSchedule
+from spinorbit import SingularElementsError
 from spinorbit.core import (
-    SingularElementsError,
     andoyer_to_canonical,
     canonical_to_andoyer,
     torque_free_states_many,

@@ -19,7 +19,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from spinorbit import InvalidBodyError, InvalidStateError, NonFiniteError, RigidBody, RotationState
-from spinorbit.core import SingularElementsError
+from spinorbit import SingularElementsError
 from spinorbit.core.dynamics.equations import make_model
 from spinorbit.core.integrators.elements import integrate_elements, integrate_elements_fixed_step
 from spinorbit.core.integrators.handover import integrate_with_handover

@@ -17,7 +17,8 @@ from hypothesis import strategies as st
 
 from spinorbit import RigidBody, RotationState
 from spinorbit.body import InvalidBodyError
-from spinorbit.core import SingularElementsError, canonical_to_andoyer
+from spinorbit import SingularElementsError
+from spinorbit.core import canonical_to_andoyer
 from spinorbit.core.elements.canonical import (MO_MODE, MO_PARAM, MO_PARAM_C, MODE_LAM, MODE_SAM, inertia_constants, motion_from_elements,
                                       symmetric_gap_resolved)
 from spinorbit.core.math.rotations import euler313_to_attitude

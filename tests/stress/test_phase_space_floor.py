@@ -12,7 +12,7 @@ state:
   cannot resolve J or I below √(2 ulp) ≈ 1.5e-8 rad, so the round trip loses the 1e-12 rad and the
   floor is ~1e-8; a body spherical to 1e-12: the energy interval is 1e-12 wide, one ulp of S moves
   the state by 5e-4 rad). This is why the element integrator turns its reference frame and stops
-  near spin about C (``integrate_elements.MIN_SIN_J``, ``integrate_handover``).
+  near spin about C (``spinorbit.core.integrators.elements.MIN_SIN_J``, ``spinorbit.core.integrators.handover``).
 * **round trip** state → canonical elements (eq. 4) → state (eqs. 7–8): within ``ROUND_TRIP_FLOORS``
   floors of the backward map (measured ≤ 0.71 over the sweep).
 * **group property** of the exact flow (restart at t1): within ``GROUP_FLOORS`` floors of the flow

@@ -7,10 +7,3 @@ baselines that must not use compiled code (scipy with a plain-Python right-hand 
 the two equal. :mod:`.validation` holds the checks every integrator's wrapper makes on its input
 (state, output times, sampled span) before compiled code runs.
 """
-
-from spinorbit import old_paths
-
-
-def __getattr__(name):
-    # This path was a module before the reorganisation: its names are forwarded, with a warning.
-    return old_paths.forward_attribute(__name__, name)

@@ -9,12 +9,3 @@
   of the force function in the elements).
 """
 
-from spinorbit.core.elements.paper_maps import andoyer_to_canonical, canonical_to_andoyer
-
-__all__ = ["andoyer_to_canonical", "canonical_to_andoyer"]
-
-
-def __getattr__(name):
-    from spinorbit import old_paths
-
-    return old_paths.forward_attribute(__name__, name)

@@ -29,8 +29,10 @@ eq. (13). X_d and ∂X/∂s are built per mode from the parameter derivatives be
 
 Short-axis mode (0 ≤ m < 1), argument u = κ s (eq. 8), κ = √((a−d)(b−c)/(a d)):
     u_d = −a u / (2 d (a−d)),  m_d = f (a−c)/(a−d)²,  jm = ∫₀ᵘ sn²/dn² du′ = (pn(u, m|m) − u)/m.
+
 Long-axis mode (m > 1), argument v = √m u, parameter μ = 1/m:
     v_d = c v / (2 d (d−c)),  μ_d = −(b−c)(a−c)/((a−b)(d−c)²),  jμ = ∫₀^v sn²/dn² dv′(v|μ).
+
 The g-derivative needs no derivative with respect to a characteristic in either mode: at fixed u the
 characteristic −f of pn(u, −f|m) is a constant, and the d-derivative of g collapses (the pn and
 ∫sn²/(1 + f sn²) terms cancel exactly) to

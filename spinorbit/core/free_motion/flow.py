@@ -17,7 +17,7 @@ where a − b = (B − A)/(AB) etc. and M is the working-frame body momentum. S,
 node frame R1(I) R3(h), never change.
 
 Long spans: the phase as (whole half periods, reduced remainder)
----------------------------------------------------------------
+----------------------------------------------------------------
 Rounding ν, c G and the per-period advance of pn to doubles makes the phase drift by ≈ ε·ν·t: the
 attitude error of a double-precision evaluation grows linearly, 4e-11 rad after 1e5 time units for
 the Hairer–Lubich–Wanner body. Here every secular quantity is formed in double-double from the exact
@@ -140,18 +140,12 @@ from spinorbit.core.math.elliptic_periods import (
 from spinorbit.core.math.jacobi import sncndn_k, sncndn_reduced
 from spinorbit.core.math.rotations import attitude_to_quat, qmul_parts, quat_to_attitude
 
-# The FL_* layout and the set-up belong to .flow_constants; they are named here too because the
-# callers of the flow (the splitting integrator, tests, benchmarks) read the constants it returns.
+# The FL_* layout and the set-up are exported by their home, .flow_constants (one path per name).
 __all__ = [
-    "FLOW_SIZE", "FL_ARG0", "FL_AXIS_X", "FL_AXIS_Y", "FL_AXIS_Z", "FL_FLIP", "FL_FLIP_X", "FL_FLIP_Y",
-    "FL_FLIP_Z", "FL_G_ADVANCE_HI", "FL_G_ADVANCE_LO", "FL_G_CONST_HI", "FL_G_CONST_LO", "FL_G_RATE_HI",
-    "FL_G_RATE_LO", "FL_KAPPA_HI", "FL_KAPPA_LO", "FL_M0_X", "FL_M0_Y", "FL_M0_Z", "FL_MODE",
-    "FL_PERIODIC", "FL_PERIOD_HI", "FL_PERIOD_LO", "FL_QN_W", "FL_QN_X", "FL_QN_Y", "FL_QN_Z",
-    "FL_RATE_HI", "FL_RATE_LO", "evaluate_flow", "evaluate_into", "flow_constants", "flow_state", "propagate_many_into",
-    "propagate_state_into", "propagate_states_into", "torque_free_attitudes", "torque_free_states", "torque_free_states_many",
+    "evaluate_flow", "evaluate_into", "flow_state", "propagate_many_into", "propagate_state_into",
+    "propagate_states_into", "torque_free_attitudes", "torque_free_states", "torque_free_states_many",
     "uniform_rotation",
 ]
-
 
 
 @jit

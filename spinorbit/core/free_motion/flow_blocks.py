@@ -75,7 +75,7 @@ from spinorbit.core.math.lanes import WIDTH, broadcast, lane_of, load_lanes, sel
 
 BLOCK = WIDTH  # states per block
 
-__all__ = ["BLOCK", "INTEGRALS_SIZE", "MOTION_SIZE", "NODE_SIZE", "STAGE_SIZE", "finish_lane", "integrals_of_block", "nodes_of_block",
+__all__ = ["BLOCK", "MOTION_SIZE", "NODE_SIZE", "finish_lane", "integrals_of_block", "nodes_of_block",
            "set_up_block_start"]
 
 

@@ -73,7 +73,7 @@ from spinorbit.core.jit import jit
 from spinorbit.core.model.gravity_field import BODY_NMAX, FIG_THERMAL
 from spinorbit.core.model.perturbers import sampled_span
 
-__all__ = ["DEFAULT_LANES", "MAX_LANES", "batch_taylor_kernel", "integrate_taylor_batch"]
+__all__ = ["batch_taylor_kernel", "integrate_taylor_batch"]
 
 
 @jit

@@ -4,7 +4,7 @@ Hairer, Nørsett & Wanner, Solving ODEs I, §II.10 (the method, its error estima
 continuous extension), with scipy's ``DOP853`` coefficients (:mod:`.dop853_tableau`) and error norm,
 so a comparison against scipy measures the implementation, not the method. Every DOP853 propagator of
 the package is a thin user of this module: the quaternion equations (:mod:`.quaternion`), the
-canonical elements (:mod:`.elements`) and the mean elements
+canonical elements (:mod:`~spinorbit.core.integrators.elements`) and the mean elements
 (:mod:`spinorbit.core.averaging.propagate`, fixed steps). The pieces, as in hapsira's numba DOP853:
 
 - :func:`dop853_stages` — stages 1..11 and the 8th-order solution, for a right-hand side given as an
@@ -51,12 +51,12 @@ from spinorbit.core.integrators.dop853_tableau import INTERPOLATOR_POWER, N_STAG
 from spinorbit.core.jit import jit
 
 # Contiguous copies of the tableau: numba freezes them into the compiled code as constants.
-A = np.ascontiguousarray(_A_FULL)
-B = np.ascontiguousarray(_A_FULL[N_STAGES, :N_STAGES])
-C = np.ascontiguousarray(_C_FULL)
-D = np.ascontiguousarray(_D_FULL)
-E3 = np.ascontiguousarray(_E3_FULL)
-E5 = np.ascontiguousarray(_E5_FULL)
+A = np.array(_A_FULL, order="C")
+B = np.array(_A_FULL[N_STAGES, :N_STAGES], order="C")
+C = np.array(_C_FULL, order="C")
+D = np.array(_D_FULL, order="C")
+E3 = np.array(_E3_FULL, order="C")
+E5 = np.array(_E5_FULL, order="C")
 
 #: Step-size controller constants (Hairer's DOP853 / scipy): safety factor on the predicted step,
 #: and bounds on the step ratio that keep the controller stable after rejections and near events.

@@ -31,8 +31,7 @@ Hot-loop API: precompute per-parameter constants once, then call the ``*_k`` ker
     reciprocal parameter 1/m when m > 1, note §6.2). ``method == METHOD_DIVERGENT`` (n = m > 1)
     makes ``pn_k`` return NaN.
 
-``sncndn_k(u, mk) -> (sn, cn, dn)``, ``am_k(u, mk)``, ``ellipf_k(phi, mk)``,
-``ellippi_k(phi, mk, nk)``, ``pn_k(u, mk, pk)``
+``sncndn_k(u, mk) -> (sn, cn, dn)``, ``am_k(u, mk)``, ``ellipf_k(phi, mk)``, ``ellippi_k(phi, mk, nk)``, ``pn_k(u, mk, pk)``
     The same values as the convenience kernels below, with no per-m work.
 
 Convenience kernels (compute the constants on every call; fine outside hot loops):

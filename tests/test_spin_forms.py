@@ -15,11 +15,11 @@ from astropy import units as u
 from astropy.coordinates import ICRS, BarycentricMeanEcliptic, SkyCoord
 from astropy.time import Time
 
-from spinorbit import RigidBody, RotationState, Scene
+from spinorbit import RigidBody, RotationState
 from spinorbit.core.elements.canonical import MODE_LAM, MODE_SAM
 from spinorbit.core.free_motion import from_periods
 from spinorbit.quantities import QuantityInputError
-from spinorbit.scene import SceneError
+from spinorbit.scene import Scene, SceneError
 from spinorbit.spin_forms import SpinFormError
 
 EPOCH = Time("2013-01-01T00:00:00", scale="tdb")

@@ -118,12 +118,9 @@ def _perturbers(earth, sun):
 
 @functools.cache
 def _published_state(i1_i3, i2_i3):
-    from spinorbit.body import RigidBody
-    from spinorbit.data.asteroids import (APOPHIS_MOMENTUM_ECLIPTIC_DEG, APOPHIS_P_PHI, APOPHIS_P_PSI,
-                                          ecliptic_direction, sam_state_from_periods)
+    from spinorbit.data.asteroids import apophis_rotation_state
 
-    body = RigidBody([i1_i3, i2_i3, 1.0], name="Apophis")
-    return sam_state_from_periods(body, APOPHIS_P_PSI, APOPHIS_P_PHI, ecliptic_direction(*APOPHIS_MOMENTUM_ECLIPTIC_DEG))
+    return apophis_rotation_state(moment_ratios=(i1_i3, i2_i3))
 
 
 def member_state(phase_psi, phase_momentum, i1_i3, i2_i3):

@@ -35,12 +35,12 @@ from spinorbit.core.errors import SpinorbitError
 from spinorbit.core.free_motion import from_periods
 from spinorbit.core.free_motion.summary import MODE_SEPARATRIX, motion_summary
 from spinorbit.core.elements.canonical import MODE_UNIFORM
-from spinorbit.core.math.rotations import attitude_to_euler313, euler313_to_attitude, rot3
+from spinorbit.core.math.rotations import attitude_to_euler313, attitude_to_quat, euler313_to_attitude, rot3
 from spinorbit.frames import icrf_to_ecliptic_matrix
 from spinorbit.quantities import value_in
 
 __all__ = ["PoleSolution", "SpinFormError", "TumblingParameters", "FRAMES", "CYCLIC_AXES", "POLE_MAX_WOBBLE",
-           "THETA0_TOLERANCE", "check_epoch", "momentum_frame", "pole_attitude", "tumbling_attitude", "pole_of", "tumbling_of"]
+           "THETA0_TOLERANCE", "attitude_quaternion", "check_epoch", "momentum_frame", "pole_attitude", "tumbling_attitude", "pole_of", "tumbling_of"]
 
 #: Frames of the published angles: "ecliptic" (ecliptic and equinox J2000, IAU 2006 obliquity with the frame
 #: bias, as every spin pole in spinorbit: docs/conventions.md) and "icrf" (then λ, β are RA, Dec).
@@ -205,6 +205,12 @@ def _period_days(name, value):
     if not days > 0:
         raise SpinFormError(f"{name} expects a positive period such as 8 * u.hour; got {value!s}.")
     return days
+
+
+def attitude_quaternion(attitude) -> np.ndarray:
+    """The quaternion (w ≥ 0) of attitude matrix R (inertial → body): the sign the published forms give."""
+    q = attitude_to_quat(np.ascontiguousarray(attitude, dtype=float))
+    return -q if q[0] < 0 else q
 
 
 def _user_attitude(relabelled_attitude, axes):

@@ -219,11 +219,12 @@ class RotationState:
         r_ecl = R_z(λ) R_y(90° − β) R_z(φ0 + 2π (t − t0)/P) r_ast (Ďurech et al. 2010): the body spins at 2π/P
         about its axis of largest moment; the state is at t0 = ``epoch`` (its :attr:`epoch`). ``pole_lon``,
         ``pole_lat`` and ``phase`` are angles, ``period`` a time; ``frame`` "ecliptic" (J2000, IAU 2006) or
-        "icrf" (RA, Dec); ``axes`` which user axes are DAMIT's x, y, z (None: the largest moment on z).
+        "icrf" (RA, Dec); ``axes`` which user axes are DAMIT's x, y, z (None: the largest moment on z). The
+        quaternion has w ≥ 0.
         Definitions: ``docs/conventions.md``, "Published spin forms"; :func:`spinorbit.spin_forms.pole_attitude`.
         """
         attitude, omega, _ = _spin_forms.pole_attitude(body, pole_lon, pole_lat, period, phase, frame, axes)
-        return cls.from_matrix(body, attitude, omega * RAD_PER_DAY, _spin_forms.check_epoch(epoch))
+        return cls(body, _spin_forms.attitude_quaternion(attitude), omega * RAD_PER_DAY, _spin_forms.check_epoch(epoch))
 
     @classmethod
     def from_tumbling(cls, body, p_psi, p_phi, momentum_lon, momentum_lat, phi0, theta0, psi0, epoch, mode=None,
@@ -239,7 +240,7 @@ class RotationState:
         """
         attitude, omega, _, _ = _spin_forms.tumbling_attitude(
             body, p_psi, p_phi, momentum_lon, momentum_lat, phi0, theta0, psi0, mode, frame, axes, theta_tolerance)
-        return cls.from_matrix(body, attitude, omega * RAD_PER_DAY, _spin_forms.check_epoch(epoch))
+        return cls(body, _spin_forms.attitude_quaternion(attitude), omega * RAD_PER_DAY, _spin_forms.check_epoch(epoch))
 
     def with_epoch(self, epoch) -> "RotationState":
         """The same attitude and spin tied to ``epoch`` (a scalar Time, or None to untie it)."""

@@ -276,3 +276,28 @@ def test_epoch_travels_with_the_state_into_the_scene():
     assert moved.epoch == EPOCH + 1 * u.day and state.epoch is EPOCH
     assert np.array_equal(moved.quaternion, state.quaternion)
     assert RotationState(state.body, [1, 0, 0, 0], [0, 0, 1] * u.rad / u.day).epoch is None
+
+
+def test_apophis_data_module_is_the_published_tumbler():
+    """Pravec et al. (2014): P_ψ = 263 ± 6 h, P_φ = 27.38 ± 0.07 h, L to ecliptic (250°, −75°), I1/I3 = 0.61,
+    I2/I3 = 0.965, SAM, E/E0 = 1.024 ± 0.013 (3σ). The state is built from the first five; its periods must
+    give them back (to the round-trip bar) and its E/E0, an outcome, must lie in the published interval."""
+    from spinorbit.data.asteroids import APOPHIS_PHI0, APOPHIS_PSI0, APOPHIS_STATE_EPOCH, apophis_rotation_state
+
+    state = apophis_rotation_state()
+    p_psi, p_phi = state.periods
+    assert (p_psi / (263 * u.hour)).to_value(u.one) == pytest.approx(1, rel=ROUND_TRIP)
+    assert (p_phi / (27.38 * u.hour)).to_value(u.one) == pytest.approx(1, rel=ROUND_TRIP)
+    assert state.mode == "SAM" and state.sense == "+C" and state.epoch is APOPHIS_STATE_EPOCH
+    assert abs(state.energy_ratio - 1.024) <= 0.013
+    published = state.tumbling_parameters()
+    assert published.momentum_lon.to_value(u.deg) == pytest.approx(250, abs=1e-11)
+    assert published.momentum_lat.to_value(u.deg) == pytest.approx(-75, abs=1e-11)
+    assert (published.i1_i3, published.i2_i3) == (0.61, 0.965)
+    assert abs(_wrap((published.phi0 - APOPHIS_PHI0).to_value(u.rad))) < ROUND_TRIP
+    assert abs(_wrap((published.psi0 - APOPHIS_PSI0).to_value(u.rad))) < ROUND_TRIP
+    # another phase of the same motion at the same epoch; other moment ratios keep the published periods
+    later = apophis_rotation_state(0.25)
+    assert later.epoch is APOPHIS_STATE_EPOCH and later.periods[0].to_value(u.hour) == pytest.approx(263, rel=1e-12)
+    other = apophis_rotation_state(moment_ratios=(0.64, 0.97))  # Lee et al. 2022's ratios
+    assert [p.to_value(u.hour) for p in other.periods] == pytest.approx([263, 27.38], rel=1e-12)

@@ -4,7 +4,8 @@ What is published and what is constructed
 -----------------------------------------
 **Spin states** (cited): (99942) Apophis, Pravec et al. 2014 (Icarus 233, 48): short-axis mode,
 retrograde, P_ψ = 263 h, P_φ = 27.38 h, E/E0 = 1.024 ± 0.013, moment ratios A:B:C ≈ 0.61:0.965:1,
-angular momentum towards ecliptic (λ, β) ≈ (250°, −75°). (4179) Toutatis, Takahashi, Busch & Scheeres
+angular momentum towards ecliptic (λ, β) ≈ (250°, −75°), taken in the published tumbler form by
+:meth:`spinorbit.RotationState.from_tumbling` (the rotation phase, unknown at 2029, is this package's choice). (4179) Toutatis, Takahashi, Busch & Scheeres
 2013 (AJ 146, 95, Table 2): epoch 1992-11-09T17:49:47 UTC, moments (x, y, z) = 3.0836 : 3.235 : 1
 (z the long axis), ZXZ Euler angles body → inertial (145.498°, 65.865°, 241.524°), body angular
 velocity (14.51, 33.529, −98.709) deg/day.
@@ -45,7 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 from astropy import units as u
 from astropy.time import Time
-from scipy.optimize import brentq, minimize_scalar
+from scipy.optimize import minimize_scalar
 
 from spinorbit.body import RigidBody
 from spinorbit.core.math import rotations as _rotations
@@ -81,8 +82,13 @@ __all__ = [
     "apophis_encounter_simulation",
     "apophis_rotation_state",
     "APOPHIS_STATE_EPOCH",
+    "APOPHIS_P_PSI",
+    "APOPHIS_P_PHI",
+    "APOPHIS_MOMENTUM_ECLIPTIC_DEG",
+    "APOPHIS_MOMENT_RATIOS",
+    "APOPHIS_PHI0",
+    "APOPHIS_PSI0",
     "toutatis_rotation_state",
-    "sam_state_from_periods",
     "ecliptic_direction",
     "aligning_quaternion",
     "OsculatingElements",
@@ -485,90 +491,53 @@ def aligning_quaternion(v_body, v_inertial):
     return q / np.linalg.norm(q)
 
 
-def _sam_state(body, d, momentum, direction):
-    big_a, big_b, big_c = body.principal_moments
-    b, c = 1 / big_b, 1 / big_c
-    along_c = momentum * math.sqrt((b - d) / (b - c))  # from 2T = b(G² − L²) + c L² = d G²
-    principal_momentum = np.array([0.0, math.sqrt(momentum**2 - along_c**2), along_c])
-    p = body.to_principal
-    user_momentum = p.T @ principal_momentum
-    q = aligning_quaternion(user_momentum, direction)
-    return RotationState(body, q, user_momentum / body.moment_values)
-
-
-def sam_state_from_periods(body, p_psi, p_phi, momentum_direction):
-    """A short-axis-mode state with given periods and angular-momentum direction.
-
-    P_ψ/P_φ depends only on d = 2T/G² (at fixed moments), and both periods scale as 1/G, so d is
-    found by root finding on the ratio and G then from P_ψ. The attitude puts the body momentum
-    (0, ·, +L_C) on ``momentum_direction`` by the smallest rotation — one choice of the (unknown)
-    rotation phase; the momentum has a positive component on +C.
-
-    Parameters
-    ----------
-    body : RigidBody
-    p_psi, p_phi : Quantity
-        Rotation and precession periods (Pravec et al. 2005 convention, :attr:`RotationState.periods`).
-    momentum_direction : array_like (3,)
-        Unit vector of the angular momentum in the inertial frame of the state (ICRF here).
-
-    Returns
-    -------
-    RotationState
-    """
-    big_a, big_b, big_c = body.principal_moments
-    b, c = 1 / big_b, 1 / big_c
-    ratio = (p_psi / p_phi).to_value(u.dimensionless_unscaled)
-    direction = np.asarray(momentum_direction, float)
-
-    def mismatch(d):
-        pp, pf = _sam_state(body, d, 1.0, direction).periods
-        return (pp / pf).to_value(u.dimensionless_unscaled) - ratio
-
-    # Keep off the separatrix (d = b, periods → ∞) and principal rotation (d = c, P_ψ → finite but
-    # the mode degenerates) by relative margins of 1e-9.
-    d = brentq(mismatch, c * (1 + 1e-9), b * (1 - 1e-9), xtol=1e-15, rtol=1e-14)
-    unit_periods = _sam_state(body, d, 1.0, direction).periods
-    momentum = (unit_periods[0] / p_psi).to_value(u.dimensionless_unscaled)
-    return _sam_state(body, d, momentum, direction)
-
-
-#: Pravec et al. (2014) Apophis: P_ψ, P_φ and the angular-momentum direction (ecliptic J2000).
+#: (99942) Apophis as Pravec et al. (2014, Icarus 233, 48) publish it, in the tumbler form of Kaasalainen (2001):
+#: SAM, P_ψ = 263 ± 6 h, P_φ = 27.38 ± 0.07 h, angular momentum towards ecliptic (λ_L, β_L) = (250°, −75°),
+#: moment ratios I1/I3 = 0.61, I2/I3 = 0.965 (3σ errors as published; E/E0 = 1.024 ± 0.013 follows from them,
+#: the state gives 1.0236). Their Euler angles (φ0, ψ0) and epoch JD0 are not reproduced here: they were not in the
+#: sources available when this module was written, and a 2012–13 phase could not be carried to 2029 anyway (P_ψ ± 6 h is
+#: ± 0.5 turns after 16 years). :data:`APOPHIS_PHI0`, :data:`APOPHIS_PSI0` below are this package's choice.
 APOPHIS_P_PSI = 263.0 * u.hour
 APOPHIS_P_PHI = 27.38 * u.hour
 APOPHIS_MOMENTUM_ECLIPTIC_DEG = (250.0, -75.0)
-
+APOPHIS_MOMENT_RATIOS = (0.61, 0.965)
 
 #: Where the Apophis state is placed: 5 days before the 2029 perigee (APOPHIS_2029, TDB). The published
 #: periods and pole (2012-2013 photometry) do not fix the rotation phase 16 years later, so the state
 #: at this epoch is the constructed one moved along its free motion by ``phase`` × P_psi.
 APOPHIS_STATE_EPOCH = APOPHIS_2029.time_tdb - 5 * u.day
+#: The rotation phase at :data:`APOPHIS_STATE_EPOCH` (not published; see above): ψ0 = 0 puts the body momentum in
+#: the body's y–z plane, and φ0 is that of the state the examples and docs have used since they began (the
+#: smallest rotation taking that body momentum to the published direction), so their numbers stay comparable.
+#: θ0 follows from the periods and ψ0 (53.83°).
+APOPHIS_PHI0 = 62.373763573 * u.deg
+APOPHIS_PSI0 = 0.0 * u.deg
 
 
-def apophis_rotation_state(phase=0.0):
-    """Apophis (Pravec et al. 2014) as a :class:`RotationState` with the attitude relative to ICRF.
+def apophis_rotation_state(phase=0.0, moment_ratios=APOPHIS_MOMENT_RATIOS):
+    """Apophis (Pravec et al. 2014) at :data:`APOPHIS_STATE_EPOCH`, attitude relative to ICRF (its ``epoch``).
 
-    SAM with P_ψ = 263 h, P_φ = 27.38 h, moments 0.61 : 0.965 : 1; angular momentum towards ecliptic
-    (λ, β) = (250°, −75°) — a retrograde spin (β < 0). E/E0 then follows from the moments and periods
-    (the examples print it against the published 1.024 ± 0.013). The state belongs to
-    :data:`APOPHIS_STATE_EPOCH` (5 d before the 2029 perigee).
+    ``RotationState.from_tumbling`` of the published P_ψ, P_φ, (λ_L, β_L) and moment ratios, with the phase
+    (:data:`APOPHIS_PHI0`, :data:`APOPHIS_PSI0`) the published solution leaves unknown at 2029.
 
     Parameters
     ----------
     phase : float
-        The rotation phase, which the published solution leaves unknown at 2029, in [0, 1): the
-        state is :func:`sam_state_from_periods`' (the smallest rotation putting the momentum on its
-        direction) moved along its own free motion by ``phase`` × P_ψ. 0 (default) is that state
-        itself, the one the examples and docs quote as "phase as constructed".
+        The rotation phase, in [0, 1): the state is moved along its own free motion by ``phase`` × P_ψ
+        (its epoch stays). 0 (default) is the state itself, "phase as constructed" in the examples and docs.
+    moment_ratios : (float, float)
+        I1/I3, I2/I3 of the body (default: the published 0.61, 0.965); the ensemble varies them.
     """
     if not (isinstance(phase, (int, float)) and 0.0 <= phase < 1.0):
         raise ValueError(f"phase expects a fraction of the rotation period P_psi in [0, 1); got {phase!r}.")
-    state = sam_state_from_periods(APOPHIS_BODY, APOPHIS_P_PSI, APOPHIS_P_PHI,
-                                   ecliptic_direction(*APOPHIS_MOMENTUM_ECLIPTIC_DEG))
+    body = APOPHIS_BODY if tuple(moment_ratios) == APOPHIS_MOMENT_RATIOS else RigidBody(
+        [*moment_ratios, 1.0], name="Apophis")
+    state = RotationState.from_tumbling(body, APOPHIS_P_PSI, APOPHIS_P_PHI, *(a * u.deg for a in APOPHIS_MOMENTUM_ECLIPTIC_DEG),
+                                        APOPHIS_PHI0, None, APOPHIS_PSI0, APOPHIS_STATE_EPOCH, mode="SAM")
     if phase == 0.0:
         return state
     quaternions, omegas = state.propagate_torque_free(phase * APOPHIS_P_PSI)
-    return RotationState(APOPHIS_BODY, quaternions[0], omegas[0])
+    return RotationState(body, quaternions[0], omegas[0], epoch=state.epoch)
 
 
 #: Takahashi et al. (2013) Toutatis Euler angles (deg) and body angular velocity (deg/day, x, y, z).

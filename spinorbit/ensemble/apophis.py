@@ -40,23 +40,12 @@ def encounter_orbit(orbit="published"):
 def apophis_member(phase_psi, phase_momentum, i1_i3, i2_i3, span_days=4.0, orbit="published",
                    perturbers=("sun", "earth", "moon"), tolerance_arcsec=1.0):
     """One member's Scene: from the published state's epoch to ``span_days / 2`` after the 2029 perigee."""
-    from spinorbit.body import RigidBody
-    from spinorbit.data.asteroids import (
-        APOPHIS_2029,
-        APOPHIS_MOMENTUM_ECLIPTIC_DEG,
-        APOPHIS_P_PHI,
-        APOPHIS_P_PSI,
-        APOPHIS_STATE_EPOCH,
-        ecliptic_direction,
-        sam_state_from_periods,
-    )
+    from spinorbit.data.asteroids import APOPHIS_2029, APOPHIS_STATE_EPOCH, apophis_rotation_state
     from spinorbit.scene import Scene
 
     if isinstance(perturbers, str):  # a table column holds the names as one string
         perturbers = perturbers.split()
-    body = RigidBody([i1_i3, i2_i3, 1.0], name="Apophis")
-    state = sam_state_from_periods(body, APOPHIS_P_PSI, APOPHIS_P_PHI, ecliptic_direction(*APOPHIS_MOMENTUM_ECLIPTIC_DEG))
-    state = state_at_phase(state, phase_psi, phase_momentum)
+    state = state_at_phase(apophis_rotation_state(moment_ratios=(i1_i3, i2_i3)), phase_psi, phase_momentum)
     end = APOPHIS_2029.time_tdb + 0.5 * span_days * u.day
     return Scene(state, APOPHIS_STATE_EPOCH, end, perturbers=tuple(perturbers), orbit=encounter_orbit(orbit),
                  tolerance=tolerance_arcsec * u.arcsec)

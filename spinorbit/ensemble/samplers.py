@@ -142,6 +142,8 @@ def state_at_phase(state, fraction_of_p_psi=0.0, fraction_about_momentum=0.0):
         Rotation of the whole body about its (fixed, inertial) angular momentum by 2π × this fraction:
         the precession's phase. Body-frame spin, mode, periods and pole are unchanged.
 
+    The result keeps ``state.epoch``: it is another phase of the motion at the same instant.
+
     Returns
     -------
     RotationState
@@ -153,11 +155,11 @@ def state_at_phase(state, fraction_of_p_psi=0.0, fraction_about_momentum=0.0):
             raise SamplerError(f"{name} expects a fraction in [0, 1); got {value!r}.")
     if fraction_of_p_psi:
         quaternions, omegas = state.propagate_torque_free(fraction_of_p_psi * state.periods[0])
-        state = RotationState(state.body, quaternions[0], omegas[0])
+        state = RotationState(state.body, quaternions[0], omegas[0], epoch=state.epoch)  # another phase, same epoch
     if fraction_about_momentum:
         turn = _turn_about(state.angular_momentum_direction, 2.0 * np.pi * float(fraction_about_momentum))
         # R' = R Tᵀ: the body turned by T about L; R' L = R L, so the body-frame momentum is unchanged
-        state = RotationState.from_matrix(state.body, state.attitude_matrix @ turn.T, state.angular_velocity)
+        state = RotationState.from_matrix(state.body, state.attitude_matrix @ turn.T, state.angular_velocity, state.epoch)
     return state
 
 

@@ -134,7 +134,7 @@ def scenes():
                       orbit=Orbit.rebound(simulation_from_de421(EPOCH), "Moon"), tolerance=1 * u.arcsec,
                       integrator="taylor")))
     start = asteroids.APOPHIS_2029.time_tdb - 1 * u.day
-    flyby = Scene(asteroids.apophis_rotation_state(), start, start + np.linspace(0.02, 2.0, 100) * u.day,
+    flyby = Scene(asteroids.apophis_rotation_state().with_epoch(start), start, start + np.linspace(0.02, 2.0, 100) * u.day,
                   perturbers=("sun", "earth", "moon", "venus", "mars", "jupiter"),
                   orbit=Orbit.rebound(asteroids.apophis_encounter_simulation("published"), "Apophis"), tolerance=1 * u.arcsec)
     out.append(("drop perturbers (N-body)", "Apophis 2029 flyby +-1 d, Sun, Earth, Moon + 3 planets (REBOUND)",

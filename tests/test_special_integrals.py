@@ -16,7 +16,7 @@ from spinorbit.core.math import elliptic as kernels
 
 pytestmark = pytest.mark.validation
 
-# F, Π, pn: relative error target from the issue; the Carlson forms chosen (note §6.3–6.6) have no
+# F, Π, pn: relative error target from the issue; the Carlson forms chosen (DLMF 19.25.5, 19.25.14, 19.7.8, 19.20.18) have no
 # cancellation, so a few ε are expected away from the m > 1 turning points.
 INTEGRAL_REL_TOL = 1e-14
 
@@ -151,7 +151,7 @@ EXPONENT = st.floats(-30.0, 30.0)
 @given(x=EXPONENT, y=EXPONENT, z=EXPONENT, p=EXPONENT, zero_z=st.booleans())
 def test_carlson_against_mpmath(x, y, z, p, zero_z):
     # arguments log-uniform over 60 decades (unbalanced arguments are where a wrong stopping
-    # constant shows, note pitfall 14), and z = 0 as in the complete integrals
+    # constant shows: Carlson 1995's stopping rule), and z = 0 as in the complete integrals
     x, y, z, p = 10.0**x, 10.0**y, 0.0 if zero_z else 10.0**z, 10.0**p
     X, Y, Z, P = (mp.mpf(v) for v in (x, y, z, p))
     assert relative_error(kernels.rf(x, y, z), mp.elliprf(X, Y, Z)) <= CARLSON_REL_TOL
@@ -162,7 +162,7 @@ def test_carlson_against_mpmath(x, y, z, p, zero_z):
 
 
 # R_F at the largest deviation its stopping rule leaves to the series: the degree-7 series there
-# truncates at 0.05 ε (note on RF_STOP); with the rounding of the series, the root and the quotient
+# truncates at 0.05 ε (the comment on RF_STOP); with the rounding of the series, the root and the quotient
 # the measured worst is 1.4 ε over these draws. A degree-5 series at this stop would be off by ~1e-13.
 RF_AT_STOP_REL_TOL = 2.0 * 2.0**-52
 

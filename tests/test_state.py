@@ -11,7 +11,7 @@ from spinorbit import SingularElementsError
 from spinorbit.state import InvalidStateError, RotationState
 
 # Takahashi, Busch & Scheeres 2013 (AJ 146, 95), Table 2: torque-free from their state gives
-# 5.369 d / 7.412 d (anchors.md); quoted to 4 digits, so compare to half a unit of the last digit.
+# 5.369 d / 7.412 d (torque-free from Takahashi, Busch & Scheeres 2013, Table 2); quoted to 4 digits, so compare to half a unit of the last digit.
 TOUTATIS_PERIODS_DAY = (5.369, 7.412)
 QUOTED_DIGITS_TOLERANCE = 0.0005  # day
 

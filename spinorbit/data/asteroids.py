@@ -146,15 +146,15 @@ TOUTATIS_ELEMENTS = HeliocentricDirections(
 #: "dubious year"); we assume none after 2017, so TT = UTC + 69.184 s.
 APOPHIS_2029 = EncounterGeometry(
     "Apophis", Time("2029-04-13T21:47:09.184", scale="tt"), 38_000.0, 7.4, APOPHIS_ELEMENTS,
-    "≈ 38 000 km from Earth's centre at ≈ 7.4 km/s on 2029-04-13 21:46 UTC (project anchors, "
-    "/work/shared/notes/anchors.md; JPL close-approach data give 38 012 km)",
+    "≈ 38 000 km from Earth's centre at ≈ 7.4 km/s on 2029-04-13 21:46 UTC ("
+    "JPL Small-Body Database close-approach data give 38 012 km)",
 )
-#: 2004-09-29 ≈ 13:37 UTC at 0.01036 au (project anchors). The perigee speed is not in the anchors;
-#: it is the one of the element-derived v∞ (computed, see :func:`encounter_state`), so ``speed_km_s``
+#: 2004-09-29 ≈ 13:37 UTC at 0.01036 au (JPL Small-Body Database close-approach data). The perigee
+#: speed is the one of the element-derived v∞ (computed, see :func:`encounter_state`), so ``speed_km_s``
 #: is None here.
 TOUTATIS_2004 = EncounterGeometry(
     "Toutatis", Time("2004-09-29T13:37:00", scale="utc"), 0.01036 * 149_597_870.7, None, TOUTATIS_ELEMENTS,
-    "0.01036 au from Earth on 2004-09-29 (project anchors); time of day ≈ 13:37 UTC (recalled, approximate)",
+    "0.01036 au from Earth on 2004-09-29 (JPL Small-Body Database close-approach data); time of day ≈ 13:37 UTC (recalled, approximate)",
 )
 
 #: Apophis moment ratios A:B:C (Pravec et al. 2014), principal axes = user axes.
@@ -433,7 +433,7 @@ class OsculatingElements:
 
 
 _TOUTATIS_SOURCE = ("JPL Small-Body Database osculating elements (ecliptic and equinox J2000) as quoted in public "
-                    "encyclopedia infoboxes, 4-5 digits (/work/shared/data/toutatis_orbit.json)")
+                    "encyclopedia infoboxes, 4-5 digits)")
 #: (4179) Toutatis: the two published element sets of the project's reference data
 #: (``../shared/data/toutatis_orbit.json``), keyed by the epoch's year. SBDB's ecliptic is JPL's
 #: (IAU 1976 obliquity): ``frame="ecliptic"``. The 2008 set, the nearer to 1992–2012, is the default.

@@ -9,7 +9,7 @@ Earth's and Moon's degree-2 torques on the published orbit (REBOUND from the JPL
 once per process and shared by the members of a chunk).
 
 Moment ratios: the default ranges span the two published solutions in the project's sources
-(``/work/shared/notes/anchors.md``): Pravec et al. 2014, 0.61 : 0.965 : 1, and Lee et al. 2022,
+(see :mod:`spinorbit.data.asteroids`): Pravec et al. 2014, 0.61 : 0.965 : 1, and Lee et al. 2022,
 0.64 : 0.97 : 1. They stand in for the formal uncertainties, which those sources do not quote.
 """
 
@@ -23,7 +23,7 @@ from spinorbit.ensemble.samplers import Uniform, sample_parameters, state_at_pha
 
 __all__ = ["I1_I3_RANGE", "I2_I3_RANGE", "apophis_member", "apophis_parameters", "encounter_orbit"]
 
-#: I1/I3 and I2/I3 between Pravec et al. (2014) and Lee et al. (2022) (anchors.md).
+#: I1/I3 and I2/I3 between Pravec et al. (2014) and Lee et al. (2022).
 I1_I3_RANGE = (0.61, 0.64)
 I2_I3_RANGE = (0.965, 0.97)
 

@@ -358,7 +358,7 @@ def _argument_of_momentum(mx, my, mz, mode, ic, mk):
 
     :func:`.canonical.amplitude_from_momentum` followed by :func:`.elliptic_integrals.ellipf_k`,
     without the atan2 and the sin, cos of its result (:func:`_amplitude_of_momentum`):
-    F = 2jK + sin r · R_F(cos² r, cos² r + p_c sin² r, 1) (note §6.3). The set-up forms the same
+    F = 2jK + sin r · R_F(cos² r, cos² r + p_c sin² r, 1) (DLMF 19.25.5, 19.25.14). The set-up forms the same
     sum with this R_F paired with another (:func:`flow_constants_buffers`).
     """
     j, s, c = _amplitude_of_momentum(mx, my, mz, mode, ic)

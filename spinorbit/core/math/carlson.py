@@ -13,7 +13,7 @@ from spinorbit.core.math.lanes import any_lane, select
 
 EPSILON = 2.0**-52
 # Carlson (1995) stopping constants: iterate until 4^-n Q < |A_n| with Q = C·max|A0 − arg|, i.e.
-# until the iterates' largest relative deviation from their mean is below 1/C (note pitfall 14: a
+# until the iterates' largest relative deviation from their mean is below 1/C (Carlson 1995's stopping rule; a
 # wrong constant here fails silently). R_F sums its series to degree 7 (DLMF 19.36.1), whose
 # truncation error is ∝ deviation⁸: C = (3ε)^(-1/8) stops one duplication (three square roots)
 # earlier than the degree-5 series' (3ε)^(-1/6) ≈ 338, with a smaller worst truncation error
@@ -125,7 +125,7 @@ def rf_pair_lanes(x1, y1, z1, x2, y2, z2):
 def rc_from_difference(x, y, y_minus_x):
     """R_C(x, y) for x ≥ 0, y > 0, with d = y − x supplied by the caller (DLMF 19.2.17–19).
 
-    Exact when d is known without cancellation (note §6.4: y − x = s²(1 + m + f + g)).
+    Exact when d is known without cancellation (DLMF 19.7.8: y − x = s²(1 + m + f + g)).
     y > x: atan2(√d, √x)/√d. y < x: atanh(√(−d/x))/√(−d) while −d/x ≤ ½, else the logarithm
     ln((√x + √(−d))/√y)/√(−d), because atanh near 1 would amplify the rounding of its argument.
     """

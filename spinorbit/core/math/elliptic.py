@@ -6,7 +6,7 @@ complementary parameter ``mc = 1 − m``, formed by the caller from inertia diff
 (``docs/conventions.md``). The sign of ``mc`` selects the regime: ``mc > 0`` short-axis mode
 (0 ≤ m < 1), ``mc == 0`` the separatrix m = 1 (closed forms), ``mc < 0`` long-axis mode (m > 1,
 through the reciprocal parameter μ = 1/m with μ_c = −mc/m). Formulas and the reasons for each
-choice: ``/work/shared/notes/elliptic-numerics.md`` ("note §6.x") and ``docs/elliptic.md``.
+choice, with the DLMF and Carlson (1995) equations each one follows: ``docs/elliptic.md``.
 
 The kernels live in four modules, one concept each; this module gathers their public names so that
 callers (and :mod:`spinorbit.special`) have one place to import the elliptic layer from:
@@ -28,7 +28,7 @@ Hot-loop API: precompute per-parameter constants once, then call the ``*_k`` ker
     For Π(φ, n | m): (method, n, f, g, Π(n|m)) with f = −n, g = m/f and the complete integral.
 ``pk = pn_constants(n, m, mc)``
     For pn(u, n | m): the same layout, for the characteristic actually integrated (n/m with the
-    reciprocal parameter 1/m when m > 1, note §6.2). ``method == METHOD_DIVERGENT`` (n = m > 1)
+    reciprocal parameter 1/m when m > 1, DLMF 22.17.2–4). ``method == METHOD_DIVERGENT`` (n = m > 1)
     makes ``pn_k`` return NaN.
 
 ``sncndn_k(u, mk) -> (sn, cn, dn)``, ``am_k(u, mk)``, ``ellipf_k(phi, mk)``, ``ellippi_k(phi, mk, nk)``, ``pn_k(u, mk, pk)``

@@ -5,7 +5,7 @@ The hot-loop forms take the constants of :func:`.elliptic_periods.parameter_cons
 characteristic (``characteristic_constants`` for Π, ``pn_constants`` for pn: the ``NK_*`` layout);
 φ is reduced by π and u by the half period, so the secular part is exact multiples of the complete
 integrals. pn (paper eq. 9) is Π evaluated at the sn, cn, dn of the reduced argument, no
-trigonometric call. Domain, NaN cases and formulas: ``docs/elliptic.md`` (notes §6.2–6.7).
+trigonometric call. Domain, NaN cases and formulas: ``docs/elliptic.md`` (DLMF 19.25, 22.5, 22.17).
 """
 
 import math
@@ -30,9 +30,9 @@ from spinorbit.core.math.elliptic_periods import (
 from spinorbit.core.math.jacobi import sncndn_reduced
 
 # Methods for the characteristic n (see characteristic_constants).
-METHOD_GENERAL = 0  # Π = F + (n/3) s³ R_J(c², Δ², 1, p), n < 1 and not the cases below (note §6.3)
-METHOD_LARGE_NEGATIVE = 1  # n = −f with f ≥ 1: R_C form (note §6.4), no cancellation for f → ∞
-METHOD_EQUAL_TO_M = 2  # n = m: R_J(c², Δ², 1, Δ²) = R_D(c², 1, Δ²), exact as m → 1 (note §6.5)
+METHOD_GENERAL = 0  # Π = F + (n/3) s³ R_J(c², Δ², 1, p), n < 1 and not the cases below (DLMF 19.25.5, 19.25.14)
+METHOD_LARGE_NEGATIVE = 1  # n = −f with f ≥ 1: R_C form (DLMF 19.7.8), no cancellation for f → ∞
+METHOD_EQUAL_TO_M = 2  # n = m: R_J(c², Δ², 1, Δ²) = R_D(c², 1, Δ²), exact as m → 1 (DLMF 19.20.18)
 METHOD_DIVERGENT = 3  # pn(u, m | m) for m > 1: 1/(1 − m sn²) is non-integrable; result NaN
 
 # Indices into the characteristic-constants tuple (characteristic_constants, pn_constants).
@@ -51,7 +51,7 @@ def characteristic_constants(n, m, mc):
     """Constants of the characteristic n for Π(φ, n | m): (method, n, f, g, Π(n|m)).
 
     method (``METHOD_*``) picks the formula: n == m → R_D form; n = −f with f ≥ 1 → R_C form with
-    g = m/f (note §6.4; never used at f = 0); otherwise the plain Carlson form. Π(n|m) is the
+    g = m/f (DLMF 19.7.8; never used at f = 0); otherwise the plain Carlson form. Π(n|m) is the
     complete integral for 0 ≤ m < 1 (used for the reduction φ = jπ + r), NaN for m ≥ 1 where no
     reduction happens (F, Π are only real on |φ| ≤ π/2 there).
     """
@@ -115,7 +115,7 @@ def pi_principal(s, c2, delta2, f_part, nk):
         m_term = g * f  # ≈ m
         one_g = 1.0 + g * s2
         x = c2 * delta2
-        # y − x = s²(1 + m + f + g) exactly, because f·g = m (note §6.4)
+        # y − x = s²(1 + m + f + g) exactly, because f·g = m (DLMF 19.7.8)
         y_minus_x = s2 * (1.0 + m_term + f + g)
         rc_term = rc_from_difference(x, x + y_minus_x, y_minus_x)
         result = s * rc_term
@@ -140,9 +140,9 @@ def pi_principal(s, c2, delta2, f_part, nk):
 def ellipf_k(phi, mk):
     """Incomplete integral of the first kind F(φ|m) = ∫₀^φ dθ/√(1 − m sin²θ) (DLMF 19.2.4).
 
-    m < 1: φ = jπ + r, F = 2jK + s R_F(c², c² + mc s², 1) (note §6.1, §6.3). m = 1: atanh(sin φ)
+    m < 1: φ = jπ + r, F = 2jK + s R_F(c², c² + mc s², 1) (DLMF 19.2.10, 19.25.5). m = 1: atanh(sin φ)
     via the same Carlson form for |φ| < π/2, ±inf beyond. m > 1: Carlson form unchanged where
-    m sin²φ ≤ 1 and |φ| ≤ π/2 (note §6.2), NaN elsewhere.
+    m sin²φ ≤ 1 and |φ| ≤ π/2 (DLMF 22.17.2–4), NaN elsewhere.
     """
     mc = mk[MK_MC]
     if mc > 0.0:
@@ -210,7 +210,7 @@ def ellippi(n, phi, m, mc):
 def pn_constants(n, m, mc):
     """Characteristic constants for pn, in the layout of characteristic_constants.
 
-    m ≤ 1: those of Π(·, n | m). m > 1: those of Π(·, n/m | 1/m) (note §6.2:
+    m ≤ 1: those of Π(·, n | m). m > 1: those of Π(·, n/m | 1/m) (DLMF 22.17.2–4:
     pn(u, n|m) = pn(√m u, n/m | 1/m)/√m); n = m > 1 gives METHOD_DIVERGENT (NaN results).
     """
     if mc >= 0.0:
@@ -224,7 +224,7 @@ def pn_constants(n, m, mc):
 
 @jit
 def _pn_separatrix(u, n):
-    """pn(u, n | 1) in closed form (integrate 1/(1 − n tanh²u); note §6.7 with atanh(tanh u) = u)."""
+    """pn(u, n | 1) in closed form (integrate 1/(1 − n tanh²u); DLMF 22.5.8 with atanh(tanh u) = u)."""
     if n == 1.0:
         return 0.5 * u + 0.25 * math.sinh(2.0 * u)  # ∫ cosh²
     if n <= 0.0:
@@ -239,9 +239,9 @@ def _pn_separatrix(u, n):
 def pn_k(u, mk, pk):
     """pn(u, n | m) with ``mk = parameter_constants(m, mc)``, ``pk = pn_constants(n, m, mc)``.
 
-    m < 1 (note §6.6): u = 2jK + r, pn = 2jΠ(n|m) + Π(am r, n|m), where Π(am r) comes from
+    m < 1 (docs/elliptic.md, Formulas): u = 2jK + r, pn = 2jΠ(n|m) + Π(am r, n|m), where Π(am r) comes from
     s, c, d = sn, cn, dn(r) with Δ² = d² and F(am r) = r (no trigonometric call).
-    m > 1: the same at (√m r, n/m | 1/m), divided by √m (note §6.2). m = 1: closed forms.
+    m > 1: the same at (√m r, n/m | 1/m), divided by √m (DLMF 22.17.2–4). m = 1: closed forms.
     """
     mc = mk[MK_MC]
     method = pk[NK_METHOD]

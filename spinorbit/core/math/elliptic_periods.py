@@ -5,7 +5,7 @@ takes (``mk = parameter_constants(m, mc)``: the reduced parameter, the quarter p
 double-double from the AGM, the half period split for exact multiples), the complete integral
 K(m), and the two reductions built on them: of u by the half period 2K and of φ by π (Cody–Waite).
 Dimensionless numba scalar kernels; m is the parameter and mc = 1 − m is supplied exactly by the
-caller (``docs/conventions.md``). Why double-double and why the split: ``docs/elliptic.md`` (note §6.1).
+caller (``docs/conventions.md``). Why double-double and why the split: ``docs/elliptic.md`` (docs/elliptic.md, Reduction).
 """
 
 import math
@@ -74,11 +74,11 @@ def parameter_constants(m, mc):
 
     Layout (indices ``MK_*``): (m, mc, μ, μ_c, √μ_c, √m, K_hi, K_lo, head, tail).
     For m < 1: μ = m, μ_c = mc, K = K(m), and head + tail = 2K (the half period of sn, cn in u).
-    For m > 1: μ = 1/m, μ_c = −mc/m (from the supplied mc, never 1 − 1/m; note §6.2), K = K(μ)
+    For m > 1: μ = 1/m, μ_c = −mc/m (from the supplied mc, never 1 − 1/m; DLMF 22.17.2–4), K = K(μ)
     (quarter period of the functions of v = √m u), head + tail = 2K(μ)/√m (half period in u).
-    For m = 1 (mc == 0): K = head = ∞ and the kernels use closed forms (note §6.7).
+    For m = 1 (mc == 0): K = head = ∞ and the kernels use closed forms (DLMF 22.5.8).
     NaN m or mc gives all-NaN constants, so every kernel then returns NaN.
-    head has 24 significant bits so ``j*head`` is exact for |j| < 2^29 (note §6.1).
+    head has 24 significant bits so ``j*head`` is exact for |j| < 2^29 (docs/elliptic.md, Reduction).
     """
     if m != m or mc != mc:
         nan = math.nan
@@ -164,7 +164,7 @@ def reduce_by_period(u, head, tail):
 
 @jit
 def reduce_by_pi(phi):
-    """j = rint(φ/π), r = φ − jπ with π in three parts (Cody–Waite; note §6.1).
+    """j = rint(φ/π), r = φ − jπ with π in three parts (Cody–Waite; docs/elliptic.md, Reduction).
 
     Parameters
     ----------

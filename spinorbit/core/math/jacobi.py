@@ -144,8 +144,8 @@ def sncndn_k(u, mk):
     """sn(u|m), cn(u|m), dn(u|m) with precomputed ``mk = parameter_constants(m, mc)``.
 
     m < 1: u = 2jK + r, |r| ≤ K, sn = (−1)^j sn r, cn = (−1)^j cn r, dn = dn r (DLMF 22.4.3).
-    m > 1: reciprocal parameter (DLMF 22.17.2–4, note §6.2), v = √m·r with the reduction done in u.
-    m = 1: sn = tanh u, cn = dn = sech u (DLMF 22.5.8, note §6.7).
+    m > 1: reciprocal parameter (DLMF 22.17.2–4, DLMF 22.17.2–4), v = √m·r with the reduction done in u.
+    m = 1: sn = tanh u, cn = dn = sech u (DLMF 22.5.8, DLMF 22.5.8).
     """
     mc = mk[MK_MC]
     if mc == 0.0:
@@ -168,7 +168,7 @@ def am_k(u, mk):
     """Jacobi amplitude am(u|m) with precomputed constants (DLMF 22.16.1).
 
     m < 1: am = jπ + atan2(sn r, cn r), |r| ≤ K, so it is continuous and never jumps by 2π
-    (note §6.1, pitfall 9). m > 1: bounded, am = atan2(sn, cn) with cn > 0 (note §6.2).
+    (docs/elliptic.md, Reduction). m > 1: bounded, am = atan2(sn, cn) with cn > 0 (DLMF 22.17.2–4).
     m = 1: the Gudermannian gd(u) = 2 atan(tanh(u/2)) (DLMF 4.23.41), finite for every u.
     """
     mc = mk[MK_MC]

@@ -31,6 +31,9 @@ def add_scene_arguments(parser: argparse.ArgumentParser, span_default: str, pert
     run.add_argument("--perturbers", nargs="+", default=list(perturbers_default), metavar="BODY",
                      help=f"bodies whose torque may act (default: {' '.join(perturbers_default)}); the planner "
                      "drops those that cannot matter and says why")
+    run.add_argument("--pa-threshold", nargs="+", default=["1", "deg"], metavar="ANGLE",
+                     help="wobble amplitude up to which a state is a principal-axis rotator (PA: one sidereal period; "
+                     "above it SAM/LAM with P_psi, P_phi), e.g. '0.1 deg'; default 1 deg (docs/design.md 'PA or NPA')")
     run.add_argument("--plan", action="store_true", help="print the plan (decisions and reasons) and stop")
     run.add_argument("--no-skip", action="store_true",
                      help="run the reference plan: every perturber, the orbits as given, nothing skipped")
@@ -46,7 +49,8 @@ def span_and_times(args, start, max_days: float):
     import astropy.units as u
     import numpy as np
 
-    tolerance(args)  # before the orbit is built: a wrong tolerance costs no N-body run
+    tolerance(args)  # before the orbit is built: a wrong tolerance or threshold costs no N-body run
+    pa_threshold(args)
     span = quantity("--span", args.span, "d", "time", "4 d")
     days = span.to_value(u.day)
     if not 0 < days <= max_days:
@@ -73,6 +77,18 @@ def tolerance(args):
     except SceneError:
         raise CommandError(f"--tolerance expects an attitude angle between 1e-12 rad and 0.1 rad (2e-7 to 2e4 "
                            f"arcsec); got '{' '.join(args.tolerance)}'.") from None
+    return value
+
+
+def pa_threshold(args):
+    """The --pa-threshold angle, checked to lie in [0°, 90°) (before the orbit is built)."""
+    from spinorbit.spin_forms import SpinFormError, wobble_threshold_deg
+
+    value = quantity("--pa-threshold", getattr(args, "pa_threshold", ["1", "deg"]), "deg", "angle", "1 deg")
+    try:
+        wobble_threshold_deg(value, "--pa-threshold")
+    except SpinFormError as error:
+        raise CommandError(str(error)) from None
     return value
 
 
@@ -137,7 +153,8 @@ def run_and_report(args, state, start, times, orbit, name: str, title: str, peri
     """Build the Scene from the shared options, run it (or print its plan), print the summary, write files."""
     from spinorbit.scene import Scene
 
-    scene = Scene(state, start, times, perturbers=tuple(args.perturbers), orbit=orbit, tolerance=tolerance(args))
+    scene = Scene(state, start, times, perturbers=tuple(args.perturbers), orbit=orbit, tolerance=tolerance(args),
+                  pa_threshold=pa_threshold(args))
     result = run_scene(scene, args)
     if result is not None:
         for line in summary(result, period_unit, args.plan_seconds):
@@ -153,13 +170,9 @@ def summary(result, period_unit: str, plan_seconds: float = 0.0) -> list[str]:
     plan, table = result.plan, result.table
     lines = [f"plan               {plan.route}, orbits from {plan.orbit_source}, integrator {plan.integrator}",
              f"perturbers         kept {', '.join(plan.kept) or 'none'}; dropped {', '.join(plan.dropped) or 'none'}"]
-    if "P_psi" in table.colnames:
+    if "rotation_class" in table.colnames:
         for label, row in (("first", table[0]), ("last", table[-1])):
-            lines.append(f"{label:5s} {row['time'].tdb.iso[:16]} TDB  {row['mode']:3s}  "
-                         f"P_psi = {row['P_psi'].to_value(period_unit):9.4f} {period_unit}  "
-                         f"P_phi = {row['P_phi'].to_value(period_unit):9.4f} {period_unit}  "
-                         f"P_sid = {row['sidereal_period'].to_value(period_unit):9.4f} {period_unit}  "
-                         f"E/E0 = {row['energy_ratio']:.5f}")
+            lines.append(f"{label:5s} {row['time'].tdb.iso[:16]} TDB  {motion_line(row, period_unit)}")
     parts = ", ".join(f"{k} {v.to_value(u.arcsec):.2g}" for k, v in result.error_parts.items())
     lines.append(f"wall time          {plan_seconds + result.wall_seconds:.2f} s (plan {plan_seconds:.2f} s, "
                  f"run {result.wall_seconds:.2f} s)")
@@ -169,6 +182,31 @@ def summary(result, period_unit: str, plan_seconds: float = 0.0) -> list[str]:
                      f"{result.plan.tolerance_rad * 206264.80624709636:.3g} arcsec (long spans: the integration "
                      "error of double precision grows with the number of rotations); loosen --tolerance or shorten --span")
     return lines
+
+
+def motion_line(row, period_unit: str) -> str:
+    """A table row's motion as an observer reports it: "PA, P = 8.0000 h" for a principal-axis rotator, else
+    "SAM, P_psi = …, P_phi = …, P_sid = …"; then the wobble amplitude and E/E0."""
+    import astropy.units as u
+
+    def hours(name):
+        return f"{u.Quantity(getattr(row[name], 'unmasked', row[name])).to_value(period_unit):.4f} {period_unit}"
+
+    if row["rotation_class"] == "PA":
+        periods = f"PA, P = {hours('sidereal_period')}"
+    else:
+        periods = (f"{row['rotation_class']}, P_psi = {hours('P_psi')}, P_phi = {hours('P_phi')}, "
+                   f"P_sid = {hours('sidereal_period')}")
+    wobble = u.Quantity(row["wobble_amplitude"]).to_value(u.deg)
+    return f"{periods}  wobble {wobble:.3g} deg  E/E0 = {row['energy_ratio']:.5f}"
+
+
+def state_motion_line(state, threshold, period_unit: str) -> str:
+    """:func:`motion_line` of a RotationState (the state a command starts from), at ``threshold``."""
+    p_psi, p_phi = state.periods
+    return motion_line({"rotation_class": state.rotation_class(threshold), "sidereal_period": state.sidereal_period,
+                        "P_psi": p_psi, "P_phi": p_phi, "wobble_amplitude": state.wobble_amplitude,
+                        "energy_ratio": state.energy_ratio}, period_unit)
 
 
 def ecsv_table(result, name: str, period_unit: str = "h"):

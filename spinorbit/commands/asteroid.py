@@ -11,7 +11,8 @@ from __future__ import annotations
 import argparse
 
 from spinorbit.commands._common import check_outputs
-from spinorbit.commands._scene_command import add_scene_arguments, run_and_report, span_and_times
+from spinorbit.commands._scene_command import (add_scene_arguments, pa_threshold, run_and_report, span_and_times,
+                                               state_motion_line)
 
 NAME = "asteroid"
 SUMMARY = "your own asteroid: orbit from elements, moments, spin state at an epoch (planned scene, TOML or options)"
@@ -45,7 +46,7 @@ SCENE_KEYS = {
     "orbit": ("epoch", "a", "e", "inc", "raan", "argp", "mean_anomaly", "frame", "non_gravitational"),
     "body": ("moments",),
     "spin": ("epoch", "euler313", "omega", "frame"),
-    "run": ("start", "span", "n_times", "end_only", "perturbers", "tolerance", "output", "plot"),
+    "run": ("start", "span", "n_times", "end_only", "perturbers", "tolerance", "pa_threshold", "output", "plot"),
 }
 #: Options read as plain numbers and their units (the TOML file takes any astropy unit instead).
 ELEMENT_UNITS = ("au", "", "deg", "deg", "deg", "deg")
@@ -199,7 +200,7 @@ def _apply_run_table(args, parser_defaults, run_table):
         value = run_table[key]
         if getattr(args, key) != parser_defaults.get(key):
             continue  # given on the command line
-        if key in ("span", "tolerance"):
+        if key in ("span", "tolerance", "pa_threshold"):
             value = str(value).split()
         elif key == "perturbers":
             value = list(value)
@@ -216,8 +217,7 @@ def run(args) -> int:
     name, orbit, state, epoch, start = scene_inputs(args)
     span, times = span_and_times(args, start, MAX_SPAN_DAYS)
     print(f"orbit              {orbit.description}")
-    print(f"spin state         at {epoch.tdb.iso[:19]} TDB: mode {state.mode}, "
-          f"P_psi = {state.periods[0].to_value('h'):.4f} h, P_phi = {state.periods[1].to_value('h'):.4f} h")
+    print(f"spin state         at {epoch.tdb.iso[:19]} TDB: {state_motion_line(state, pa_threshold(args), 'h')}")
     from spinorbit.cli import CommandError
     from spinorbit.ephemeris import EphemerisRangeError
 

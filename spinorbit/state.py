@@ -246,11 +246,13 @@ class RotationState:
         """The same attitude and spin tied to ``epoch`` (a scalar Time, or None to untie it)."""
         return RotationState(self._body, self._q, self._omega * RAD_PER_DAY, epoch)
 
-    def pole(self, frame="ecliptic", max_wobble=_spin_forms.POLE_MAX_WOBBLE, axes=None):
+    def pole(self, frame="ecliptic", max_wobble=_spin_forms.PA_MAX_WOBBLE, axes=None):
         """(λ, β, P, φ0 at :attr:`epoch`, …) of this state, the inverse of :meth:`from_pole`.
 
         Returns a :class:`spinorbit.spin_forms.PoleSolution` (P is :attr:`sidereal_period`); raises
-        SpinFormError when the rotation axis is more than ``max_wobble`` (an angle) from the momentum.
+        SpinFormError when the rotation axis is more than ``max_wobble`` (an angle) from the momentum, or the
+        :attr:`wobble_amplitude` exceeds it (with the default, exactly the states :meth:`rotation_class` calls
+        "PA" about their largest moment).
         """
         return _spin_forms.PoleSolution(**_spin_forms.pole_of(self.attitude_matrix, self._omega, self._body, frame,
                                                               max_wobble, axes), epoch=self._epoch)
@@ -368,6 +370,31 @@ class RotationState:
         if mo[_canonical.MO_MODE] == _canonical.MODE_LAM:
             return "+A" if momentum[0] > 0 else "-A"
         return "+C" if momentum[2] >= 0 else "-C"
+
+    @property
+    def wobble_amplitude(self) -> u.Quantity:
+        """The wobble amplitude (deg): the largest angle over the torque-free motion between the angular
+        momentum and the circulation axis (C, the largest moment, in SAM; A, the smallest, in LAM).
+
+        sin²θ_max = (M_y² + M_x² B(C − A)/(A(C − B)))/G² in SAM, (M_y² + M_z² B(C − A)/(C(B − A)))/G² in LAM
+        (principal axes A ≤ B ≤ C; ``spinorbit.core.free_motion.wobble``); 0 for a permanent rotation, 90 on the
+        separatrix. A constant of the free motion, the osculating value of a torqued one.
+        ``docs/conventions.md``, "Wobble and rotation class".
+        """
+        self._rotating_momentum()  # refuses zero spin and unrepresentable momenta, as every motion property
+        return _spin_forms.wobble_amplitude_deg(self._omega, self._body) * u.deg
+
+    def rotation_class(self, threshold=_spin_forms.PA_MAX_WOBBLE) -> str:
+        """"PA" (principal-axis rotator) when :attr:`wobble_amplitude` ≤ ``threshold`` (an angle in [0°, 90°)),
+        else the non-principal-axis mode: "SAM", "LAM" or "separatrix".
+
+        The default, 1° (:data:`spinorbit.spin_forms.PA_MAX_WOBBLE`), is about where a wobble becomes detectable
+        in lightcurves (Pravec et al. 2005 call a rotation NPA only then; ``docs/design.md``, "PA or NPA"). A PA
+        state is reported by its pole and :attr:`sidereal_period` (:meth:`pole`), an NPA one by P_ψ, P_φ
+        (:meth:`tumbling_parameters`).
+        """
+        amplitude = self.wobble_amplitude.to_value(u.deg)
+        return str(_spin_forms.rotation_classes(np.array([amplitude]), np.array([self.mode]), threshold)[0])
 
     @property
     def energy_ratio(self) -> float:

@@ -186,7 +186,7 @@ def test_classify_rows_masks_the_periods_of_principal_axis_rows_and_reclassifies
     assert list(table["rotation_class"]) == ["PA", "PA", "PA", "SAM"] and table.meta["pa_threshold"] == "1 deg"
     assert table.colnames[-2:] == ["wobble_amplitude", "rotation_class"]
     assert list(table["P_psi"].mask) == list(table["P_phi"].mask) == [True, True, True, False]
-    tumbler = RotationState(body, [1.0, 0, 0, 0], omegas[3])
+    tumbler = RotationState(body, [1.0, 0, 0, 0], omegas[3] * u.rad / u.day)
     assert table["P_psi"][3] == tumbler.periods[0].to(u.h) and table["P_phi"][3] == tumbler.periods[1].to(u.h)
     for path in (tmp_path / "t.ecsv", tmp_path / "t.csv"):
         table.write(path)

@@ -24,6 +24,17 @@ SCENE_FILE = Path(__file__).resolve().parent.parent / "examples" / "asteroid_sce
 BEFORE_ANY_WORK_S = 2.0
 
 
+@pytest.fixture(scope="module", autouse=True)
+def imported():
+    """The commands' modules imported once, so the clock below times the checks, not the first import."""
+    import spinorbit.binary  # noqa: F401
+    import spinorbit.coupling.moon  # noqa: F401
+    import spinorbit.data.asteroids  # noqa: F401
+    import spinorbit.data.didymos  # noqa: F401
+    import spinorbit.ensemble  # noqa: F401
+    import spinorbit.scene  # noqa: F401
+
+
 def refusal(capsys, argv):
     """(status, the one error line) of ``spinorbit argv``, checked to come before any work."""
     begin = time.perf_counter()

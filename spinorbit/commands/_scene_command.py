@@ -47,12 +47,11 @@ def _where(args, option: str) -> str:
     return getattr(args, "sources", {}).get(option, option)
 
 
-def span_and_times(args, start, max_days: float):
-    """(span Quantity, output Time(s)) from --span, --n-times and --end-only, starting at ``start``."""
+def check_run_options(args, max_days: float):
+    """(span, n_times): --tolerance, --span and --n-times checked before any work (no orbit built yet)."""
     import astropy.units as u
-    import numpy as np
 
-    tolerance(args)  # before the orbit is built: a wrong tolerance costs no N-body run
+    tolerance(args)
     span = check.quantity(_where(args, "--span"), args.span, "d", "4 d", default_unit="d", low=0.0, high=max_days,
                           low_open=True)
     days = span.to_value(u.day)
@@ -61,6 +60,16 @@ def span_and_times(args, start, max_days: float):
         raise CommandError(f"--span {' '.join(args.span)} with --n-times {n_times} spaces the output times by "
                            f"{days / n_times:.3g} d, below the {MIN_SPACING_DAYS:g} d that TDB days since J2000 resolve; "
                            "give a longer --span or fewer --n-times.")
+    return span, n_times
+
+
+def span_and_times(args, start, max_days: float):
+    """(span Quantity, output Time(s)) from --span, --n-times and --end-only, starting at ``start``."""
+    import astropy.units as u
+    import numpy as np
+
+    span, n_times = check_run_options(args, max_days)
+    days = span.to_value(u.day)
     if args.end_only:
         return span, start + days * u.day
     # the first row is the start itself (the output schema), then evenly to the end

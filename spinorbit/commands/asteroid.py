@@ -13,7 +13,7 @@ import argparse
 from spinorbit.commands import _inputs as check
 from spinorbit.commands._common import check_outputs, number
 from spinorbit.commands._scene_file import read_scene_file
-from spinorbit.commands._scene_command import add_scene_arguments, run_and_report, span_and_times
+from spinorbit.commands._scene_command import add_scene_arguments, check_run_options, run_and_report, span_and_times
 
 NAME = "asteroid"
 SUMMARY = "your own asteroid: orbit from elements, moments, spin state at an epoch (planned scene, TOML or options)"
@@ -152,6 +152,7 @@ def run(args) -> int:
     scene = read_scene_file(args.scene) if args.scene else {}
     _apply_run_table(args, vars(defaults.parse_args([])), scene.get("run", {}))
     check_outputs(args)
+    check_run_options(args, MAX_SPAN_DAYS)  # before the orbit is integrated
     name, orbit, state, epoch, start = scene_inputs(args, scene)
     span, times = span_and_times(args, start, MAX_SPAN_DAYS)
     print(f"orbit              {orbit.description}")

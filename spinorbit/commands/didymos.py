@@ -77,17 +77,27 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _report(label, run):
     import astropy.units as u
 
-    parts = run.libration_components()
     e_rel, e_potential = run.energy_drift()
     tumbling, energy_excess, p_psi, p_phi = run.tumbling_summary()
+    unbound = run.unbound_reason()
+    if unbound is not None:
+        # An escaping pair has no orbit period and no libration: say so instead of fitting lines to it.
+        orbit_lines = [f"  unbound                  {unbound}; no mutual period or libration"]
+    else:
+        period = run.mutual_period()
+        parts = run.libration_components()
+        orbit_lines = [
+            f"  mutual orbit period      {period.to_value(u.h):.5f} h",
+            f"  free libration           period {parts.free_period.to_value(u.h):.4f} h, amplitude "
+            f"{parts.free_amplitude.to_value(u.deg):.4f} deg",
+            f"  forced libration         period {parts.forced_period.to_value(u.h):.4f} h, amplitude "
+            f"{parts.forced_amplitude.to_value(u.deg):.4f} deg (fit residual {parts.residual_rms.to_value(u.deg):.2g} "
+            "deg rms)",
+            f"  max |libration|          {abs(run.libration()).max().to_value(u.deg):.4f} deg",
+        ]
     lines = [
         f"{label}",
-        f"  mutual orbit period      {run.mutual_period().to_value(u.h):.5f} h",
-        f"  free libration           period {parts.free_period.to_value(u.h):.4f} h, amplitude "
-        f"{parts.free_amplitude.to_value(u.deg):.4f} deg",
-        f"  forced libration         period {parts.forced_period.to_value(u.h):.4f} h, amplitude "
-        f"{parts.forced_amplitude.to_value(u.deg):.4f} deg (fit residual {parts.residual_rms.to_value(u.deg):.2g} deg rms)",
-        f"  max |libration|          {abs(run.libration()).max().to_value(u.deg):.4f} deg",
+        *orbit_lines,
         f"  Dimorphos rotation       non-principal-axis (SAM/LAM) at {100 * tumbling:.0f} % of the output times, "
         f"principal-axis at the rest, max E/E0 - 1 = {energy_excess:.3g}"
         + (f", P_psi = {p_psi.to_value(u.h):.3f} h, P_phi = {p_phi.to_value(u.h):.3f} h" if tumbling else ""),

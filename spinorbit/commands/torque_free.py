@@ -150,13 +150,14 @@ def _summary(state) -> list[str]:
 
 
 def _propagate(state, offsets):
+    import astropy.units as u
     import numpy as np
 
     progress = Progress(len(offsets), "propagating")
     quaternions, omegas = [], []
     try:
         for start in range(0, len(offsets), CHUNK):
-            q, omega = state.propagate_torque_free(offsets[start : start + CHUNK])
+            q, omega = state.propagate_torque_free(offsets[start : start + CHUNK] * u.day)
             quaternions.append(q)
             omegas.append(omega)
             progress.advance(len(q))

@@ -19,9 +19,11 @@ orbit, both attitudes and both spins, with DOP853. The set-up is the GUBAS examp
 Dimorphos a 103.16 x 79.35 x 66.13 m ellipsoid, synchronous, 1.20 km from a spherical Didymos
 spinning in 2.260 h, density 2.2031 g/cm^3.
 
-Prints the mutual orbit period, Dimorphos's free and forced libration (periods and amplitudes,
-from the periodogram of its libration angle), its rotation mode in Fukushima's canonical elements,
-and the energy and angular-momentum drift. With --impact the same run is repeated after an
+Prints the mutual orbit period, Dimorphos's free and forced libration (periods with the run's
+resolution P^2/T, and amplitudes, from the periodogram of its libration angle), its rotation mode in
+Fukushima's canonical elements, and the energy and angular-momentum drift. A run too short to
+resolve the two libration lines (about 26 orbits are needed) says so and prints no lines; a pair
+that the impact unbinds is reported as unbound, with no period. With --impact the same run is repeated after an
 impulsive change of Dimorphos's velocity, dv = beta m v / M_Dimorphos, against its orbital motion
 (DART: 579.4 kg at 6.1449 km/s, beta = 3.61 by default), and the excited libration or tumbling is
 reported."""
@@ -85,17 +87,7 @@ def _report(label, run):
         # An escaping pair has no orbit period and no libration: say so instead of fitting lines to it.
         orbit_lines = [f"  unbound                  {unbound}; no mutual period or libration"]
     else:
-        period = run.mutual_period()
-        parts = run.libration_components()
-        orbit_lines = [
-            f"  mutual orbit period      {period.to_value(u.h):.5f} h",
-            f"  free libration           period {parts.free_period.to_value(u.h):.4f} h, amplitude "
-            f"{parts.free_amplitude.to_value(u.deg):.4f} deg",
-            f"  forced libration         period {parts.forced_period.to_value(u.h):.4f} h, amplitude "
-            f"{parts.forced_amplitude.to_value(u.deg):.4f} deg (fit residual {parts.residual_rms.to_value(u.deg):.2g} "
-            "deg rms)",
-            f"  max |libration|          {abs(run.libration()).max().to_value(u.deg):.4f} deg",
-        ]
+        orbit_lines = _orbit_lines(run)
     lines = [
         f"{label}",
         *orbit_lines,
@@ -107,6 +99,49 @@ def _report(label, run):
         f"  steps                    {run.stats['accepted']} accepted, {run.stats['rejected']} rejected",
     ]
     print("\n".join(lines))
+
+
+def _orbit_lines(run):
+    """The mutual period and the libration lines, each with its resolution, or why the run cannot give them."""
+    import astropy.units as u
+
+    from spinorbit.core.binary.errors import UnresolvedPeriodError
+
+    def short(error):
+        # A run too short for a period: say so and how long it must be, instead of printing the wrong line.
+        hint = ""
+        if error.required_span is not None:
+            hint = f" Here: --orbits {math.ceil(error.required_span / _nominal_period_s())} or more."
+        return f"  not resolved             {error}{hint}"
+
+    try:
+        period = run.mutual_period()
+    except UnresolvedPeriodError as error:
+        return [short(error)]
+    lines = [f"  mutual orbit period      {period.to_value(u.h):.5f} h"]
+    try:
+        parts = run.libration_components()
+    except UnresolvedPeriodError as error:
+        return [*lines, short(error), f"  max |libration|          {abs(run.libration()).max().to_value(u.deg):.4f} deg"]
+    return [
+        *lines,
+        f"  free libration           period {parts.free_period.to_value(u.h):.4f} ± {parts.free_resolution.to_value(u.h):.2g} h, "
+        f"amplitude {parts.free_amplitude.to_value(u.deg):.4f} deg",
+        f"  forced libration         period {parts.forced_period.to_value(u.h):.4f} ± {parts.forced_resolution.to_value(u.h):.2g} h, "
+        f"amplitude {parts.forced_amplitude.to_value(u.deg):.4f} deg (fit residual {parts.residual_rms.to_value(u.deg):.2g} "
+        "deg rms)",
+        "                           (± one resolution P²/T of the run's periodogram)",
+        f"  max |libration|          {abs(run.libration()).max().to_value(u.deg):.4f} deg",
+    ]
+
+
+def _nominal_period_s():
+    """The nominal mutual period of the set-up (s): the unit of --orbits."""
+    import astropy.units as u
+
+    from spinorbit.data.didymos import RELATIVE_SPEED, SEPARATION
+
+    return (2 * math.pi * SEPARATION / RELATIVE_SPEED).to_value(u.s)
 
 
 def _table(runs):

@@ -65,6 +65,7 @@ def test_velocity_change_with_its_unit_and_beta(capsys):
     (["--impact", "--dv", "-2.63", "km"], "--dv expects a velocity"),
     (["--dv", "-2.63"], "add --impact"),
     (["--impact", "--dv", "-2.63", "--beta", "3"], "--beta: not allowed with argument --dv"),
+    (["--impact", "--impactor-mass", "600"], "add --beta"),
 ])
 def test_bad_options_are_refused_in_words(capsys, args, message):
     status, _, err = run_didymos(capsys, *args)

@@ -26,6 +26,8 @@ from astropy import units as u
 from spinorbit.binary.sun import HeliocentricOrbit
 from spinorbit.binary.system import G_SI, BinaryState
 from spinorbit.core.binary import equations as core
+from spinorbit.core.binary.boundedness import ENERGY, first_unbound, hill_radius, orbit_energies
+from spinorbit.core.binary.errors import UnboundPairError
 from spinorbit.core.binary.libration import (
     COL_ENERGY_RATIO,
     COL_LIBRATION,
@@ -142,12 +144,58 @@ class BinaryRun:
         return (float(np.mean(tumbling)), float(np.max(table[:, COL_ENERGY_RATIO]) - 1.0),
                 float(np.median(table[tumbling, COL_P_PSI])) * u.s, float(np.median(table[tumbling, COL_P_PHI])) * u.s)
 
+    def orbit_energy(self):
+        """The mutual orbit's energy ½ ν |Ṙ|² − U at each output time (J; < 0 while the pair is bound)."""
+        return orbit_energies(np.ascontiguousarray(self.states), self.model) * u.J
+
+    def is_bound(self):
+        """True if the pair is bound at every output time (:mod:`spinorbit.core.binary.boundedness`)."""
+        return first_unbound(np.ascontiguousarray(self.states), self.model)[0] < 0
+
+    def unbound_reason(self):
+        """None while the pair stays bound; else one sentence: the first output time at which it is not, and why.
+
+        Why is the energy (≥ 0, with the speed against the escape speed there) or the Hill radius
+        (:mod:`spinorbit.core.binary.boundedness`).
+        """
+        model = self.model
+        index, reason, value = first_unbound(np.ascontiguousarray(self.states), model)
+        if index < 0:
+            return None
+        y = self.states[index]
+        when = self.times[index].to(u.h)
+        r = float(np.linalg.norm(y[core.POSITION:core.POSITION + 3]))
+        speed = float(np.linalg.norm(y[core.VELOCITY:core.VELOCITY + 3]))
+        if reason == ENERGY:
+            reduced_mass = 1.0 / (1.0 / model[core.M_MASS_A] + 1.0 / model[core.M_MASS_B])
+            potential = 0.5 * reduced_mass * speed ** 2 - value  # U = ½ ν v² − E_orb
+            escape = math.sqrt(2.0 * potential / reduced_mass) if potential > 0 else 0.0
+            why = (f"the mutual orbit's energy is {value:.4g} J ≥ 0 (relative speed {speed:.4g} m/s against the escape "
+                   f"speed {escape:.4g} m/s at a separation of {r:.4g} m): B is escaping A")
+        else:
+            why = f"the separation {value:.4g} m exceeds the Hill radius {hill_radius(model):.4g} m: the Sun holds B, not A"
+        return f"the pair is unbound at t = {when:.4g} (output time {index}): {why}"
+
+    def require_bound(self, what):
+        """Raise :class:`~spinorbit.core.binary.errors.UnboundPairError` for ``what`` unless the pair stays bound."""
+        reason = self.unbound_reason()
+        if reason is not None:
+            raise UnboundPairError(f"{what}: {reason}. There is no mutual period or libration to report; lower the "
+                                   "impulse or start from a bound orbit.")
+
     def orbital_longitude(self):
         """Unwrapped longitude of B about A in the inertial x-y plane (rad)."""
         return np.unwrap(np.arctan2(self.states[:, core.POSITION + 1], self.states[:, core.POSITION]))
 
     def mutual_period(self):
-        """Mean sidereal period of the mutual orbit: 2π over the least-squares slope of the longitude (s)."""
+        """Mean sidereal period of the mutual orbit: 2π over the least-squares slope of the longitude (s).
+
+        Raises
+        ------
+        UnboundPairError
+            The pair is not bound at some output time (:meth:`require_bound`).
+        """
+        self.require_bound("mutual_period")
         t = self.times.to_value(u.s)
         slope = np.polyfit(t, self.orbital_longitude(), 1)[0]
         return 2.0 * math.pi / abs(slope) * u.s
@@ -164,7 +212,13 @@ class BinaryRun:
         period change over 12 orbits, 0.01 s with them). r(t) is fitted with a constant and the first
         harmonic of κ, whose amplitude over the constant is e. On two point masses the period equals
         vis-viva's to 1e-7 of the change (``tests/test_dart.py``).
+
+        Raises
+        ------
+        UnboundPairError
+            The pair is not bound at some output time (:meth:`require_bound`).
         """
+        self.require_bound("mutual_orbit")
         t = self.times.to_value(u.s)
         if len(t) < 64 or not np.allclose(np.diff(t), t[1] - t[0], rtol=1e-9, atol=0):
             raise ValueError(f"mutual_orbit: expected ≥ 64 equally spaced output times, got {len(t)} times; "
@@ -190,7 +244,14 @@ class BinaryRun:
                            float(radial[0]) * u.m)
 
     def libration_components(self):
-        """The free and forced lines of φ(t) (module docstring); needs equally spaced output times."""
+        """The free and forced lines of φ(t) (module docstring); needs equally spaced output times.
+
+        Raises
+        ------
+        UnboundPairError
+            The pair is not bound at some output time (:meth:`require_bound`): φ then measures no libration.
+        """
+        self.require_bound("libration_components")
         t = self.times.to_value(u.s)
         if len(t) < 64 or not np.allclose(np.diff(t), t[1] - t[0], rtol=1e-9, atol=0):
             raise ValueError(f"libration_components: expected ≥ 64 equally spaced output times, got {len(t)} "

@@ -71,9 +71,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     impulse.add_argument("--beta", type=number, default=None, metavar="BETA",
                          help="momentum enhancement instead of --dv: dv = beta m U / M with DART's mass and speed "
                               "(3.61: Cheng et al. 2023 for 2.4 g/cm^3)")
-    impact.add_argument("--impactor-mass", type=number, default=579.4, metavar="KG",
+    impact.add_argument("--impactor-mass", type=number, default=None, metavar="KG",
                         help="with --beta: impactor mass in kg (default 579.4, Cheng et al. 2023)")
-    impact.add_argument("--impactor-speed", type=number, default=6.1449, metavar="KM_S",
+    impact.add_argument("--impactor-speed", type=number, default=None, metavar="KM_S",
                         help="with --beta: impactor speed relative to Dimorphos in km/s (default 6.1449)")
     impact.add_argument("--impact-elevation", type=number, default=0.0, metavar="DEG",
                         help="angle of the impulse out of the orbit plane (default 0: in the plane, against the motion)")
@@ -86,22 +86,31 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _report(label, run):
     import astropy.units as u
 
-    parts = run.libration_components()
-    orbit = run.mutual_orbit()
     e_rel, e_potential = run.energy_drift()
     tumbling, energy_excess, p_psi, p_phi = run.tumbling_summary()
-    apsides = ("circular" if orbit.apsidal_rate is None else
-               f"eccentricity {orbit.eccentricity:.4f}, apsidal precession {orbit.apsidal_rate.to_value(u.deg / u.day):.2f} "
-               "deg/day")
+    unbound = run.unbound_reason()
+    if unbound is not None:
+        # An escaping pair has no orbit period and no libration: say so instead of fitting lines to it.
+        orbit_lines = [f"  unbound                  {unbound}; no mutual period or libration"]
+    else:
+        parts = run.libration_components()
+        orbit = run.mutual_orbit()
+        apsides = ("circular" if orbit.apsidal_rate is None else
+                   f"eccentricity {orbit.eccentricity:.4f}, apsidal precession "
+                   f"{orbit.apsidal_rate.to_value(u.deg / u.day):.2f} deg/day")
+        orbit_lines = [
+            f"  mutual orbit             mean sidereal period {orbit.sidereal_period.to_value(u.h):.6f} h, mean "
+            f"separation {orbit.mean_separation.to_value(u.m):.1f} m, {apsides}",
+            f"  free libration           period {parts.free_period.to_value(u.h):.4f} h, amplitude "
+            f"{parts.free_amplitude.to_value(u.deg):.4f} deg",
+            f"  forced libration         period {parts.forced_period.to_value(u.h):.4f} h, amplitude "
+            f"{parts.forced_amplitude.to_value(u.deg):.4f} deg (fit residual {parts.residual_rms.to_value(u.deg):.2g} "
+            "deg rms)",
+            f"  max |libration|          {abs(run.libration()).max().to_value(u.deg):.4f} deg",
+        ]
     lines = [
         f"{label}",
-        f"  mutual orbit             mean sidereal period {orbit.sidereal_period.to_value(u.h):.6f} h, mean separation "
-        f"{orbit.mean_separation.to_value(u.m):.1f} m, {apsides}",
-        f"  free libration           period {parts.free_period.to_value(u.h):.4f} h, amplitude "
-        f"{parts.free_amplitude.to_value(u.deg):.4f} deg",
-        f"  forced libration         period {parts.forced_period.to_value(u.h):.4f} h, amplitude "
-        f"{parts.forced_amplitude.to_value(u.deg):.4f} deg (fit residual {parts.residual_rms.to_value(u.deg):.2g} deg rms)",
-        f"  max |libration|          {abs(run.libration()).max().to_value(u.deg):.4f} deg",
+        *orbit_lines,
         f"  Dimorphos rotation       non-principal-axis (SAM/LAM) at {100 * tumbling:.0f} % of the output times, "
         f"principal-axis at the rest, max E/E0 - 1 = {energy_excess:.3g}"
         + (f", P_psi = {p_psi.to_value(u.h):.3f} h, P_phi = {p_phi.to_value(u.h):.3f} h" if tumbling else ""),
@@ -119,8 +128,11 @@ def _impulse(args, state):
 
     from spinorbit.binary import momentum_impulse
     from spinorbit.commands._common import quantity
-    from spinorbit.data.dart import DV_NAIDU
+    from spinorbit.data.dart import DART_MASS, DART_SPEED, DV_NAIDU
 
+    if args.beta is None and (args.impactor_mass is not None or args.impactor_speed is not None):
+        raise CommandError("--impactor-mass and --impactor-speed make the impulse from --beta: add --beta (3.61: "
+                           "Cheng et al. 2023), or give the velocity change itself with --dv.")
     velocity = state.velocity.to_value(u.m / u.s)
     along = velocity / np.linalg.norm(velocity)
     elevation = math.radians(args.impact_elevation)
@@ -141,9 +153,10 @@ def _impulse(args, state):
         source = " (Naidu et al. 2024)" if args.dv is None else ""
         text = f"along-track dv = {size * 1e3:.4f} mm/s{source}, elevation {args.impact_elevation:g} deg"
     else:
-        delta_v = momentum_impulse(args.impactor_mass * u.kg, backwards * args.impactor_speed * u.km / u.s, args.beta,
-                                   state.system.secondary.mass)
-        text = (f"beta {args.beta:g}, {args.impactor_mass:g} kg at {args.impactor_speed:g} km/s, elevation "
+        mass = DART_MASS.to_value(u.kg) if args.impactor_mass is None else args.impactor_mass
+        speed = DART_SPEED.to_value(u.km / u.s) if args.impactor_speed is None else args.impactor_speed
+        delta_v = momentum_impulse(mass * u.kg, backwards * speed * u.km / u.s, args.beta, state.system.secondary.mass)
+        text = (f"beta {args.beta:g}, {mass:g} kg at {speed:g} km/s, elevation "
                 f"{args.impact_elevation:g} deg: |dv| = {np.linalg.norm(delta_v.to_value(u.mm / u.s)):.4f} mm/s, "
                 f"along-track {float(np.dot(delta_v.to_value(u.mm / u.s), along)):.4f} mm/s")
     return delta_v, text
@@ -254,7 +267,9 @@ def run(args) -> int:
         progress.close()
     for label, result in runs:
         _report(label, result)
-    if args.impact:
+    if args.impact and runs[1][1].unbound_reason() is not None:
+        print("period change  none: the pair is unbound after the impact")
+    elif args.impact:
         change = (runs[1][1].mutual_orbit().sidereal_period - runs[0][1].mutual_orbit().sidereal_period).to(u.min)
         print(f"period change  {change.value:.3f} min")
         print(f"  mean sidereal period over the {args.orbits} orbits after the impact minus before; measured "

@@ -13,3 +13,11 @@ class ContactError(SpinorbitError, ValueError):
 
 class UnsupportedOrderError(SpinorbitError, ValueError):
     """An expansion order the inertia-integral tables were not built for (0 ≤ order ≤ MAX_ORDER)."""
+
+
+class UnboundPairError(SpinorbitError, ValueError):
+    """The pair is not a binary at some output time: no mutual period or libration exists to report.
+
+    Raised when the mutual orbit's energy (with the figure terms) is ≥ 0, or B is beyond the Hill
+    radius with the Sun's tide on (:mod:`spinorbit.core.binary.boundedness`).
+    """

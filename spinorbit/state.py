@@ -119,9 +119,9 @@ def _as_rotation_matrix(matrix) -> np.ndarray:
 
 
 def _as_angular_velocity(omega, name="angular_velocity") -> np.ndarray:
-    # a Quantity of an angle per time (frequencies refused: docs/conventions.md, "Units"); floats are rad/day
-    values = np.asarray(value_in(name, omega, RAD_PER_DAY, "[0.1, 0, 0.3] * u.rad / u.s", plain_unit=RAD_PER_DAY,
-                                 finite=False), dtype=float)
+    # a Quantity of an angle per time: bare numbers and frequencies refused (docs/conventions.md, "Units")
+    values = np.asarray(value_in(name, omega, RAD_PER_DAY, "[0.1, 0, 0.3] * u.rad / u.day", finite=False),
+                        dtype=float)
     if values.shape != (3,):
         raise InvalidStateError(f"the angular velocity is a 3-vector in body axes; got shape {values.shape}.")
     if not np.all(np.isfinite(values)):
@@ -159,8 +159,9 @@ class RotationState:
     quaternion : array_like, shape (4,)
         Unit quaternion (w, x, y, z), scalar first, taking inertial axes to the user's body axes
         (v_inertial = M(q) v_body).
-    angular_velocity : Quantity or array_like, shape (3,)
-        Body angular velocity in the user's body axes (rad/day if plain floats).
+    angular_velocity : Quantity, shape (3,)
+        Body angular velocity in the user's body axes, an angle per time (``[0, 0, 3] * u.rad / u.day``,
+        ``u.deg / u.hour``, ``u.cycle / u.day``; a bare number or a frequency such as ``u.Hz`` is refused).
     epoch : astropy.time.Time, optional
         The instant of this attitude and spin (scalar); None (default) when the state is not tied to
         one. A :class:`spinorbit.Scene` takes it as its epoch.
@@ -197,8 +198,8 @@ class RotationState:
 
     @classmethod
     def from_euler313(cls, body, phi, theta, psi, angular_velocity, epoch=None):
-        """From passive 3-1-3 Euler angles (Quantities or radians): R = R3(ψ) R1(θ) R3(φ)."""
-        angles = [value_in(name, a, u.rad, "30 * u.deg", plain_unit=u.rad, shape=(), finite=False)
+        """From passive 3-1-3 Euler angles (angle Quantities): R = R3(ψ) R1(θ) R3(φ)."""
+        angles = [value_in(name, a, u.rad, "30 * u.deg", shape=(), finite=False)
                   for name, a in (("phi", phi), ("theta", theta), ("psi", psi))]
         if not all(math.isfinite(a) for a in angles):
             raise NonFiniteStateError(f"Euler angles must be finite; got phi, theta, psi = {angles}.")
@@ -206,11 +207,13 @@ class RotationState:
 
     @classmethod
     def from_angular_momentum(cls, body, quaternion, angular_momentum, epoch=None):
-        """From the body angular momentum (user axes) instead of the angular velocity: ω = I⁻¹ M."""
-        values = value_in("angular_momentum", angular_momentum, body.moment_unit * RAD_PER_DAY,
-                          f"[0.1, 0, 0.3] * {body.moment_unit * RAD_PER_DAY!r}", plain_unit=body.moment_unit * RAD_PER_DAY,
-                          finite=False)
-        return cls(body, quaternion, np.asarray(values, dtype=float) / body.moment_values, epoch)
+        """From the body angular momentum (user axes, a Quantity in the body's moment unit × an angle per
+        time, such as kg m² rad/day; rad/day for moments given as ratios) instead of the angular velocity:
+        ω = I⁻¹ M."""
+        momentum_unit = body.moment_unit * RAD_PER_DAY
+        example = f"[0.1, 0, 0.3] * u.Unit('{momentum_unit.to_string()}')"
+        values = value_in("angular_momentum", angular_momentum, momentum_unit, example, finite=False)
+        return cls(body, quaternion, np.asarray(values, dtype=float) / body.moment_values * RAD_PER_DAY, epoch)
 
     @classmethod
     def from_pole(cls, body, pole_lon, pole_lat, period, epoch, phase=0 * u.deg, frame="ecliptic", axes=None):
@@ -509,7 +512,7 @@ class RotationState:
         frame = np.eye(3) if reference is None else _as_rotation_matrix(reference)
         attitude_ref, momentum = _andoyer.attitude_from_andoyer(*values)
         p = body.to_principal
-        return cls.from_matrix(body, p.T @ attitude_ref @ frame, (p.T @ momentum) / body.moment_values)
+        return cls.from_matrix(body, p.T @ attitude_ref @ frame, (p.T @ momentum) / body.moment_values * RAD_PER_DAY)
 
     def canonical_elements(self, reference="auto") -> CanonicalElements:
         """Fukushima's canonical elements (paper eq. 4) of this state.
@@ -555,7 +558,7 @@ class RotationState:
         attitude_ref, momentum = _canonical.state_from_elements(values, elements.flip, ic)
         p = body.to_principal
         attitude_user = p.T @ attitude_ref @ elements.reference
-        return cls.from_matrix(body, attitude_user, (p.T @ momentum) / body.moment_values)
+        return cls.from_matrix(body, attitude_user, (p.T @ momentum) / body.moment_values * RAD_PER_DAY)
 
     def principal_flow_start(self, horizon_days: float) -> tuple[np.ndarray, np.ndarray]:
         """(principal quaternion, principal momentum) that the exact free flow starts from, checked for a
@@ -583,8 +586,8 @@ class RotationState:
 
         Parameters
         ----------
-        dt : Quantity or array_like
-            Time offsets (days if plain floats), scalar or 1-D.
+        dt : Quantity
+            Time offsets (a time Quantity such as ``[0, 1, 2] * u.day``), scalar or 1-D.
         closed_forms : bool
             True (default): a body with two exactly equal moments takes the regular precession in
             closed form (``spinorbit.core.free_motion.regular_precession``, trig only); False: the elliptic flow
@@ -597,7 +600,7 @@ class RotationState:
         angular_velocity : Quantity, shape (N, 3)
             Body angular velocity in user axes (rad/day).
         """
-        times = value_in("dt", dt, u.day, "[0, 1, 2] * u.day", plain_unit=u.day, finite=False)
+        times = value_in("dt", dt, u.day, "[0, 1, 2] * u.day", finite=False)
         times = np.atleast_1d(np.asarray(times, dtype=float))
         if times.ndim != 1:
             raise ValueError(f"dt must be a scalar or 1-D array of time offsets; got shape {times.shape}.")

@@ -37,7 +37,7 @@ MP_ATOL_NEAR_SEPARATRIX = 1e-10
 
 def _state(moments, momentum):
     body = RigidBody(list(moments))
-    return RotationState(body, [1.0, 0.0, 0.0, 0.0], np.asarray(momentum, dtype=float) / np.asarray(moments))
+    return RotationState(body, [1.0, 0.0, 0.0, 0.0], (np.asarray(momentum, dtype=float) / np.asarray(moments)) * u.rad / u.day)
 
 
 def _momentum_at_energy_ratio(moments, ratio, y_share=0.3):

@@ -1,4 +1,4 @@
-"""``spinorbit didymos``: Didymos and Dimorphos in the full two-body problem, with a DART-like impact."""
+"""``spinorbit didymos``: Didymos and Dimorphos from the published system, and DART's period change."""
 
 from __future__ import annotations
 
@@ -6,7 +6,8 @@ import argparse
 import math
 
 from spinorbit.cli import CommandError
-from spinorbit.commands._common import Progress, check_outputs, number, write_plot_output, write_table_output
+from spinorbit.commands import _inputs as check
+from spinorbit.commands._common import Progress, check_outputs, write_plot_output, write_table_output
 
 NAME = "didymos"
 SUMMARY = "Didymos-Dimorphos from the published system (full two-body problem) and DART's period change"
@@ -20,8 +21,11 @@ equatorial, 290 m polar radius), Dimorphos the 177 x 174 x 116 m ellipsoid of Da
 full model goes round in the measured 11.921473 h.
 
 Prints the mutual orbit (mean sidereal period, eccentricity, apsidal precession), Dimorphos's free
-and forced libration (periods and amplitudes, from the periodogram of its libration angle), its
-rotation mode in Fukushima's canonical elements, and the energy and angular-momentum drift. With
+and forced libration (periods with the run's resolution P^2/T, and amplitudes, from the periodogram
+of its libration angle), its rotation mode in Fukushima's canonical elements, and the energy and
+angular-momentum drift. A run too short to resolve the two libration lines (about 45 orbits are
+needed: the free libration takes ~51 h) says so and prints no lines; a pair that the impact unbinds
+is reported as unbound, with no period. With
 --impact the same run is repeated after DART's impulse on Dimorphos and the line 'period change
 <value> min' gives the mean sidereal period after it minus 11.921473 h. The impulse is the
 along-track velocity change --dv (default -2.63 mm/s, Naidu et al. 2024), or, with --beta, the
@@ -53,14 +57,14 @@ def _positive_count(text):
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of ``spinorbit didymos``."""
     model = parser.add_argument_group("model and run")
-    model.add_argument("--order", type=int, default=4, metavar="N",
-                       help="mutual-potential order 0..4 (default 4, the GUBAS case's; 2 = point mass + inertia tensors)")
+    model.add_argument("--order", default=4, metavar="N",
+                       help="mutual-potential order 0..4 (default 4; 2 = point masses + inertia tensors)")
     model.add_argument("--orbits", type=_positive_count, default=100, metavar="N",
-                       help="span in mutual orbits of 11.92 h (default 100: enough to separate the libration lines)")
+                       help="span in mutual orbits of 11.921473 h (default 100: enough to separate the libration lines)")
     model.add_argument("--per-orbit", type=_positive_count, default=40, metavar="N",
                        help="output times per orbit (default 40)")
-    model.add_argument("--rtol", type=number, default=1e-12, metavar="RTOL", help="DOP853 relative tolerance (default 1e-12)")
-    model.add_argument("--libration", type=number, default=0.0, metavar="DEG",
+    model.add_argument("--rtol", default=1e-12, metavar="RTOL", help="DOP853 relative tolerance (default 1e-12)")
+    model.add_argument("--libration", default=0.0, metavar="DEG",
                        help="Dimorphos turned this many degrees from the line to Didymos at the start (default 0)")
     impact = parser.add_argument_group("DART's impact at t = 0")
     impact.add_argument("--impact", action="store_true", help="also run after an impulsive velocity change of Dimorphos")
@@ -68,14 +72,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     impulse.add_argument("--dv", nargs="+", default=None, metavar="DV",
                          help="Dimorphos's along-track velocity change, e.g. '-2.63 mm/s' (a number alone is mm/s; "
                               "negative: against its motion; default -2.63 mm/s, Naidu et al. 2024)")
-    impulse.add_argument("--beta", type=number, default=None, metavar="BETA",
+    impulse.add_argument("--beta", default=None, metavar="BETA",
                          help="momentum enhancement instead of --dv: dv = beta m U / M with DART's mass and speed "
                               "(3.61: Cheng et al. 2023 for 2.4 g/cm^3)")
-    impact.add_argument("--impactor-mass", type=number, default=None, metavar="KG",
+    impact.add_argument("--impactor-mass", default=None, metavar="KG",
                         help="with --beta: impactor mass in kg (default 579.4, Cheng et al. 2023)")
-    impact.add_argument("--impactor-speed", type=number, default=None, metavar="KM_S",
+    impact.add_argument("--impactor-speed", default=None, metavar="KM_S",
                         help="with --beta: impactor speed relative to Dimorphos in km/s (default 6.1449)")
-    impact.add_argument("--impact-elevation", type=number, default=0.0, metavar="DEG",
+    impact.add_argument("--impact-elevation", default=0.0, metavar="DEG",
                         help="angle of the impulse out of the orbit plane (default 0: in the plane, against the motion)")
     files = parser.add_argument_group("output files")
     files.add_argument("--output", metavar="FILE.ecsv", help="write the run (time, relative orbit, libration, "
@@ -93,21 +97,7 @@ def _report(label, run):
         # An escaping pair has no orbit period and no libration: say so instead of fitting lines to it.
         orbit_lines = [f"  unbound                  {unbound}; no mutual period or libration"]
     else:
-        parts = run.libration_components()
-        orbit = run.mutual_orbit()
-        apsides = ("circular" if orbit.apsidal_rate is None else
-                   f"eccentricity {orbit.eccentricity:.4f}, apsidal precession "
-                   f"{orbit.apsidal_rate.to_value(u.deg / u.day):.2f} deg/day")
-        orbit_lines = [
-            f"  mutual orbit             mean sidereal period {orbit.sidereal_period.to_value(u.h):.6f} h, mean "
-            f"separation {orbit.mean_separation.to_value(u.m):.1f} m, {apsides}",
-            f"  free libration           period {parts.free_period.to_value(u.h):.4f} h, amplitude "
-            f"{parts.free_amplitude.to_value(u.deg):.4f} deg",
-            f"  forced libration         period {parts.forced_period.to_value(u.h):.4f} h, amplitude "
-            f"{parts.forced_amplitude.to_value(u.deg):.4f} deg (fit residual {parts.residual_rms.to_value(u.deg):.2g} "
-            "deg rms)",
-            f"  max |libration|          {abs(run.libration()).max().to_value(u.deg):.4f} deg",
-        ]
+        orbit_lines = _orbit_lines(run)
     lines = [
         f"{label}",
         *orbit_lines,
@@ -121,13 +111,60 @@ def _report(label, run):
     print("\n".join(lines))
 
 
+def _orbit_lines(run):
+    """The mean mutual orbit and the libration lines, each with its resolution, or why the run cannot give them."""
+    import astropy.units as u
+
+    from spinorbit.core.binary.errors import UnresolvedPeriodError
+
+    def short(error):
+        # A run too short for a period: say so and how long it must be, instead of printing the wrong line.
+        hint = ""
+        if error.required_span is not None:
+            # (rounded up, less a hair: a span of exactly 3 periods asks for 3 orbits, not 4)
+            hint = f" Here: --orbits {math.ceil(error.required_span / _nominal_period_s() - 1e-6)} or more."
+        return f"  not resolved             {error}{hint}"
+
+    try:
+        orbit = run.mutual_orbit()
+    except UnresolvedPeriodError as error:
+        return [short(error)]
+    apsides = ("circular" if orbit.apsidal_rate is None else
+               f"eccentricity {orbit.eccentricity:.4f}, apsidal precession {orbit.apsidal_rate.to_value(u.deg / u.day):.2f} "
+               "deg/day")
+    lines = [f"  mutual orbit             mean sidereal period {orbit.sidereal_period.to_value(u.h):.6f} h, mean "
+             f"separation {orbit.mean_separation.to_value(u.m):.1f} m, {apsides}"]
+    try:
+        parts = run.libration_components()
+    except UnresolvedPeriodError as error:
+        return [*lines, short(error), f"  max |libration|          {abs(run.libration()).max().to_value(u.deg):.4f} deg"]
+    return [
+        *lines,
+        f"  free libration           period {parts.free_period.to_value(u.h):.4f} ± {parts.free_resolution.to_value(u.h):.2g} h, "
+        f"amplitude {parts.free_amplitude.to_value(u.deg):.4f} deg",
+        f"  forced libration         period {parts.forced_period.to_value(u.h):.4f} ± {parts.forced_resolution.to_value(u.h):.2g} h, "
+        f"amplitude {parts.forced_amplitude.to_value(u.deg):.4f} deg (fit residual {parts.residual_rms.to_value(u.deg):.2g} "
+        "deg rms)",
+        "                           (± one resolution P²/T of the run's periodogram)",
+        f"  max |libration|          {abs(run.libration()).max().to_value(u.deg):.4f} deg",
+    ]
+
+
+def _nominal_period_s():
+    """The pre-impact mutual period (s): the unit of --orbits."""
+    import astropy.units as u
+
+    from spinorbit.data.dart import PERIOD_BEFORE
+
+    return PERIOD_BEFORE.to_value(u.s)
+
+
 def _impulse(args, state):
     """(Δv Quantity (3,) on the inertial axes, its description) from --dv or --beta and --impact-elevation."""
     import astropy.units as u
     import numpy as np
 
     from spinorbit.binary import momentum_impulse
-    from spinorbit.commands._common import quantity
     from spinorbit.data.dart import DART_MASS, DART_SPEED, DV_NAIDU
 
     if args.beta is None and (args.impactor_mass is not None or args.impactor_speed is not None):
@@ -139,15 +176,12 @@ def _impulse(args, state):
     # against the motion, tilted by the elevation towards the orbit normal (+z)
     backwards = -along * math.cos(elevation) + np.array([0.0, 0.0, math.sin(elevation)])
     if args.beta is None:
-        dv = DV_NAIDU if args.dv is None else quantity("--dv", args.dv, "mm/s", "velocity", "-2.63 mm/s")
+        dv = DV_NAIDU if args.dv is None else args.dv
         size = dv.to_value(u.m / u.s)
         if size > 0 and args.impact_elevation != 0.0:
             raise CommandError(f"--dv expects the along-track change, negative against the motion, with "
-                               f"--impact-elevation; got {args.dv} with an elevation of {args.impact_elevation:g} deg. "
+                               f"--impact-elevation; got {dv:g} with an elevation of {args.impact_elevation:g} deg. "
                                "Give a negative --dv (the impulse's size is |dv| / cos(elevation)).")
-        if math.cos(elevation) <= 1e-12:
-            raise CommandError(f"--impact-elevation expects an angle below 90 deg with --dv (the along-track part "
-                               f"must be the given dv); got {args.impact_elevation:g} deg.")
         # the along-track component is the given dv; out of the plane the impulse is longer by 1/cos
         delta_v = abs(size) / math.cos(elevation) * (backwards if size < 0 else along) * u.m / u.s
         source = " (Naidu et al. 2024)" if args.dv is None else ""
@@ -214,6 +248,26 @@ def _plot(runs, path):
     plt.close(figure)
 
 
+def check_options(args) -> None:
+    """Every number in range before any work (the validation layer, :mod:`spinorbit.commands._inputs`)."""
+    args.order = check.integer("--order", args.order, "4", low=0, high=4)
+    # DOP853 in double precision: the binary propagator's own range (spinorbit.core.binary.propagate)
+    args.rtol = check.number("--rtol", args.rtol, "1e-12", low=1e-15, high=1.0, high_open=True,
+                             advice="Double precision cannot do better than 1e-15.")
+    args.libration = check.number("--libration", args.libration, "10", low=-180.0, high=180.0)
+    if args.dv is not None:
+        args.dv = check.quantity("--dv", args.dv, "mm/s", "-2.63 mm/s", default_unit="mm/s")
+    if args.beta is not None:
+        args.beta = check.number("--beta", args.beta, "3.61", low=0.0,
+                                 advice="beta is the momentum enhancement, ≥ 1 in practice.")
+    if args.impactor_mass is not None:
+        args.impactor_mass = check.number("--impactor-mass", args.impactor_mass, "579.4", low=0.0, low_open=True)
+    if args.impactor_speed is not None:
+        args.impactor_speed = check.number("--impactor-speed", args.impactor_speed, "6.1449", low=0.0, low_open=True)
+    args.impact_elevation = check.number("--impact-elevation", args.impact_elevation, "30", low=-90.0, high=90.0,
+                                         high_open=True, low_open=True)
+
+
 def run(args) -> int:
     """Run ``spinorbit didymos``; return the exit status."""
     import astropy.units as u
@@ -225,6 +279,7 @@ def run(args) -> int:
     from spinorbit.data.dart import PERIOD_BEFORE, PERIOD_CHANGE_INITIAL_NAIDU, PERIOD_CHANGE_THOMAS, dart_state, dart_system
 
     check_outputs(args)
+    check_options(args)
     rows = args.orbits * args.per_orbit + 1
     if rows > MAX_ROWS:
         raise CommandError(f"--orbits {args.orbits} with --per-orbit {args.per_orbit} gives {rows} output rows, more than "

@@ -1,6 +1,8 @@
 """Physics that no longer applies is refused, not reported (issue 36, class 3).
 
-- a pair that is not bound has no mutual period and no libration lines (``spinorbit.core.binary.boundedness``).
+- a pair that is not bound has no mutual period and no libration lines (``spinorbit.core.binary.boundedness``);
+- a period that the run is too short to resolve is refused, with the span it needs; one that it resolves
+  comes with its resolution P²/T (``spinorbit.binary.run``).
 """
 
 import math
@@ -13,7 +15,9 @@ from astropy import constants
 
 from spinorbit import cli
 from spinorbit.binary import BinaryState, BinarySystem, Figure, HeliocentricOrbit, propagate
-from spinorbit.core.binary.errors import UnboundPairError
+from spinorbit.binary.run import MIN_LINE_CYCLES, MIN_LINE_SEPARATION
+from spinorbit.core.binary.errors import UnboundPairError, UnresolvedPeriodError
+from spinorbit.data.didymos import RELATIVE_SPEED, SEPARATION, didymos_state
 
 G = constants.G.si.value
 DENSITY = 2 * u.g / u.cm ** 3
@@ -55,13 +59,71 @@ def test_an_unbound_pair_has_no_mutual_period_or_libration(factor):
             method()
 
 
-def test_a_bound_pair_just_below_escape_speed_reports_its_period():
+def test_a_bound_pair_just_below_escape_speed_is_bound_but_two_hours_give_no_period():
     separation = 2000.0
     state = sphere_pair(separation, 1.0)
     state = sphere_pair(separation, 0.99 * escape_speed(state, separation))
     run = propagate(state, np.linspace(0, 2, 9) * u.h)
     assert run.is_bound() and run.unbound_reason() is None
-    assert run.mutual_period() > 0 * u.s
+    # Far above a day on so eccentric an orbit: two hours at pericentre turn the longitude by a fraction of a
+    # revolution. The span asked for is that rate's revolution, a lower bound of the true period.
+    with pytest.raises(UnresolvedPeriodError, match=r"covers 0\.\d+ of a revolution") as refusal:
+        run.mutual_period()
+    assert refusal.value.required_span > 10 * 2 * 3600
+
+
+def test_a_circular_pair_over_a_few_revolutions_gives_kepler_s_period():
+    separation = 2000.0
+    state = sphere_pair(separation, 1.0)
+    state = sphere_pair(separation, escape_speed(state, separation) / math.sqrt(2))
+    kepler = 2 * math.pi * separation / (escape_speed(state, separation) / math.sqrt(2))
+    run = propagate(state, np.linspace(0, 3 * kepler, 121) * u.s)
+    # Two spheres on a circle: the longitude is linear in t; 1e-9 is DOP853's rtol 1e-12 over 3 orbits, amply.
+    assert run.mutual_period().to_value(u.s) == pytest.approx(kepler, rel=1e-9)
+
+
+def didymos_run(orbits, order=2):
+    period = (2 * math.pi * SEPARATION / RELATIVE_SPEED).to(u.s)
+    return propagate(didymos_state(order=order), np.linspace(0, orbits, orbits * 40 + 1) * period)
+
+
+def test_a_didymos_run_of_four_orbits_does_not_resolve_the_libration_lines():
+    # Free 13.8 h and forced 11.7 h: 1/Δf = 78 h, so 4 resolutions need ~310 h (26 orbits); 4 orbits give 48 h.
+    run = didymos_run(4)
+    with pytest.raises(UnresolvedPeriodError, match="not resolved by this run of 47.68 h") as refusal:
+        run.libration_components()
+    span = run.times[-1].to_value(u.s)
+    assert refusal.value.required_span > 2 * span
+
+
+def test_resolved_libration_lines_carry_their_resolution():
+    run = didymos_run(30)
+    parts = run.libration_components()
+    span = run.times[-1]
+    for period, resolution in ((parts.free_period, parts.free_resolution),
+                               (parts.forced_period, parts.forced_resolution)):
+        assert span / period >= MIN_LINE_CYCLES
+        assert resolution.to_value(u.s) == pytest.approx((period ** 2 / span).to_value(u.s), rel=1e-14)
+    assert abs(1 / parts.free_period - 1 / parts.forced_period) * span >= MIN_LINE_SEPARATION
+    # Against the 100-orbit run's lines (13.8447 h, 11.7309 h at order 2): 30 orbits are 4.7 resolutions
+    # apart, measured within 1e-4 of them, a small share of the ~4 % resolution.
+    assert parts.free_period.to_value(u.h) == pytest.approx(13.8447, rel=2e-4)
+    assert parts.forced_period.to_value(u.h) == pytest.approx(11.7309, rel=2e-4)
+    assert parts.free_resolution.to_value(u.h) < 0.6 and parts.forced_resolution.to_value(u.h) < 0.4
+
+
+def test_didymos_over_four_orbits_says_the_lines_are_not_resolved(capsys):
+    # Four orbits give the mean orbit (3 revolutions at least) but not the ~51 h free libration (10 cycles).
+    status = cli.main(["didymos", "--orbits", "4", "--order", "2"])
+    out, err = capsys.readouterr()
+    assert status == 0, err
+    assert "mean sidereal period" in out and "free libration" not in out and "forced libration" not in out
+    assert re.search(r"not resolved .*run of 47.69 h.*at least [\d.]+ h .*--orbits \d+ or more", out)
+    status = cli.main(["didymos", "--orbits", "2", "--order", "2"])
+    out, err = capsys.readouterr()
+    assert status == 0, err
+    assert "mean sidereal period" not in out
+    assert re.search(r"not resolved .*mutual_orbit: the run of 23.84 h covers 2 revolutions.*--orbits 3 or more", out)
 
 
 def test_beyond_the_hill_radius_the_pair_is_not_bound():

@@ -76,7 +76,7 @@ def shapes(tmp_path):
            for sigma, seed in ((0.1, 3), (0.2, 1), (0.3, 2))]
     path = tmp_path / "bilobed.obj"
     write_bilobed_obj(path)
-    return out + [("bilobed OBJ", read_obj(path))]
+    return out + [("bilobed OBJ", read_obj(path, unit=u.km))]
 
 
 def test_direct_block_is_the_facet_sum():

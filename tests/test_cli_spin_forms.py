@@ -58,7 +58,7 @@ def test_pole_period_phase_on_the_command_line_is_from_pole(capsys, tmp_path):
     assert back.pole_lat.to_value(u.deg) == pytest.approx(-40.0, abs=ROUND_TRIP_DEG)
     assert back.phase.to_value(u.deg) == pytest.approx(10.0, abs=ROUND_TRIP_DEG)
     assert back.period.to_value(u.h) == pytest.approx(8.0, rel=ROUND_TRIP_RELATIVE)
-    assert "sidereal period    0.3333 d" in out
+    assert "P = 0.3333 d (sidereal, principal-axis rotator)" in out
 
 
 def test_a_number_alone_is_in_the_unit_help_names(capsys, tmp_path):

@@ -97,8 +97,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     files = parser.add_argument_group("output files")
     files.add_argument("--output", metavar="FILE.ecsv", help="write the table (time, attitude, spin, pole, periods; "
                        "docs/conventions.md 'Output tables') as ECSV (FILE.ecsv) or CSV (FILE.csv)")
-    files.add_argument("--plot", metavar="FILE.png", help="plot periods, pole and mode against the date "
-                       "(needs matplotlib; .png, .pdf or .svg)")
+    files.add_argument("--plot", metavar="FILE.png", help="plot against the date: a tumbler's periods, pole and "
+                       "class; a principal-axis rotator's pole drift (arcsec), period residual and wobble (needs "
+                       "matplotlib; .png, .pdf or .svg)")
 
 
 def _offsets(args):

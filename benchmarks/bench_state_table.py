@@ -47,7 +47,7 @@ def cases():
 
 def per_row_table(body, quaternions, omegas):
     """The former build: one RotationState per row and its properties."""
-    states = [RotationState(body, q, w) for q, w in zip(quaternions, omegas)]
+    states = [RotationState(body, q, w * u.rad / u.day) for q, w in zip(quaternions, omegas)]
     table = QTable()
     for i, name in enumerate(("q_w", "q_x", "q_y", "q_z")):
         table[name] = np.array([s.quaternion[i] for s in states])
@@ -78,10 +78,10 @@ def measure(repeat):
     for name, state in cases():
         body = state.body
         scene = Scene(state, EPOCH, EPOCH + offsets * u.day, tolerance=1e-12 * u.rad)
-        quaternions, omegas = state.propagate_torque_free(offsets)
+        quaternions, omegas = state.propagate_torque_free(offsets * u.day)
         omegas = omegas.to_value(u.rad / u.day)
         work = {
-            "flow": lambda: state.propagate_torque_free(offsets),
+            "flow": lambda: state.propagate_torque_free(offsets * u.day),
             "per row": lambda: per_row_table(body, quaternions, omegas),
             "columns, rows": lambda: columns_table(body, quaternions, omegas, "rows"),
             "columns, constants": lambda: columns_table(body, quaternions, omegas, state),

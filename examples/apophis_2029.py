@@ -109,7 +109,7 @@ def main(argv=None):
     afters = []
     if args.phases > 1:
         offsets = np.arange(args.phases) / args.phases * published.periods[0].to_value(u.day)
-        quaternions, omegas = published.propagate_torque_free(offsets)
+        quaternions, omegas = published.propagate_torque_free(offsets * u.day)
         for q, w in zip(quaternions, omegas):
             state = RotationState(published.body, q, w)
             result = propagate_one_way(state, start, end, samples, rtol=args.rtol)[-1]

@@ -142,7 +142,7 @@ def flyby_phases(state, flyby, samples, phases, rtol):
 
     start = flyby - 150 * u.day
     offsets = np.arange(phases) / phases * state.periods[1].to_value(u.day)
-    quaternions, omegas = state.propagate_torque_free(offsets)
+    quaternions, omegas = state.propagate_torque_free(offsets * u.day)
     changes = []
     for q, w in zip(quaternions, omegas):
         table = propagate_one_way(RotationState(state.body, q, w), start,

@@ -2,7 +2,12 @@
 
 Every Quantity argument of the units layer, and every option of the command line that takes a
 quantity, goes through :func:`value_in`: a wrong physical type is refused with the argument's name,
-the unit expected and what arrived; NaN and ±inf are refused where a finite value is needed. The
+the unit expected and what arrived; NaN and ±inf are refused where a finite value is needed.
+
+**Units are never guessed** (``docs/conventions.md``, "Units"): a dimensional argument is a Quantity,
+and a bare number for it is refused with a one-line hint (:func:`bare_number_message`): "omega
+expects an angular velocity Quantity (e.g. 2.18e-4 * u.rad / u.s); got the bare float 0.000218". Only
+dimensionless arguments (ratios, an eccentricity) take plain numbers. The
 command line parses its text with :func:`parse_quantity` and :func:`parse_unit`, which end in the
 same checks, so ``RotationState(..., 1 * u.Hz)`` and ``--omega-unit Hz`` give the same refusal.
 
@@ -20,7 +25,7 @@ import math
 import numpy as np
 from astropy import units as u
 
-__all__ = ["QuantityInputError", "finite_values", "parse_quantity", "parse_unit", "value_in"]
+__all__ = ["QuantityInputError", "bare_number_message", "finite_values", "parse_quantity", "parse_unit", "value_in"]
 
 # The physical types value_in compares with, looked up once: comparing with a string parses the name
 # on every call (~4 µs each, several per member of an ensemble); comparing PhysicalTypes is the same test.
@@ -53,6 +58,29 @@ def _arrived(value) -> str:
     return f"{value!r} ({type(value).__name__})"
 
 
+def _bare(value) -> str:
+    """A bare number or array as the user wrote it, short: "float 0.000218", "list [0.1, 0, 0.3]"."""
+    if isinstance(value, np.ndarray):
+        shown = np.array2string(value, threshold=6, separator=", ")
+    else:
+        shown = repr(value)
+        shown = shown if len(shown) <= 60 else shown[:57] + "..."
+    return f"{type(value).__name__} {shown}"
+
+
+def bare_number_message(name: str, unit, example: str, value) -> str:
+    """The one-line refusal of a bare number where a Quantity of ``unit``'s physical type is needed.
+
+    ``name`` is the argument, ``example`` a correct value to copy (``"2.18e-4 * u.rad / u.s"``) and
+    ``value`` what arrived. Used by :func:`value_in`; a check of its own (an ``isinstance`` test before
+    a conversion) raises ``QuantityInputError`` with this message, so every refusal reads the same.
+    """
+    kind = _kind(unit)
+    article = "an" if kind[0] in "aeiou" else "a"
+    return (f"{name} expects {article} {kind} Quantity (e.g. {example}); got the bare {_bare(value)}: units are "
+            "never guessed, multiply by the unit meant.")
+
+
 def _frequency_advice(name: str, value, unit: u.UnitBase) -> str:
     time_unit = (u.rad / unit).to_string()  # the time unit of the expected rate: d for rad / d
     return (
@@ -72,13 +100,15 @@ def value_in(name: str, value, unit, example: str, *, plain_unit=None, finite: b
     name : str
         The argument or option, as the user wrote it (``"angular_velocity"``, ``"--span"``).
     value : Quantity or array_like
-        A Quantity of ``unit``'s physical type; plain numbers are read in ``plain_unit``.
+        A Quantity of ``unit``'s physical type. Plain numbers only where ``unit`` is dimensionless
+        (or, until every caller is converted, read in ``plain_unit``).
     unit : str or astropy unit
         The unit the caller works in (``rad / day``, ``day``, ``kg m2``).
     example : str
         A correct value to show in the message (``"0.1 * u.rad / u.s"``).
     plain_unit : astropy unit, optional
-        The unit of plain numbers; None: plain numbers are refused.
+        The unit of plain numbers; None (the rule): plain numbers are refused for a dimensional
+        ``unit`` with :func:`bare_number_message`, and read as they are for a dimensionless one.
     finite : bool
         Refuse NaN and ±inf (default).
     shape : tuple, optional
@@ -115,10 +145,10 @@ def value_in(name: str, value, unit, example: str, *, plain_unit=None, finite: b
                 f"{name}: expected a Quantity in {_expected(unit)} such as {example}; got "
                 f"{_arrived(value)}."
             )
-    elif plain_unit is None:
-        raise QuantityInputError(f"{name}: expected a Quantity in {_expected(unit)} such as "
-                                 f"{example}; got {_arrived(value)}.")
+    elif plain_unit is None and unit.physical_type != _DIMENSIONLESS:
+        raise QuantityInputError(bare_number_message(name, unit, example, value))
     else:
+        plain_unit = u.dimensionless_unscaled if plain_unit is None else plain_unit
         try:
             values = np.asarray(value, dtype=float) * u.Unit(plain_unit).to(unit)
         except (TypeError, ValueError):

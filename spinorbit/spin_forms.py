@@ -34,23 +34,31 @@ from spinorbit.core.elements.canonical import MODE_LAM, MODE_SAM
 from spinorbit.core.errors import SpinorbitError
 from spinorbit.core.free_motion import from_periods
 from spinorbit.core.free_motion.summary import MODE_SEPARATRIX, motion_summary
+from spinorbit.core.free_motion.wobble import wobble_amplitude
 from spinorbit.core.elements.canonical import MODE_UNIFORM
 from spinorbit.core.math.rotations import attitude_to_euler313, attitude_to_quat, euler313_to_attitude, rot3
 from spinorbit.frames import icrf_to_ecliptic_matrix
 from spinorbit.quantities import value_in
 
-__all__ = ["PoleSolution", "SpinFormError", "TumblingParameters", "FRAMES", "CYCLIC_AXES", "POLE_MAX_WOBBLE",
-           "THETA0_TOLERANCE", "attitude_quaternion", "check_epoch", "momentum_frame", "pole_attitude", "tumbling_attitude", "pole_of", "tumbling_of"]
+__all__ = ["PoleSolution", "SpinFormError", "TumblingParameters", "FRAMES", "CYCLIC_AXES", "PA_MAX_WOBBLE",
+           "ROTATION_CLASSES", "THETA0_TOLERANCE", "attitude_quaternion", "rotation_classes", "wobble_amplitude_deg",
+           "wobble_threshold_deg", "check_epoch", "momentum_frame", "pole_attitude", "tumbling_attitude", "pole_of", "tumbling_of"]
 
 #: Frames of the published angles: "ecliptic" (ecliptic and equinox J2000, IAU 2006 obliquity with the frame
 #: bias, as every spin pole in spinorbit: docs/conventions.md) and "icrf" (then λ, β are RA, Dec).
 FRAMES = ("ecliptic", "icrf")
 #: The relabellings of the user's body axes that keep the frame right-handed: which user axes play x, y, z.
 CYCLIC_AXES = ("xyz", "yzx", "zxy")
-#: Largest angle between the angular momentum and the rotation axis for which :meth:`RotationState.pole`
-#: describes a state by a pole and a period: beyond it the motion is a visible tumble (Pravec et al. 2005
-#: call a rotation NPA when its second period is detected), and its pole form would drop the wobble.
-POLE_MAX_WOBBLE = 1.0 * u.deg
+#: Default threshold of the rotation class (:func:`rotation_classes`, ``RotationState.rotation_class``) and of
+#: :meth:`RotationState.pole`: a state whose wobble amplitude (the largest nutation angle of its circulation axis
+#: about the angular momentum over the free motion, :func:`wobble_amplitude_deg`) is at most this is a
+#: principal-axis rotator (PA), reported by a pole and one sidereal period. Pravec et al. (2005) call a rotation
+#: NPA only when its second period is detected in the lightcurve; a wobble below ~1° changes the aspect of the body
+#: by less than 1°, which moves a lightcurve by less than the 0.01–0.02 mag errors of dense photometry
+#: (docs/design.md, "PA or NPA"). Every table, CLI command and scene file takes another value.
+PA_MAX_WOBBLE = 1.0 * u.deg
+#: The values of a rotation class: principal-axis, or the non-principal-axis mode of the motion.
+ROTATION_CLASSES = ("PA", "SAM", "LAM", "separatrix")
 #: How far a published θ0 may be from the nutation angle that (P_ψ, P_φ, ψ0, I1/I3, I2/I3) imply (θ0 is not
 #: independent of them): published angles are rounded to 0.1°–1° and the periods to 3–5 digits, which
 #: moves the implied θ by up to a few tenths of a degree (docs/conventions.md, "Published spin forms").
@@ -80,7 +88,8 @@ class PoleSolution:
         The state's epoch.
     frame : str
     wobble : Quantity
-        Angle (deg) between the angular momentum and the rotation axis: 0 for a state made by ``from_pole``.
+        Angle (deg) between the angular momentum and the rotation axis at ``epoch``: 0 for a state made by
+        ``from_pole``. Its largest value over the free motion is the state's ``wobble_amplitude``.
     axes : str
         Which user body axes are DAMIT's x, y, z (:data:`CYCLIC_AXES`).
     """
@@ -256,22 +265,67 @@ def _summary(attitude, omega, body):
     return motion_summary(*(float(m) for m in principal), *body.principal_moments)
 
 
-def pole_of(attitude, omega, body, frame="ecliptic", max_wobble=POLE_MAX_WOBBLE, axes=None) -> dict:
+# -- which form: principal-axis or tumbling -----------------------------------------------------------
+def wobble_amplitude_deg(omega, body) -> float:
+    """The wobble amplitude (deg) of body angular velocity ``omega`` (user axes, rad/day) of ``body``.
+
+    The largest angle between the circulation axis (C in SAM, A in LAM) and the angular momentum over the
+    torque-free motion through this state (:mod:`spinorbit.core.free_motion.wobble`): 0 for a permanent
+    rotation, 90 on the separatrix.
+    """
+    principal = body.to_principal @ (body.moment_values * np.asarray(omega, dtype=float))
+    if not np.any(principal):
+        raise SpinFormError("the body is not rotating (zero spin): it has no wobble or rotation class.")
+    return math.degrees(wobble_amplitude(*(float(m) for m in principal), *body.principal_moments))
+
+
+def wobble_threshold_deg(threshold, name="threshold") -> float:
+    """``threshold`` (an angle) in degrees, checked to lie in [0°, 90°): at 90° even the separatrix would be PA."""
+    degrees = value_in(name, threshold, u.deg, "1 * u.deg", shape=())
+    if not 0.0 <= degrees < 90.0:
+        raise SpinFormError(f"{name} expects a wobble amplitude in [0°, 90°) below which a rotation is principal-axis "
+                            f"(default {PA_MAX_WOBBLE}); got {threshold!s}.")
+    return degrees
+
+
+def rotation_classes(amplitudes_deg, modes, threshold=PA_MAX_WOBBLE) -> np.ndarray:
+    """"PA" where the wobble amplitude (deg) is at most ``threshold``, else the motion's mode ("SAM", "LAM", "separatrix").
+
+    ``modes`` are the mode names of ``RotationState.mode`` (a permanent rotation has amplitude 0 and is "PA"
+    at every threshold). Arrays of one shape; returns a str array of that shape.
+    """
+    limit = wobble_threshold_deg(threshold)
+    amplitudes = np.asarray(amplitudes_deg, dtype=float)
+    modes = np.asarray(modes)
+    if amplitudes.shape != modes.shape:
+        raise SpinFormError(f"amplitudes_deg and modes must have one shape; got {amplitudes.shape} and {modes.shape}.")
+    classes = np.where(amplitudes <= limit, "PA", modes).astype(f"<U{len('separatrix')}")
+    unknown = set(np.unique(classes).tolist()) - set(ROTATION_CLASSES)
+    if unknown:
+        raise SpinFormError(f"a state with wobble amplitude above {limit}° has mode {sorted(unknown)}, not one of "
+                            f"{ROTATION_CLASSES[1:]}: the amplitudes and the modes do not belong together.")
+    return classes
+
+
+def pole_of(attitude, omega, body, frame="ecliptic", max_wobble=PA_MAX_WOBBLE, axes=None) -> dict:
     """The DAMIT form of (R, ω): the fields of :class:`PoleSolution` but ``epoch``.
 
     Raises :class:`SpinFormError` when the rotation axis (largest moment, DAMIT's z) is further than
-    ``max_wobble`` from the angular momentum: that state tumbles, and :func:`tumbling_of` describes it.
+    ``max_wobble`` from the angular momentum now, or the motion's wobble amplitude (:func:`wobble_amplitude_deg`)
+    exceeds it: that state tumbles, and :func:`tumbling_of` describes it. ``wobble`` is the angle now.
     """
     limit = value_in("max_wobble", max_wobble, u.rad, "1 * u.deg", shape=())
     lon, lat, _ = _momentum_direction(attitude, omega, body, frame)
     axes = _axes_with_z(body, np.max) if axes is None else axes
     in_momentum_frame = _relabelling(axes) @ attitude @ _frame_matrix(frame).T @ momentum_frame(lon, lat).T
     wobble = math.atan2(math.hypot(in_momentum_frame[0, 2], in_momentum_frame[1, 2]), in_momentum_frame[2, 2])
-    if not wobble <= limit:
+    amplitude = math.radians(wobble_amplitude_deg(omega, body))
+    if not max(wobble, amplitude) <= limit:
         raise SpinFormError(
             f"the rotation axis ({axes[2]}, largest moment) is {math.degrees(wobble):.6g}° from the angular momentum, "
-            f"more than max_wobble = {max_wobble!s}: the state tumbles and a pole and one period would drop its "
-            "wobble. Use state.tumbling_parameters(), or pass a larger max_wobble.")
+            f"and the motion's wobble amplitude is {math.degrees(amplitude):.6g}°; more than max_wobble = "
+            f"{max_wobble!s}: the state tumbles and a pole and one period would drop its wobble. Use "
+            "state.tumbling_parameters(), or pass a larger max_wobble.")
     r = in_momentum_frame
     phase = math.atan2(r[0, 1] - r[1, 0], r[0, 0] + r[1, 1]) % (2 * math.pi)  # φ + ψ of the 3-1-3 angles
     sidereal_days = _summary(attitude, omega, body)[4]

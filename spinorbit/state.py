@@ -119,9 +119,9 @@ def _as_rotation_matrix(matrix) -> np.ndarray:
 
 
 def _as_angular_velocity(omega, name="angular_velocity") -> np.ndarray:
-    # a Quantity of an angle per time (frequencies refused: docs/conventions.md, "Units"); floats are rad/day
-    values = np.asarray(value_in(name, omega, RAD_PER_DAY, "[0.1, 0, 0.3] * u.rad / u.s", plain_unit=RAD_PER_DAY,
-                                 finite=False), dtype=float)
+    # a Quantity of an angle per time: bare numbers and frequencies refused (docs/conventions.md, "Units")
+    values = np.asarray(value_in(name, omega, RAD_PER_DAY, "[0.1, 0, 0.3] * u.rad / u.day", finite=False),
+                        dtype=float)
     if values.shape != (3,):
         raise InvalidStateError(f"the angular velocity is a 3-vector in body axes; got shape {values.shape}.")
     if not np.all(np.isfinite(values)):
@@ -159,8 +159,9 @@ class RotationState:
     quaternion : array_like, shape (4,)
         Unit quaternion (w, x, y, z), scalar first, taking inertial axes to the user's body axes
         (v_inertial = M(q) v_body).
-    angular_velocity : Quantity or array_like, shape (3,)
-        Body angular velocity in the user's body axes (rad/day if plain floats).
+    angular_velocity : Quantity, shape (3,)
+        Body angular velocity in the user's body axes, an angle per time (``[0, 0, 3] * u.rad / u.day``,
+        ``u.deg / u.hour``, ``u.cycle / u.day``; a bare number or a frequency such as ``u.Hz`` is refused).
     epoch : astropy.time.Time, optional
         The instant of this attitude and spin (scalar); None (default) when the state is not tied to
         one. A :class:`spinorbit.Scene` takes it as its epoch.
@@ -197,8 +198,8 @@ class RotationState:
 
     @classmethod
     def from_euler313(cls, body, phi, theta, psi, angular_velocity, epoch=None):
-        """From passive 3-1-3 Euler angles (Quantities or radians): R = R3(ψ) R1(θ) R3(φ)."""
-        angles = [value_in(name, a, u.rad, "30 * u.deg", plain_unit=u.rad, shape=(), finite=False)
+        """From passive 3-1-3 Euler angles (angle Quantities): R = R3(ψ) R1(θ) R3(φ)."""
+        angles = [value_in(name, a, u.rad, "30 * u.deg", shape=(), finite=False)
                   for name, a in (("phi", phi), ("theta", theta), ("psi", psi))]
         if not all(math.isfinite(a) for a in angles):
             raise NonFiniteStateError(f"Euler angles must be finite; got phi, theta, psi = {angles}.")
@@ -206,11 +207,13 @@ class RotationState:
 
     @classmethod
     def from_angular_momentum(cls, body, quaternion, angular_momentum, epoch=None):
-        """From the body angular momentum (user axes) instead of the angular velocity: ω = I⁻¹ M."""
-        values = value_in("angular_momentum", angular_momentum, body.moment_unit * RAD_PER_DAY,
-                          f"[0.1, 0, 0.3] * {body.moment_unit * RAD_PER_DAY!r}", plain_unit=body.moment_unit * RAD_PER_DAY,
-                          finite=False)
-        return cls(body, quaternion, np.asarray(values, dtype=float) / body.moment_values, epoch)
+        """From the body angular momentum (user axes, a Quantity in the body's moment unit × an angle per
+        time, such as kg m² rad/day; rad/day for moments given as ratios) instead of the angular velocity:
+        ω = I⁻¹ M."""
+        momentum_unit = body.moment_unit * RAD_PER_DAY
+        example = f"[0.1, 0, 0.3] * u.Unit('{momentum_unit.to_string()}')"
+        values = value_in("angular_momentum", angular_momentum, momentum_unit, example, finite=False)
+        return cls(body, quaternion, np.asarray(values, dtype=float) / body.moment_values * RAD_PER_DAY, epoch)
 
     @classmethod
     def from_pole(cls, body, pole_lon, pole_lat, period, epoch, phase=0 * u.deg, frame="ecliptic", axes=None):
@@ -246,11 +249,13 @@ class RotationState:
         """The same attitude and spin tied to ``epoch`` (a scalar Time, or None to untie it)."""
         return RotationState(self._body, self._q, self._omega * RAD_PER_DAY, epoch)
 
-    def pole(self, frame="ecliptic", max_wobble=_spin_forms.POLE_MAX_WOBBLE, axes=None):
+    def pole(self, frame="ecliptic", max_wobble=_spin_forms.PA_MAX_WOBBLE, axes=None):
         """(λ, β, P, φ0 at :attr:`epoch`, …) of this state, the inverse of :meth:`from_pole`.
 
         Returns a :class:`spinorbit.spin_forms.PoleSolution` (P is :attr:`sidereal_period`); raises
-        SpinFormError when the rotation axis is more than ``max_wobble`` (an angle) from the momentum.
+        SpinFormError when the rotation axis is more than ``max_wobble`` (an angle) from the momentum, or the
+        :attr:`wobble_amplitude` exceeds it (with the default, exactly the states :meth:`rotation_class` calls
+        "PA" about their largest moment).
         """
         return _spin_forms.PoleSolution(**_spin_forms.pole_of(self.attitude_matrix, self._omega, self._body, frame,
                                                               max_wobble, axes), epoch=self._epoch)
@@ -370,6 +375,31 @@ class RotationState:
         return "+C" if momentum[2] >= 0 else "-C"
 
     @property
+    def wobble_amplitude(self) -> u.Quantity:
+        """The wobble amplitude (deg): the largest angle over the torque-free motion between the angular
+        momentum and the circulation axis (C, the largest moment, in SAM; A, the smallest, in LAM).
+
+        sin²θ_max = (M_y² + M_x² B(C − A)/(A(C − B)))/G² in SAM, (M_y² + M_z² B(C − A)/(C(B − A)))/G² in LAM
+        (principal axes A ≤ B ≤ C; ``spinorbit.core.free_motion.wobble``); 0 for a permanent rotation, 90 on the
+        separatrix. A constant of the free motion, the osculating value of a torqued one.
+        ``docs/conventions.md``, "Wobble and rotation class".
+        """
+        self._rotating_momentum()  # refuses zero spin and unrepresentable momenta, as every motion property
+        return _spin_forms.wobble_amplitude_deg(self._omega, self._body) * u.deg
+
+    def rotation_class(self, threshold=_spin_forms.PA_MAX_WOBBLE) -> str:
+        """"PA" (principal-axis rotator) when :attr:`wobble_amplitude` ≤ ``threshold`` (an angle in [0°, 90°)),
+        else the non-principal-axis mode: "SAM", "LAM" or "separatrix".
+
+        The default, 1° (:data:`spinorbit.spin_forms.PA_MAX_WOBBLE`), is about where a wobble becomes detectable
+        in lightcurves (Pravec et al. 2005 call a rotation NPA only then; ``docs/design.md``, "PA or NPA"). A PA
+        state is reported by its pole and :attr:`sidereal_period` (:meth:`pole`), an NPA one by P_ψ, P_φ
+        (:meth:`tumbling_parameters`).
+        """
+        amplitude = self.wobble_amplitude.to_value(u.deg)
+        return str(_spin_forms.rotation_classes(np.array([amplitude]), np.array([self.mode]), threshold)[0])
+
+    @property
     def energy_ratio(self) -> float:
         """E/E0 = 2 T C / G²: kinetic energy over that of rotation about C with the same momentum.
 
@@ -482,7 +512,7 @@ class RotationState:
         frame = np.eye(3) if reference is None else _as_rotation_matrix(reference)
         attitude_ref, momentum = _andoyer.attitude_from_andoyer(*values)
         p = body.to_principal
-        return cls.from_matrix(body, p.T @ attitude_ref @ frame, (p.T @ momentum) / body.moment_values)
+        return cls.from_matrix(body, p.T @ attitude_ref @ frame, (p.T @ momentum) / body.moment_values * RAD_PER_DAY)
 
     def canonical_elements(self, reference="auto") -> CanonicalElements:
         """Fukushima's canonical elements (paper eq. 4) of this state.
@@ -528,7 +558,7 @@ class RotationState:
         attitude_ref, momentum = _canonical.state_from_elements(values, elements.flip, ic)
         p = body.to_principal
         attitude_user = p.T @ attitude_ref @ elements.reference
-        return cls.from_matrix(body, attitude_user, (p.T @ momentum) / body.moment_values)
+        return cls.from_matrix(body, attitude_user, (p.T @ momentum) / body.moment_values * RAD_PER_DAY)
 
     def principal_flow_start(self, horizon_days: float) -> tuple[np.ndarray, np.ndarray]:
         """(principal quaternion, principal momentum) that the exact free flow starts from, checked for a
@@ -556,8 +586,8 @@ class RotationState:
 
         Parameters
         ----------
-        dt : Quantity or array_like
-            Time offsets (days if plain floats), scalar or 1-D.
+        dt : Quantity
+            Time offsets (a time Quantity such as ``[0, 1, 2] * u.day``), scalar or 1-D.
         closed_forms : bool
             True (default): a body with two exactly equal moments takes the regular precession in
             closed form (``spinorbit.core.free_motion.regular_precession``, trig only); False: the elliptic flow
@@ -570,7 +600,7 @@ class RotationState:
         angular_velocity : Quantity, shape (N, 3)
             Body angular velocity in user axes (rad/day).
         """
-        times = value_in("dt", dt, u.day, "[0, 1, 2] * u.day", plain_unit=u.day, finite=False)
+        times = value_in("dt", dt, u.day, "[0, 1, 2] * u.day", finite=False)
         times = np.atleast_1d(np.asarray(times, dtype=float))
         if times.ndim != 1:
             raise ValueError(f"dt must be a scalar or 1-D array of time offsets; got shape {times.shape}.")

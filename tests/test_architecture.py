@@ -25,7 +25,8 @@ PACKAGE = Path(__file__).resolve().parent.parent / "spinorbit"
 FORBIDDEN_IN_CORE = ("astropy", "skyfield", "rebound", "reboundx", "heyoka", "jplephem")
 
 #: The core's folders, lowest first: each may import only itself and those before it.
-CORE_LAYERS = ("math", "model", "dynamics", "elements", "free_motion", "integrators", "averaging", "binary")
+CORE_LAYERS = ("math", "model", "dynamics", "elements", "free_motion", "integrators", "averaging", "binary",
+               "photometry")
 #: Core modules every core folder may use (numba settings, error types).
 CORE_BASE = ("spinorbit.core.jit", "spinorbit.core.errors")
 
@@ -39,6 +40,7 @@ UPPER_LAYERS = (
     ("coupling", ("spinorbit.coupling",)),
     ("binary", ("spinorbit.binary",)),
     ("scene", ("spinorbit.scene",)),
+    ("photometry", ("spinorbit.photometry",)),
     ("fit", ("spinorbit.fit",)),
     ("data", ("spinorbit.data",)),
     ("ensemble", ("spinorbit.ensemble",)),

@@ -41,7 +41,7 @@ def member(phase, distance_km=40000.0, torque=True, fail=False, die_marker="", m
         os._exit(1)  # the worker process dies here, for real
     if fail:
         raise ValueError(f"member asked to fail at phase {phase}")
-    state = state_at_phase(RotationState(BODY, [1.0, 0.0, 0.0, 0.0], [0.3, 0.1, 2.0]), phase)
+    state = state_at_phase(RotationState(BODY, [1.0, 0.0, 0.0, 0.0], [0.3, 0.1, 2.0] * u.rad / u.day), phase)
     perturbers = (FixedPerturber("earth", EARTH_GM, [distance_km, 0.0, 0.0] * u.km),) if torque else ()
     return Scene(state, EPOCH, END, perturbers=perturbers)
 
@@ -203,7 +203,7 @@ def test_outcomes_at_named_times():
 
 
 def _timed(phase):
-    state = state_at_phase(RotationState(BODY, [1.0, 0.0, 0.0, 0.0], [0.3, 0.1, 2.0]), phase)
+    state = state_at_phase(RotationState(BODY, [1.0, 0.0, 0.0, 0.0], [0.3, 0.1, 2.0] * u.rad / u.day), phase)
     return Scene(state, EPOCH, EPOCH + [0.0, 0.1, 0.2] * u.day,
                  perturbers=(FixedPerturber("earth", EARTH_GM, [40000.0, 0.0, 0.0] * u.km),))
 
@@ -315,7 +315,7 @@ MOVING_EARTH = EphemerisPerturber("earth", EARTH_GM, _earth_states, relative=Tru
 
 
 def moving_member(phase):
-    state = state_at_phase(RotationState(BODY, [1.0, 0.0, 0.0, 0.0], [0.3, 0.1, 2.0]), phase)
+    state = state_at_phase(RotationState(BODY, [1.0, 0.0, 0.0, 0.0], [0.3, 0.1, 2.0] * u.rad / u.day), phase)
     return Scene(state, EPOCH, END, perturbers=(MOVING_EARTH,))
 
 

@@ -93,7 +93,7 @@ def test_the_ensemble_of_scenes_gives_the_vectorised_bits_and_agrees_with_each_s
 
 def test_named_times_and_members_of_other_epochs():
     def member(phase, late):
-        state = state_at_phase(RotationState(RigidBody([0.61, 0.965, 1.0]), [1.0, 0.0, 0.0, 0.0], [0.3, 0.1, 2.0]), phase)
+        state = state_at_phase(RotationState(RigidBody([0.61, 0.965, 1.0]), [1.0, 0.0, 0.0, 0.0], [0.3, 0.1, 2.0] * u.rad / u.day), phase)
         epoch = EPOCH + (0.5 * u.day if late else 0.0 * u.day)
         return Scene(state, epoch, EPOCH + [1.0, 2.0] * u.day)
 
@@ -124,7 +124,7 @@ def test_bad_members_are_refused_with_the_reason():
 def _permuted_member(phase):
     """A body whose axes are not its principal axes in increasing order (C, A, B along x, y, z)."""
     body = RigidBody([1.0, 0.61, 0.965])
-    return Scene(state_at_phase(RotationState(body, [1.0, 0.0, 0.0, 0.0], [2.0, 0.3, 0.1]), phase), EPOCH,
+    return Scene(state_at_phase(RotationState(body, [1.0, 0.0, 0.0, 0.0], [2.0, 0.3, 0.1] * u.rad / u.day), phase), EPOCH,
                  EPOCH + 2.0 * u.day)
 
 

@@ -41,7 +41,7 @@ EARTH = EphemerisPerturber("earth", EARTH_GM, _earth_states, relative=True)
 
 
 def member(phase):
-    state = state_at_phase(RotationState(BODY, [1.0, 0.0, 0.0, 0.0], [0.3, 0.1, 2.0]), phase)
+    state = state_at_phase(RotationState(BODY, [1.0, 0.0, 0.0, 0.0], [0.3, 0.1, 2.0] * u.rad / u.day), phase)
     return Scene(state, EPOCH, END, perturbers=(EARTH,))
 
 

@@ -37,6 +37,7 @@ DOORS = (
     "spinorbit.shape",
     "spinorbit.binary",
     "spinorbit.scene",
+    "spinorbit.photometry",
     "spinorbit.fit",
     "spinorbit.ensemble",
 )

@@ -62,7 +62,7 @@ def test_no_perturbers_is_the_exact_free_motion():
     plan = scene.plan()
     assert plan.route == "torque-free" and plan.integrator == "exact"
     result = scene.run(plan)
-    q, _ = state.propagate_torque_free([1.0, 2.0, 10.0])
+    q, _ = state.propagate_torque_free([1.0, 2.0, 10.0] * u.day)
     assert np.max(attitude_angles(quaternion_array(result.table), q)) < 1e-14
     assert result.error_estimate.value == 0.0
 
@@ -93,11 +93,11 @@ def test_axisymmetric_body_takes_the_regular_precession_within_tolerance_of_the_
 def test_nearly_symmetric_or_principal_axis_states_keep_the_exact_elliptic_flow():
     # One ulp from symmetric, 1e-6 rad of wobble: no approximate form is claimed or run.
     body = RigidBody([1.0, np.nextafter(1.0, 2.0), 2.0])
-    state = RotationState.from_angular_momentum(body, [1.0, 0.0, 0.0, 0.0], [1e-6, 0.0, 1.0])
+    state = RotationState.from_angular_momentum(body, [1.0, 0.0, 0.0, 0.0], [1e-6, 0.0, 1.0] * u.rad / u.day)
     decision = _closed_form_decision(Scene(state, EPOCH, EPOCH + 1 * u.day).plan())
     assert decision.choice.startswith("elliptic free flow") and "no approximate form" in decision.choice
     assert "no tested bound" in decision.reason and "wobble" in decision.reason
-    permanent = RotationState(RigidBody([0.61, 0.965, 1.0]), [1.0, 0.0, 0.0, 0.0], [0.0, 2.0, 0.0])
+    permanent = RotationState(RigidBody([0.61, 0.965, 1.0]), [1.0, 0.0, 0.0, 0.0], [0.0, 2.0, 0.0] * u.rad / u.day)
     assert _closed_form_decision(Scene(permanent, EPOCH, EPOCH + 1 * u.day).plan()).choice.startswith("uniform")
 
 
@@ -188,7 +188,7 @@ def test_dropped_torque_bound_holds_against_full_runs(which, span, tighter):
         "SAM": sam_state(),
         "LAM": RotationState.from_euler313(RigidBody([3.0836, 3.235, 1.0]), 145.498 * u.deg, 65.865 * u.deg,
                                            241.524 * u.deg, [14.51, 33.529, -98.709] * u.deg / u.day),
-        "near separatrix": RotationState(RigidBody([1.0, 2.0, 3.0]), [1, 0, 0, 0], [1e-3, 1.0, 1e-3]),
+        "near separatrix": RotationState(RigidBody([1.0, 2.0, 3.0]), [1, 0, 0, 0], [1e-3, 1.0, 1e-3] * u.rad / u.day),
         "slow rotator": slow_rotator(),
         "close flyby": sam_state(),
         "flat disc": RotationState.from_euler313(RigidBody([0.5, 0.51, 1.0]), 10 * u.deg, 40 * u.deg, 70 * u.deg,
@@ -239,7 +239,7 @@ def test_inertial_torques_along_is_the_rotated_body_torque():
 
 
 def test_sensitivity_is_measured_large_near_the_separatrix():
-    near = RotationState(RigidBody([1.0, 2.0, 3.0]), [1, 0, 0, 0], [1e-3, 1.0, 1e-3])
+    near = RotationState(RigidBody([1.0, 2.0, 3.0]), [1, 0, 0, 0], [1e-3, 1.0, 1e-3] * u.rad / u.day)
     assert attitude_sensitivity(near, 50.0) > 10  # measured 88.8
     assert attitude_sensitivity(sam_state(), 50.0) < 1.5  # measured 1.0
 
@@ -329,7 +329,7 @@ def test_elements_asked_away_from_singular_sets_are_used_and_agree():
 
 
 def test_elements_asked_near_the_separatrix_fall_back_to_quaternions():
-    near = RotationState(RigidBody([1.0, 2.0, 3.0]), [1, 0, 0, 0], [1e-3, 1.0, 1e-3])
+    near = RotationState(RigidBody([1.0, 2.0, 3.0]), [1, 0, 0, 0], [1e-3, 1.0, 1e-3] * u.rad / u.day)
     scene = Scene(near, EPOCH, EPOCH + 5 * u.day, perturbers=("sun",), orbit=Orbit.circular(2.5 * u.au),
                   tolerance=1e-3 * u.arcsec, integrator="elements")
     plan = scene.plan()
@@ -344,7 +344,7 @@ def test_elements_asked_next_to_a_symmetric_permanent_rotation_fall_back_to_quat
     # The hand-over's sin P set (integrate_elements.MIN_SIN_P): a symmetric body spinning next to its
     # equal-moment plane, where the elements' error grows like ε/sin²P; asking for them there used to
     # end in ElementsSingularityError from the run instead of a plan that says why not.
-    state = RotationState(RigidBody(list(moments)), [1, 0, 0, 0], omega)
+    state = RotationState(RigidBody(list(moments)), [1, 0, 0, 0], omega * u.rad / u.day)
     scene = Scene(state, EPOCH, EPOCH + 2 * u.day, perturbers=("sun",), orbit=Orbit.circular(2.5 * u.au),
                   tolerance=1e-2 * u.arcsec, integrator="elements")
     plan = scene.plan()
@@ -510,7 +510,7 @@ def direct_coupled(scene, coupled, eps=1e-13, names=("Sun", "Planet"), sim=None,
     for day in scene.output_days:
         body.integrate(day)
         out.append(RotationState.from_matrix(scene.state.body, p.T @ quat_to_attitude(body.quaternion),
-                                             p.T @ body.omega).quaternion)
+                                             (p.T @ body.omega) * u.rad / u.day).quaternion)
     return np.array(out)
 
 

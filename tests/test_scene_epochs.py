@@ -42,7 +42,7 @@ def row_at(result, when):
 def test_backward_torque_free_is_the_exact_free_motion_at_negative_times():
     times = EPOCH - [10.0, 2.0, 1.0] * u.day
     result = Scene(state(), EPOCH, times).run()
-    quaternions, omegas = state().propagate_torque_free([-10.0, -2.0, -1.0])
+    quaternions, omegas = state().propagate_torque_free([-10.0, -2.0, -1.0] * u.day)
     assert np.max(attitude_angles(quaternion_array(result.table), quaternions)) < 1e-13
     assert np.allclose(omega_array(result.table), omegas.to_value(u.rad / u.day),
                        rtol=0, atol=1e-12)
@@ -58,7 +58,7 @@ def test_backward_leg_matches_a_direct_backward_integration():
     samples = sample_from_ephemeris(ORBIT.function, EPOCH - 7 * u.day, EPOCH, perturbers=("sun",), tolerance=1e-11)
     direct = propagate_one_way(state(), EPOCH, times[::-1], samples, rtol=1e-12)
     assert np.max(attitude_angles(quaternion_array(result.table), quaternion_array(direct)[::-1])) < 2e-9
-    free, _ = state().propagate_torque_free([-6.0])
+    free, _ = state().propagate_torque_free([-6.0] * u.day)
     assert attitude_angles(quaternion_array(result.table)[:1], free)[0] > 1e-3  # the torque matters here
 
 

@@ -100,7 +100,7 @@ def test_state_elements_round_trip_in_user_axes():
 
 def test_auto_reference_frame_keeps_away_from_i_zero():
     body = RigidBody([1.0, 2.0, 2.5])
-    state = RotationState.from_angular_momentum(body, [1.0, 0.0, 0.0, 0.0], [0.02, 0.03, 1.0])  # momentum 2° from z
+    state = RotationState.from_angular_momentum(body, [1.0, 0.0, 0.0, 0.0], [0.02, 0.03, 1.0] * u.rad / u.day)  # momentum 2° from z
     elements = state.canonical_elements()
     assert abs(elements.H) < 0.2 * elements.Z  # the reference frame was turned: I is near 90°
     back = RotationState.from_canonical_elements(body, elements)
@@ -109,9 +109,9 @@ def test_auto_reference_frame_keeps_away_from_i_zero():
 
 def test_energy_ratio_and_modes_at_principal_axes():
     body = RigidBody([1.0, 2.0, 2.5])
-    about_c = RotationState(body, [1, 0, 0, 0], [0.0, 0.0, 1.0])
-    about_a = RotationState(body, [1, 0, 0, 0], [-1.0, 0.0, 0.0])
-    about_b = RotationState(body, [1, 0, 0, 0], [0.0, 1.0, 0.0])
+    about_c = RotationState(body, [1, 0, 0, 0], [0.0, 0.0, 1.0] * u.rad / u.day)
+    about_a = RotationState(body, [1, 0, 0, 0], [-1.0, 0.0, 0.0] * u.rad / u.day)
+    about_b = RotationState(body, [1, 0, 0, 0], [0.0, 1.0, 0.0] * u.rad / u.day)
     # spin exactly about C or A is a permanent rotation (issue 15; its periods: tests/test_periods.py);
     # the sense is still the sign of the momentum on that axis
     assert about_c.energy_ratio == pytest.approx(1.0) and about_c.mode == "permanent rotation" and about_c.sense == "+C"
@@ -126,7 +126,7 @@ def test_torque_free_propagation_keeps_momentum_and_energy():
     quaternions, omega = state.propagate_torque_free(np.linspace(0, 400, 9) * u.day)
     moments = np.array([3.0836, 3.235, 1.0])
     momentum_body = omega.value * moments
-    inertial = np.array([RotationState(state.body, q, w).angular_momentum_direction for q, w in zip(quaternions, omega.value)])
+    inertial = np.array([RotationState(state.body, q, w * u.rad / u.day).angular_momentum_direction for q, w in zip(quaternions, omega.value)])
     assert np.abs(inertial - inertial[0]).max() < 1e-12
     energy = np.sum(momentum_body**2 / moments, axis=1)
     assert np.abs(energy / energy[0] - 1).max() < 1e-13
@@ -135,8 +135,8 @@ def test_torque_free_propagation_keeps_momentum_and_energy():
 
 def test_permanent_rotation_about_b_propagates_uniformly():
     body = RigidBody([1.0, 2.0, 2.5])
-    state = RotationState(body, [1, 0, 0, 0], [0.0, 2 * math.pi, 0.0])  # one turn a day about B
-    quaternions, _ = state.propagate_torque_free([0.25, 1.0])
+    state = RotationState(body, [1, 0, 0, 0], [0.0, 2 * math.pi, 0.0] * u.rad / u.day)  # one turn a day about B
+    quaternions, _ = state.propagate_torque_free([0.25, 1.0] * u.day)
     assert abs(abs(quaternions[1][0]) - 1.0) < 1e-14  # back where it started after a day
     assert abs(quaternions[0][0]) == pytest.approx(math.cos(math.pi / 4))
 
@@ -152,12 +152,12 @@ def test_permanent_rotation_about_b_propagates_uniformly():
 )
 def test_bad_states_are_named(quaternion, omega, message):
     with pytest.raises(InvalidStateError, match=message):
-        RotationState(RigidBody([1.0, 2.0, 2.5]), quaternion, omega)
+        RotationState(RigidBody([1.0, 2.0, 2.5]), quaternion, omega * u.rad / u.day)
 
 
 def test_rotation_matrix_must_be_a_rotation():
     with pytest.raises(InvalidStateError, match="not a rotation"):
-        RotationState.from_matrix(RigidBody([1.0, 2.0, 2.5]), np.diag([1.0, 1.0, -1.0]), [1.0, 0, 0])
+        RotationState.from_matrix(RigidBody([1.0, 2.0, 2.5]), np.diag([1.0, 1.0, -1.0]), [1.0, 0, 0] * u.rad / u.day)
     with pytest.raises(u.UnitTypeError, match="angle per time"):
         RotationState(RigidBody([1.0, 2.0, 2.5]), [1, 0, 0, 0], [1.0, 0, 0] * u.m / u.s)
 
@@ -167,9 +167,9 @@ def test_hairer_lubich_wanner_body_needs_physical_false_and_is_lam():
     with pytest.raises(InvalidBodyError, match="physical=False"):
         RigidBody([2.0, 1.0, 2 / 3])
     body = RigidBody([2.0, 1.0, 2 / 3], physical=False)
-    state = RotationState.from_angular_momentum(body, [1, 0, 0, 0], [math.cos(1.1), 0.0, math.sin(1.1)])
+    state = RotationState.from_angular_momentum(body, [1, 0, 0, 0], [math.cos(1.1), 0.0, math.sin(1.1)] * u.rad / u.day)
     assert state.mode == "LAM"
-    quaternions, omega = state.propagate_torque_free(np.linspace(0, 1e4, 5))
+    quaternions, omega = state.propagate_torque_free(np.linspace(0, 1e4, 5) * u.day)
     momentum = omega.value * np.array([2.0, 1.0, 2 / 3])
     assert np.abs(np.linalg.norm(momentum, axis=1) - 1.0).max() < 1e-14  # |M| is exact
 
@@ -177,7 +177,7 @@ def test_hairer_lubich_wanner_body_needs_physical_false_and_is_lam():
 def test_andoyer_variables_round_trip_and_meaning():
     body = RigidBody([2.5, 1.0, 2.0])
     q = np.array([0.2, 0.5, -0.4, 0.7])
-    state = RotationState(body, q / np.linalg.norm(q), [0.3, 1.2, -0.4])
+    state = RotationState(body, q / np.linalg.norm(q), [0.3, 1.2, -0.4] * u.rad / u.day)
     big_l, big_g, big_h, l, g, h = state.andoyer_variables(reference="inertial")
     momentum = body.to_principal @ state.angular_momentum.value
     assert big_g == pytest.approx(np.linalg.norm(momentum), rel=1e-15)

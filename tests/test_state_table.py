@@ -36,13 +36,13 @@ def _states():
         ("oblate A = B", RotationState.from_euler313(RigidBody([1.0, 1.0, 2.0]), 10 * u.deg, 40 * u.deg, 70 * u.deg,
                                                      [5, 3, 40] * u.deg / u.hour)),
         ("prolate B = C", RotationState.from_angular_momentum(RigidBody([2.0, 1.0, 2.0]), [0.6, 0.0, 0.8, 0.0],
-                                                              [0.3, 1.0, -0.2])),
+                                                              [0.3, 1.0, -0.2] * u.rad / u.day)),
         ("near separatrix", RotationState.from_angular_momentum(near, [1.0, 0.0, 0.0, 0.0],
-                                                                [1.0, 0.3, math.sqrt(5.0) * (1 + 1e-7)])),
+                                                                [1.0, 0.3, math.sqrt(5.0) * (1 + 1e-7)] * u.rad / u.day)),
         # (3, 4, 6) has a − b = b − c = 1/12 exactly: M_x = M_z is on the separatrix without rounding.
         ("separatrix", RotationState.from_angular_momentum(RigidBody([3.0, 4.0, 6.0]), [1.0, 0.0, 0.0, 0.0],
-                                                           [1.0, 0.5, 1.0])),
-        ("permanent rotation", RotationState(near, [0.8, 0.6, 0.0, 0.0], [0.0, 1.7, 0.0])),
+                                                           [1.0, 0.5, 1.0] * u.rad / u.day)),
+        ("permanent rotation", RotationState(near, [0.8, 0.6, 0.0, 0.0], [0.0, 1.7, 0.0] * u.rad / u.day)),
     ]
 
 
@@ -51,9 +51,9 @@ TIMES = np.linspace(0.0, 60.0, 97)
 
 
 def _rows(state):
-    quaternions, omegas = state.propagate_torque_free(TIMES)
+    quaternions, omegas = state.propagate_torque_free(TIMES * u.day)
     omegas = omegas.to_value(u.rad / u.day)
-    return quaternions, omegas, [RotationState(state.body, q, w) for q, w in zip(quaternions, omegas)]
+    return quaternions, omegas, [RotationState(state.body, q, w * u.rad / u.day) for q, w in zip(quaternions, omegas)]
 
 
 @pytest.mark.parametrize("name, state", STATES, ids=[n for n, _ in STATES])
@@ -113,7 +113,7 @@ def test_from_principal_is_rotation_state_from_matrix():
     rows = np.hstack([q / np.linalg.norm(q, axis=1, keepdims=True), rng.normal(size=(50, 3))])
     quaternions, omegas = from_principal(body, rows)
     p = body.to_principal
-    reference = [RotationState.from_matrix(body, p.T @ quat_to_attitude(np.ascontiguousarray(y[:4])), p.T @ y[4:])
+    reference = [RotationState.from_matrix(body, p.T @ quat_to_attitude(np.ascontiguousarray(y[:4])), (p.T @ y[4:]) * u.rad / u.day)
                  for y in rows]
     # Same representative (largest component positive); ≤ 1 ulp from the second normalisation.
     assert np.abs(quaternions - [s.quaternion for s in reference]).max() <= 2 * EPS
@@ -148,7 +148,7 @@ def test_one_way_table_rows_are_their_rotation_states_and_osculate():
     # A strong nearby mass (GM 1e-3 au³/day² at 0.01 au) changes the periods visibly within 2 d.
     table = propagate_one_way(state, epoch, times, NoSamples(start, start + 2.0),
                               extra_sources=[fixed_source(1e-3, [0.01, 0.004, 0.002])])
-    rows = [RotationState(state.body, q, w) for q, w in zip(quaternion_array(table), omega_array(table))]
+    rows = [RotationState(state.body, q, w * u.rad / u.day) for q, w in zip(quaternion_array(table), omega_array(table))]
     assert np.array_equal(quaternion_array(table[3]), quaternion_array(table)[3:4])  # a Row gives its (1, 4)
     assert np.array_equal(omega_array(table[3]), omega_array(table)[3:4])
     assert np.abs(quaternion_array(table) - [s.quaternion for s in rows]).max() <= EPS  # re-normalisation: ≤ 1 ulp

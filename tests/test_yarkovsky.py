@@ -181,7 +181,7 @@ def test_units_layer_paths_agree_and_convert():
     (dict(radius=-1 * u.m), ValueError, "radius: expected a positive"),
     (dict(albedo=1.0), ValueError, r"albedo: expected a value in \[0, 1\)"),
     (dict(emissivity=0.0), ValueError, r"emissivity: expected a value in \(0, 1\]"),
-    (dict(obliquity=30.0), QuantityInputError, "obliquity: expected a Quantity in angle"),
+    (dict(obliquity=30.0), QuantityInputError, r"obliquity expects an angle Quantity \(e.g. 30 \* u.deg\); got the bare float 30.0"),
     (dict(obliquity=200 * u.deg), ValueError, "obliquity: expected an angle from 0 to 180"),
     (dict(eccentricity=1.0), ValueError, "eccentricity: expected a value"),
     (dict(conductivity=0.01 * u.W / (u.m * u.K)), ValueError, "exactly one of thermal_inertia"),

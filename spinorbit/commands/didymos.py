@@ -6,7 +6,8 @@ import argparse
 import math
 
 from spinorbit.cli import CommandError
-from spinorbit.commands._common import Progress, check_outputs, number, write_plot_output, write_table_output
+from spinorbit.commands import _inputs as check
+from spinorbit.commands._common import Progress, check_outputs, write_plot_output, write_table_output
 
 NAME = "didymos"
 SUMMARY = "Didymos-Dimorphos full two-body problem (mutual potential to order 4) and a DART-like impact"
@@ -18,9 +19,11 @@ orbit, both attitudes and both spins, with DOP853. The set-up is the GUBAS examp
 Dimorphos a 103.16 x 79.35 x 66.13 m ellipsoid, synchronous, 1.20 km from a spherical Didymos
 spinning in 2.260 h, density 2.2031 g/cm^3.
 
-Prints the mutual orbit period, Dimorphos's free and forced libration (periods and amplitudes,
-from the periodogram of its libration angle), its rotation mode in Fukushima's canonical elements,
-and the energy and angular-momentum drift. With --impact the same run is repeated after an
+Prints the mutual orbit period, Dimorphos's free and forced libration (periods with the run's
+resolution P^2/T, and amplitudes, from the periodogram of its libration angle), its rotation mode in
+Fukushima's canonical elements, and the energy and angular-momentum drift. A run too short to
+resolve the two libration lines (about 26 orbits are needed) says so and prints no lines; a pair
+that the impact unbinds is reported as unbound, with no period. With --impact the same run is repeated after an
 impulsive change of Dimorphos's velocity, dv = beta m v / M_Dimorphos, against its orbital motion
 (DART: 579.4 kg at 6.1449 km/s, beta = 3.61 by default), and the excited libration or tumbling is
 reported."""
@@ -50,23 +53,23 @@ def _positive_count(text):
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of ``spinorbit didymos``."""
     model = parser.add_argument_group("model and run")
-    model.add_argument("--order", type=int, default=4, metavar="N",
+    model.add_argument("--order", default=4, metavar="N",
                        help="mutual-potential order 0..4 (default 4, the GUBAS case's; 2 = point mass + inertia tensors)")
     model.add_argument("--orbits", type=_positive_count, default=100, metavar="N",
                        help="span in mutual orbits of 11.92 h (default 100: enough to separate the libration lines)")
     model.add_argument("--per-orbit", type=_positive_count, default=40, metavar="N",
                        help="output times per orbit (default 40)")
-    model.add_argument("--rtol", type=number, default=1e-12, metavar="RTOL", help="DOP853 relative tolerance (default 1e-12)")
-    model.add_argument("--libration", type=number, default=0.0, metavar="DEG",
+    model.add_argument("--rtol", default=1e-12, metavar="RTOL", help="DOP853 relative tolerance (default 1e-12)")
+    model.add_argument("--libration", default=0.0, metavar="DEG",
                        help="Dimorphos turned this many degrees from the line to Didymos at the start (default 0)")
     impact = parser.add_argument_group("DART-like impact at t = 0")
     impact.add_argument("--impact", action="store_true", help="also run after an impulsive velocity change of Dimorphos")
-    impact.add_argument("--beta", type=number, default=3.61, metavar="BETA",
+    impact.add_argument("--beta", default=3.61, metavar="BETA",
                         help="momentum enhancement (default 3.61, Cheng et al. 2023)")
-    impact.add_argument("--impactor-mass", type=number, default=579.4, metavar="KG", help="impactor mass in kg (default 579.4)")
-    impact.add_argument("--impactor-speed", type=number, default=6.1449, metavar="KM_S",
+    impact.add_argument("--impactor-mass", default=579.4, metavar="KG", help="impactor mass in kg (default 579.4)")
+    impact.add_argument("--impactor-speed", default=6.1449, metavar="KM_S",
                         help="impactor speed in km/s (default 6.1449)")
-    impact.add_argument("--impact-elevation", type=number, default=0.0, metavar="DEG",
+    impact.add_argument("--impact-elevation", default=0.0, metavar="DEG",
                         help="angle of the impactor's velocity out of the orbit plane (default 0: in the plane, head-on)")
     files = parser.add_argument_group("output files")
     files.add_argument("--output", metavar="FILE.ecsv", help="write the run (time, relative orbit, libration, "
@@ -77,17 +80,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _report(label, run):
     import astropy.units as u
 
-    parts = run.libration_components()
     e_rel, e_potential = run.energy_drift()
     tumbling, energy_excess, p_psi, p_phi = run.tumbling_summary()
+    unbound = run.unbound_reason()
+    if unbound is not None:
+        # An escaping pair has no orbit period and no libration: say so instead of fitting lines to it.
+        orbit_lines = [f"  unbound                  {unbound}; no mutual period or libration"]
+    else:
+        orbit_lines = _orbit_lines(run)
     lines = [
         f"{label}",
-        f"  mutual orbit period      {run.mutual_period().to_value(u.h):.5f} h",
-        f"  free libration           period {parts.free_period.to_value(u.h):.4f} h, amplitude "
-        f"{parts.free_amplitude.to_value(u.deg):.4f} deg",
-        f"  forced libration         period {parts.forced_period.to_value(u.h):.4f} h, amplitude "
-        f"{parts.forced_amplitude.to_value(u.deg):.4f} deg (fit residual {parts.residual_rms.to_value(u.deg):.2g} deg rms)",
-        f"  max |libration|          {abs(run.libration()).max().to_value(u.deg):.4f} deg",
+        *orbit_lines,
         f"  Dimorphos rotation       non-principal-axis (SAM/LAM) at {100 * tumbling:.0f} % of the output times, "
         f"principal-axis at the rest, max E/E0 - 1 = {energy_excess:.3g}"
         + (f", P_psi = {p_psi.to_value(u.h):.3f} h, P_phi = {p_phi.to_value(u.h):.3f} h" if tumbling else ""),
@@ -96,6 +99,49 @@ def _report(label, run):
         f"  steps                    {run.stats['accepted']} accepted, {run.stats['rejected']} rejected",
     ]
     print("\n".join(lines))
+
+
+def _orbit_lines(run):
+    """The mutual period and the libration lines, each with its resolution, or why the run cannot give them."""
+    import astropy.units as u
+
+    from spinorbit.core.binary.errors import UnresolvedPeriodError
+
+    def short(error):
+        # A run too short for a period: say so and how long it must be, instead of printing the wrong line.
+        hint = ""
+        if error.required_span is not None:
+            hint = f" Here: --orbits {math.ceil(error.required_span / _nominal_period_s())} or more."
+        return f"  not resolved             {error}{hint}"
+
+    try:
+        period = run.mutual_period()
+    except UnresolvedPeriodError as error:
+        return [short(error)]
+    lines = [f"  mutual orbit period      {period.to_value(u.h):.5f} h"]
+    try:
+        parts = run.libration_components()
+    except UnresolvedPeriodError as error:
+        return [*lines, short(error), f"  max |libration|          {abs(run.libration()).max().to_value(u.deg):.4f} deg"]
+    return [
+        *lines,
+        f"  free libration           period {parts.free_period.to_value(u.h):.4f} ± {parts.free_resolution.to_value(u.h):.2g} h, "
+        f"amplitude {parts.free_amplitude.to_value(u.deg):.4f} deg",
+        f"  forced libration         period {parts.forced_period.to_value(u.h):.4f} ± {parts.forced_resolution.to_value(u.h):.2g} h, "
+        f"amplitude {parts.forced_amplitude.to_value(u.deg):.4f} deg (fit residual {parts.residual_rms.to_value(u.deg):.2g} "
+        "deg rms)",
+        "                           (± one resolution P²/T of the run's periodogram)",
+        f"  max |libration|          {abs(run.libration()).max().to_value(u.deg):.4f} deg",
+    ]
+
+
+def _nominal_period_s():
+    """The nominal mutual period of the set-up (s): the unit of --orbits."""
+    import astropy.units as u
+
+    from spinorbit.data.didymos import RELATIVE_SPEED, SEPARATION
+
+    return (2 * math.pi * SEPARATION / RELATIVE_SPEED).to_value(u.s)
 
 
 def _table(runs):
@@ -150,6 +196,20 @@ def _plot(runs, path):
     plt.close(figure)
 
 
+def check_options(args) -> None:
+    """Every number in range before any work (the validation layer, :mod:`spinorbit.commands._inputs`)."""
+    args.order = check.integer("--order", args.order, "4", low=0, high=4)
+    # DOP853 in double precision: the binary propagator's own range (spinorbit.core.binary.propagate)
+    args.rtol = check.number("--rtol", args.rtol, "1e-12", low=1e-15, high=1.0, high_open=True,
+                             advice="Double precision cannot do better than 1e-15.")
+    args.libration = check.number("--libration", args.libration, "10", low=-180.0, high=180.0)
+    args.beta = check.number("--beta", args.beta, "3.61", low=0.0,
+                             advice="beta is the momentum enhancement, ≥ 1 in practice.")
+    args.impactor_mass = check.number("--impactor-mass", args.impactor_mass, "579.4", low=0.0, low_open=True)
+    args.impactor_speed = check.number("--impactor-speed", args.impactor_speed, "6.1449", low=0.0, low_open=True)
+    args.impact_elevation = check.number("--impact-elevation", args.impact_elevation, "30", low=-90.0, high=90.0)
+
+
 def run(args) -> int:
     """Run ``spinorbit didymos``; return the exit status."""
     import astropy.units as u
@@ -160,6 +220,7 @@ def run(args) -> int:
     from spinorbit.data.didymos import RELATIVE_SPEED, SEPARATION, didymos_state
 
     check_outputs(args)
+    check_options(args)
     rows = args.orbits * args.per_orbit + 1
     if rows > MAX_ROWS:
         raise CommandError(f"--orbits {args.orbits} with --per-orbit {args.per_orbit} gives {rows} output rows, more than "

@@ -79,7 +79,7 @@ def scene_orbit_normals(scene, plan):
 def run_torque_free(scene, plan):
     """The exact free motion at the scene's output times: its table, error parts and (no) statistics."""
     offsets = scene.output_days - scene.epoch_day
-    quaternions, omegas = scene.state.propagate_torque_free(offsets, closed_forms=not plan.full)
+    quaternions, omegas = scene.state.propagate_torque_free(offsets * u.day, closed_forms=not plan.full)
     # Mode, E/E0 and the periods are constants of the torque-free motion: the initial state's, once.
     table = result_table(scene, quaternions, omegas.to_value(u.rad / u.day), motion=scene.state)
     return table, {"dropped": plan.dropped_bound_rad, "integration": 0.0, "sampling": 0.0}, {}

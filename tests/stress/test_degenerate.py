@@ -51,7 +51,7 @@ PROPERTIES = {
     "andoyer_variables": lambda s: s.andoyer_variables(),
     "canonical_elements": lambda s: [getattr(s.canonical_elements(), k) for k in "SZHszh"],
     "propagate_torque_free": lambda s: np.concatenate([a.ravel() if not hasattr(a, "value") else a.value.ravel()
-                                                       for a in s.propagate_torque_free([0.0, 1.0, 1e3])]),
+                                                       for a in s.propagate_torque_free([0.0, 1.0, 1e3] * u.day)]),
     "core_state": lambda s: s.core_state(),
     "angular_momentum": lambda s: s.angular_momentum.value,
 }
@@ -87,7 +87,7 @@ def test_every_property_of_any_magnitude_is_finite_or_refused(moments, moment_de
         return
     omega = np.array(axis) * 10.0 ** spin_decade
     try:
-        state = RotationState(body, [1.0, 0.0, 0.0, 0.0], omega)
+        state = RotationState(body, [1.0, 0.0, 0.0, 0.0], omega * u.rad / u.day)
     except InvalidStateError as error:  # I ω overflows: refused when the state is made
         assert "overflows" in str(error)
         return
@@ -98,7 +98,7 @@ def test_every_property_of_any_magnitude_is_finite_or_refused(moments, moment_de
 
 @pytest.mark.parametrize("name", sorted(PROPERTIES))
 def test_zero_spin_gets_the_same_refusal_from_every_property_that_describes_the_rotation(name):
-    state = RotationState(RigidBody(MOMENTS), [1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
+    state = RotationState(RigidBody(MOMENTS), [1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0] * u.rad / u.day)
     if name in ("core_state", "angular_momentum", "propagate_torque_free"):
         values = np.asarray(PROPERTIES[name](state), dtype=float)
         assert np.all(np.isfinite(values))  # a body at rest stays at rest: exact
@@ -122,14 +122,14 @@ ENTRY_POINTS = {
     "RigidBody moments": lambda b, i: RigidBody(with_bad(MOMENTS, i % 3, b)),
     "RigidBody mass": lambda b, i: RigidBody(MOMENTS, mass=b * u.kg),
     "RigidBody radius": lambda b, i: RigidBody(MOMENTS, radius=b * u.km),
-    "RotationState quaternion": lambda b, i: RotationState(RigidBody(MOMENTS), with_bad([1, 0, 0, 0], i % 4, b), [1, 0, 0]),
-    "RotationState spin": lambda b, i: RotationState(RigidBody(MOMENTS), [1, 0, 0, 0], with_bad([1, 0, 0], i % 3, b)),
-    "from_euler313": lambda b, i: RotationState.from_euler313(RigidBody(MOMENTS), *with_bad([0.1, 0.2, 0.3], i % 3, b),
-                                                              [1, 0, 0]),
+    "RotationState quaternion": lambda b, i: RotationState(RigidBody(MOMENTS), with_bad([1, 0, 0, 0], i % 4, b), [1, 0, 0] * u.rad / u.day),
+    "RotationState spin": lambda b, i: RotationState(RigidBody(MOMENTS), [1, 0, 0, 0], with_bad([1, 0, 0], i % 3, b) * u.rad / u.day),
+    "from_euler313": lambda b, i: RotationState.from_euler313(RigidBody(MOMENTS), *with_bad([0.1, 0.2, 0.3], i % 3, b) * u.rad,
+                                                              [1, 0, 0] * u.rad / u.day),
     "from_matrix": lambda b, i: RotationState.from_matrix(RigidBody(MOMENTS), with_bad(np.eye(3), (i % 3, i % 2), b),
-                                                          [1, 0, 0]),
-    "propagate_torque_free dt": lambda b, i: RotationState(RigidBody(MOMENTS), [1, 0, 0, 0], [1, 2, 3])
-    .propagate_torque_free(with_bad([0.0, 1.0, 2.0], i % 3, b)),
+                                                          [1, 0, 0] * u.rad / u.day),
+    "propagate_torque_free dt": lambda b, i: RotationState(RigidBody(MOMENTS), [1, 0, 0, 0], [1, 2, 3] * u.rad / u.day)
+    .propagate_torque_free(with_bad([0.0, 1.0, 2.0], i % 3, b) * u.day),
     "integrate_quaternion y0": lambda b, i: integrate_quaternion(with_bad(STATE, i % 7, b), 0.0, [1.0], model()),
     "integrate_quaternion t0": lambda b, i: integrate_quaternion(STATE, b, [1.0], model()),
     "integrate_quaternion t_out": lambda b, i: integrate_quaternion(STATE, 0.0, with_bad([1.0, 2.0], i % 2, b), model()),
@@ -190,8 +190,8 @@ def test_free_flow_is_exact_for_the_double_time_up_to_its_documented_phase(phase
     q_mp, _ = exact_states(Q0, MOMENTUM, FLOW_MOMENTS, t, dps=40 + int(math.log10(phase)))
     q, m = torque_free_states(Q0, MOMENTUM, *FLOW_MOMENTS, t)
     assert rotation_angle_between_many(np.ascontiguousarray(q_mp), q)[0] <= FLOW_TOLERANCE
-    state = RotationState(RigidBody(FLOW_MOMENTS), Q0, MOMENTUM / np.array(FLOW_MOMENTS))
-    quaternions, omega = state.propagate_torque_free(t)
+    state = RotationState(RigidBody(FLOW_MOMENTS), Q0, (MOMENTUM / np.array(FLOW_MOMENTS)) * u.rad / u.day)
+    quaternions, omega = state.propagate_torque_free(t * u.day)
     assert np.all(np.isfinite(quaternions)) and np.all(np.isfinite(omega.value))
 
 
@@ -199,7 +199,7 @@ def test_free_flow_is_exact_for_the_double_time_up_to_its_documented_phase(phase
 @given(st.floats(1.001, 1e200), st.integers(-6, 6))
 def test_free_flow_beyond_its_phase_is_refused(factor, spin_decade):
     omega = np.array([0.1, 0.2, 0.3]) * 10.0 ** spin_decade
-    state = RotationState(RigidBody(MOMENTS), [1.0, 0.0, 0.0, 0.0], omega)
+    state = RotationState(RigidBody(MOMENTS), [1.0, 0.0, 0.0, 0.0], omega * u.rad / u.day)
     rate = np.linalg.norm(np.array(MOMENTS) * omega) / MOMENTS[0]
     with pytest.raises(InvalidStateError, match="beyond the free flow's domain"):
-        state.propagate_torque_free([0.0, -factor * MAX_FLOW_PHASE / rate])
+        state.propagate_torque_free([0.0, -factor * MAX_FLOW_PHASE / rate] * u.day)

@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 import pytest
+from astropy import units as u
 from hypothesis import assume, given
 from hypothesis import strategies as st
 
@@ -51,7 +52,7 @@ def test_rigid_body_from_anything_is_valid_or_refused(values):
 @given(physical_moments(), st.lists(wild, min_size=4, max_size=4), st.lists(wild, min_size=3, max_size=3))
 def test_rotation_state_from_anything_is_valid_or_refused(moments, q, omega):
     try:
-        state = RotationState(RigidBody(moments), q, omega)
+        state = RotationState(RigidBody(moments), q, omega * u.rad / u.day)
     except InvalidStateError:
         return
     assert abs(np.linalg.norm(state.quaternion) - 1.0) < 1e-15 * 4
@@ -61,7 +62,7 @@ def test_rotation_state_from_anything_is_valid_or_refused(moments, q, omega):
 @given(physical_moments(), st.lists(st.lists(wild, min_size=3, max_size=3), min_size=3, max_size=3))
 def test_from_matrix_accepts_only_rotations(moments, rows):
     try:
-        state = RotationState.from_matrix(RigidBody(moments), rows, [0.1, 0.2, 0.3])
+        state = RotationState.from_matrix(RigidBody(moments), rows, [0.1, 0.2, 0.3] * u.rad / u.day)
     except InvalidStateError:
         return
     r = state.attitude_matrix
@@ -71,7 +72,7 @@ def test_from_matrix_accepts_only_rotations(moments, rows):
 
 @given(physical_moments(), moderate, moderate, moderate, st.tuples(moderate, moderate, moderate))
 def test_euler313_round_trip(moments, phi, theta, psi, omega):
-    state = RotationState.from_euler313(RigidBody(moments), phi, theta, psi, list(omega))
+    state = RotationState.from_euler313(RigidBody(moments), phi * u.rad, theta * u.rad, psi * u.rad, list(omega) * u.rad / u.day)
     assert np.abs(state.attitude_matrix - euler313_to_attitude(phi, theta, psi)).max() < 1e-14
 
 
@@ -95,7 +96,7 @@ def test_from_andoyer_keeps_the_momentum_invariants(moments, big_l, big_g, big_h
 def test_canonical_elements_round_trip_or_singular(moments, q, omega):
     assume(np.linalg.norm(q) > 0.1 and np.linalg.norm(omega) > 1e-3)
     body = RigidBody(moments)
-    state = RotationState(body, np.array(q) / np.linalg.norm(q), list(omega))
+    state = RotationState(body, np.array(q) / np.linalg.norm(q), list(omega) * u.rad / u.day)
     try:
         elements = state.canonical_elements()
     except SingularElementsError:  # permanent rotations (also within rounding of one), separatrix arcs
@@ -131,17 +132,17 @@ UNRESOLVED = [
 
 @pytest.mark.parametrize("moments, q, omega", UNRESOLVED)
 def test_elements_within_rounding_of_a_symmetric_permanent_rotation_are_singular(moments, q, omega):
-    state = RotationState(RigidBody(moments), np.array(q) / np.linalg.norm(q), omega)
+    state = RotationState(RigidBody(moments), np.array(q) / np.linalg.norm(q), omega * u.rad / u.day)
     with pytest.raises(SingularElementsError, match="cannot resolve the gap"):
         state.canonical_elements()
     # the free motion itself is fine there (regular precession in closed form)
-    qs, w = state.propagate_torque_free([0.0, 10.0, 1e6])
+    qs, w = state.propagate_torque_free([0.0, 10.0, 1e6] * u.day)
     assert np.all(np.isfinite(qs)) and np.all(np.isfinite(w.value))
 
 
 def test_backward_map_refuses_elements_at_a_symmetric_permanent_rotation():
     body = RigidBody((1.0, 1.0, 0.5))  # principal (0.5, 1, 1): B = C, d = c ⇔ S = √(c/a) Z
-    elements = RotationState(body, [0.0, 0.0, 0.0, 1.0], [1.0, 0.0, 1e-3]).canonical_elements()
+    elements = RotationState(body, [0.0, 0.0, 0.0, 1.0], [1.0, 0.0, 1e-3] * u.rad / u.day).canonical_elements()
     at_rotation = dataclasses.replace(elements, S=math.sqrt(0.5) * elements.Z)
     with pytest.raises(SingularElementsError, match="these elements"):
         RotationState.from_canonical_elements(body, at_rotation)
@@ -187,7 +188,7 @@ def assert_round_trip_is_a_state(body, state):
 @pytest.mark.parametrize("moments, q, omega", RESOLVED_NEAR_SYMMETRIC)
 def test_round_trip_next_to_a_symmetric_permanent_rotation_is_a_rotation(moments, q, omega):
     body = RigidBody(moments)
-    state = RotationState(body, np.array(q) / np.linalg.norm(q), omega)
+    state = RotationState(body, np.array(q) / np.linalg.norm(q), omega * u.rad / u.day)
     elements = state.canonical_elements()  # resolved: these must not be refused
     ic = inertia_constants(*body.principal_moments)
     assert symmetric_gap_resolved(abs(elements.S), elements.Z, ic)
@@ -232,7 +233,7 @@ def near_symmetric_plane(draw):
 def test_elements_next_to_a_symmetric_permanent_rotation_are_refused_or_a_rotation(case):
     moments, q, omega = case
     body = RigidBody(moments)
-    state = RotationState(body, q, omega)
+    state = RotationState(body, q, omega * u.rad / u.day)
     try:
         state.canonical_elements()
     except SingularElementsError:

@@ -80,7 +80,7 @@ def test_spin_units_are_read_alike_by_the_api_and_the_cli(unit_text, value):
 @given(st.sampled_from(sorted(DAYS) + FREQUENCIES + WRONG), st.floats(0.01, 100.0))
 def test_time_units_are_read_alike_by_the_api_and_the_cli(unit_text, value):
     unit = u.Unit(unit_text) if unit_text else u.dimensionless_unscaled
-    state = RotationState(BODY, IDENTITY, [0.1, 0.2, 0.3])
+    state = RotationState(BODY, IDENTITY, [0.1, 0.2, 0.3] * u.rad / u.day)
     try:
         quaternions, _ = state.propagate_torque_free([0.0, value] * unit)
         api = None
@@ -96,7 +96,7 @@ def test_time_units_are_read_alike_by_the_api_and_the_cli(unit_text, value):
             assert status == 0
             return
         assert api is None and status == 0, (api, err)
-        plain, _ = state.propagate_torque_free([0.0, days])
+        plain, _ = state.propagate_torque_free([0.0, days] * u.day)
         assert np.abs(quaternions - plain).max() < 1e-12
         return
     assert api is not None and status == 2, (unit_text, api, err)
@@ -111,8 +111,10 @@ QUANTITY_ARGUMENTS = [
     ("angular_velocity", "angular velocity", lambda q: RotationState(BODY, IDENTITY, [1.0, 0.0, 0.0] * q)),
     ("angular_momentum", "angular velocity", lambda q: RotationState.from_angular_momentum(BODY, IDENTITY,
                                                                                            [1.0, 0.0, 0.0] * q)),
-    ("theta", "angle", lambda q: RotationState.from_euler313(BODY, 0.1, 1.0 * q, 0.2, [1.0, 0, 0])),
-    ("dt", "time", lambda q: RotationState(BODY, IDENTITY, [1.0, 0.0, 0.0]).propagate_torque_free([1.0] * q)),
+    ("theta", "angle", lambda q: RotationState.from_euler313(BODY, 0.1 * u.rad, 1.0 * q, 0.2 * u.rad,
+                                                             [1.0, 0, 0] * u.rad / u.day)),
+    ("dt", "time", lambda q: RotationState(BODY, IDENTITY, [1.0, 0.0, 0.0] * u.rad / u.day)
+     .propagate_torque_free([1.0] * q)),
 ]
 PHYSICAL = {"moment of inertia": "kg m2", "mass": "kg", "length": "km", "angular velocity": "rad/s",
             "angle": "deg", "time": "h"}

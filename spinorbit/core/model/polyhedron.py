@@ -98,7 +98,7 @@ def check_closed_mesh(vertices, faces):
     _check_edges(faces)
     volume = mass_properties(vertices, faces)[0]
     if not volume > 0:
-        raise InvalidMeshError(f"the mesh's signed volume is {volume!r} ≤ 0: its faces are ordered clockwise seen "
+        raise InvalidMeshError(f"the mesh's signed volume is {float(volume)!r} ≤ 0: its faces are ordered clockwise seen "
                                "from outside (inverted normals). Reverse the order of every face's vertices.")
     return vertices, faces
 
@@ -119,7 +119,7 @@ def _check_edges(faces):
     _, uses = np.unique(undirected, axis=0, return_counts=True)
     if np.any(uses != 2):
         bad = int(np.sum(uses != 2))
-        raise InvalidMeshError(f"{bad} edges of the {count}-face mesh belong to {sorted(set(uses[uses != 2]))} faces "
+        raise InvalidMeshError(f"{bad} edges of the {count}-face mesh belong to {sorted(set(uses[uses != 2].tolist()))} faces "
                                "instead of exactly two: the surface is open (holes) or not a manifold. Close the "
                                "holes before computing mass properties.")
 

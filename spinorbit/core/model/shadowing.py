@@ -39,7 +39,9 @@ __all__ = [
     "CONVEXITY_TOLERANCE",
     "LEAF_SIZE",
     "MAX_SHADOW_SAMPLES",
+    "STACK_DEPTH",
     "ShadowGeometry",
+    "ray_blocked",
     "shadow_candidates",
     "shadow_geometry",
     "shadowed_recoil_sums",
@@ -55,7 +57,7 @@ MAX_SHADOW_SAMPLES = 16
 #: and the facets of a convex mesh are not taken for occluders, far below any real relief.
 CONVEXITY_TOLERANCE = 1e-10
 #: Depth of the traversal stack: a median-split tree of m triangles is ⌈log₂(m / LEAF_SIZE)⌉ + 1 deep.
-_STACK_DEPTH = 64
+STACK_DEPTH = 64
 
 
 class ShadowGeometry(NamedTuple):
@@ -242,7 +244,12 @@ def _hits_box(ox, oy, oz, ix, iy, iz, t_max, box_low, box_high, node):
 
 
 @jit
-def _occluded(ox, oy, oz, dx, dy, dz, t_max, source, vertices, faces, box_low, box_high, children, leaf, order, stack):
+def ray_blocked(ox, oy, oz, dx, dy, dz, t_max, source, vertices, faces, box_low, box_high, children, leaf, order, stack):
+    """Does the ray o + t d, 0 < t ≤ t_max, cross a triangle other than ``source``? (the hierarchy's descent)
+
+    ``d`` is a unit vector; ``stack`` is scratch of :data:`STACK_DEPTH` int64. Used for the Sun's rays
+    here and for the Sun's and the observer's in :mod:`spinorbit.core.photometry.visibility`.
+    """
     ix, iy, iz = 1.0 / dx, 1.0 / dy, 1.0 / dz
     top = 0
     stack[0] = 0
@@ -266,7 +273,7 @@ def _occluded(ox, oy, oz, dx, dy, dz, t_max, source, vertices, faces, box_low, b
 @jit
 def _shadowed_sums(vertices, faces, normals, areas, candidates, heights, points, box_low, box_high, children, leaf, order,
                    directions, out):
-    stack = np.empty(_STACK_DEPTH, dtype=np.int64)
+    stack = np.empty(STACK_DEPTH, dtype=np.int64)
     weight = 1.0 / points.shape[0]
     for d in range(directions.shape[0]):
         sx, sy, sz = directions[d, 0], directions[d, 1], directions[d, 2]
@@ -288,7 +295,7 @@ def _shadowed_sums(vertices, faces, normals, areas, candidates, heights, points,
                 px = vertices[a, 0] + u * (vertices[b, 0] - vertices[a, 0]) + v * (vertices[c, 0] - vertices[a, 0])
                 py = vertices[a, 1] + u * (vertices[b, 1] - vertices[a, 1]) + v * (vertices[c, 1] - vertices[a, 1])
                 pz = vertices[a, 2] + u * (vertices[b, 2] - vertices[a, 2]) + v * (vertices[c, 2] - vertices[a, 2])
-                if candidates[k] and _occluded(px, py, pz, sx, sy, sz, t_max, k, vertices, faces, box_low, box_high,
+                if candidates[k] and ray_blocked(px, py, pz, sx, sy, sz, t_max, k, vertices, faces, box_low, box_high,
                                                children, leaf, order, stack):
                     continue
                 lit += 1.0

@@ -104,7 +104,8 @@ def _start_ensemble(tmp_path):
 def _wait_for_a_chunk(process, directory):
     deadline = time.monotonic() + FIRST_CHUNK_SECONDS
     while time.monotonic() < deadline and process.poll() is None:
-        if directory.is_dir() and any(p.suffix == ".ckpt" for p in directory.iterdir()):
+        # a finished chunk's file (its temporary file while being written is ".chunk-…tmp.ckpt")
+        if directory.is_dir() and any(p.name.startswith("chunk-") for p in directory.iterdir()):
             return
         time.sleep(0.1)
     process.kill()

@@ -41,8 +41,9 @@ def add_scene_arguments(parser: argparse.ArgumentParser, span_default: str, pert
     files = parser.add_argument_group("output files")
     files.add_argument("--output", metavar="FILE.ecsv", help="write the result table (time, attitude, spin, pole, "
                        "obliquity, periods; docs/conventions.md 'Output tables') as ECSV (FILE.ecsv) or CSV (FILE.csv)")
-    files.add_argument("--plot", metavar="FILE.png", help="plot periods, pole, obliquity and mode against the date, "
-                       "encounters marked (needs matplotlib; .png, .pdf or .svg)")
+    files.add_argument("--plot", metavar="FILE.png", help="plot against the date, encounters marked: a tumbler's "
+                       "periods, pole, obliquity and class; a principal-axis rotator's pole drift (arcsec), obliquity "
+                       "change, period residual and wobble (needs matplotlib; .png, .pdf or .svg)")
 
 
 def _where(args, option: str) -> str:

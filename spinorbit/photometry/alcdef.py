@@ -23,7 +23,7 @@ lightcurve archive, alcdef.org) is plain text, one ``KEYWORD=value`` per line. E
 The JD is the mid-exposure Julian date in UTC. ``LTCAPP`` says whether the JDs were corrected
 for light time (NONE: not), ``REDUCEDMAGS`` whether the magnitudes were reduced to unit distances
 (NONE, AVERAGE with the correction ``UCORMAG``, or POINT), and ``DELIMITER`` separates the fields (PIPE
-or TAB). :func:`read_alcdef` returns the observation table of :mod:`.observations` with each block's
+or TAB). :func:`read_alcdef` returns the observation table of :mod:`spinorbit.photometry.observations` with each block's
 keywords in ``meta["sessions"]``; the row's ``observer`` is the block's ``MPCCODE`` (the geometry
 uses the geocentre). It reads files whose JDs are not corrected for light time and whose magnitudes
 are not reduced, or reduced by one UCORMAG per block (which it undoes); other files are refused

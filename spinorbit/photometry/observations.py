@@ -1,6 +1,6 @@
 """Photometric observations: one table with each observation's epoch, magnitude, uncertainty, filter and observer.
 
-The files (:mod:`.alcdef`, :mod:`.damit`) read into it, an astropy ``TimeSeries`` of one's own turns
+The files (:mod:`spinorbit.photometry.alcdef`, :mod:`spinorbit.photometry.damit`) read into it, an astropy ``TimeSeries`` of one's own turns
 into it (:func:`photometric_observations`), and the fit to brightness reads it. Columns:
 
 - ``time``: the observation's epoch (mid-exposure; UTC for ALCDEF), an astropy Time;

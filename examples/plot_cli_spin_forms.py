@@ -1,6 +1,6 @@
 """
 Spin states typed as they are published: a pole and a period, a tumbler's periods and angles
-===========================================================================================
+============================================================================================
 
 Light-curve inversions publish a principal-axis rotator as DAMIT does — ecliptic pole (λ, β),
 sidereal period P, epoch and rotation angle φ0 — and a tumbler as Pravec et al. (2005) do — the

@@ -319,9 +319,9 @@ def mean_torque_section():
               f"{worst['exact']:.1e} of the component itself at the default {MEAN_SPIN_PHASES} phases, within the "
               "reference's own convergence; the harmonics' worst is "
               + ", ".join(f"{worst[d]:.1e} at L = {d}" for d in (8, 16, 24, 40))
-              + ". The obliquity and precession components are small remainders of large facet terms (the spin "
-              "component is often a hundred times larger), so truncating the clipped cosine's expansion moves them "
-              "most."]
+              + ". The spin (z) and obliquity (y) components, YORP proper, are small remainders of large facet terms, "
+              "often tens of times smaller than the precession component (x), so truncating the clipped cosine's "
+              "expansion moves them most; the truncation error does not fall steadily with L."]
     return lines
 
 

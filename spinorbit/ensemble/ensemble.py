@@ -1,7 +1,11 @@
 """An ensemble of Scenes: one member per parameter row, run in fixed chunks on any executor, one outcome table.
 
 A member is a :class:`~spinorbit.scene.Scene` built by ``make_scene(**parameters)`` from one row of
-the parameter table (``docs/ensembles.md``). The members are cut into chunks of consecutive indices
+the parameter table (``docs/ensembles.md``), or a member that runs itself: any object with an
+``outcome_row(at_days)`` method returning its outcome as a dict of plain numbers, strings and booleans
+(:func:`runs_itself`; e.g. a binary asteroid's run, :mod:`spinorbit.ensemble.dart`). Such members
+take the chunks, executors, checkpoints, failures and reruns of Scenes; their outcome columns are
+their rows' keys, with the units the ensemble is given (``outcome_units``). The members are cut into chunks of consecutive indices
 whose size depends on the ensemble alone (its member count, or ``chunk_size``), never on the
 executor or the number of workers; a chunk runs in one process, its members sharing the perturber
 samples of one orbit (:meth:`Scene.sharing_samples`), so the table is the same bits whichever
@@ -45,7 +49,7 @@ from spinorbit.ensemble.process_memo import clear_process_samplings, leader_plan
 from spinorbit.ensemble.samplers import SEED_COLUMNS, sample_parameters
 from spinorbit.ensemble.store import ChunkStore
 
-__all__ = ["ROUTES", "Ensemble", "run_chunk", "torque_free"]
+__all__ = ["ROUTES", "Ensemble", "run_chunk", "runs_itself", "torque_free"]
 
 #: Most members in a default chunk; the default is ceil(n / 32) up to this (chunks few enough to
 #: spread over many workers, large enough that a chunk's shared sampling pays).
@@ -93,15 +97,37 @@ def _fingerprint_text(value):
     return f"{type(value).__name__}{value!r}"
 
 
+def runs_itself(member):
+    """Whether ``member`` runs itself: not a Scene, but an object with ``outcome_row(at_days) -> dict``."""
+    from spinorbit.scene import Scene
+
+    return not isinstance(member, Scene) and callable(getattr(member, "outcome_row", None))
+
+
 def build_member(make_scene, parameters):
-    """The single-body Scene of one member (EnsembleError when make_scene returns something else)."""
+    """The member of one row: a single-body Scene or a member that runs itself (:func:`runs_itself`);
+    EnsembleError when make_scene returns something else."""
     from spinorbit.scene import Scene
 
     scene = make_scene(**parameters)
+    if runs_itself(scene):
+        return scene
     if not isinstance(scene, Scene) or scene.members is not None:
-        raise EnsembleError(f"make_scene expects to return a single-body spinorbit.scene.Scene; it returned "
+        raise EnsembleError(f"make_scene expects to return a single-body spinorbit.scene.Scene or a member with an "
+                            f"outcome_row(at_days) method; it returned "
                             f"{type(scene).__name__}{' of several bodies' if isinstance(scene, Scene) else ''}.")
     return scene
+
+
+def own_row(member, at_days):
+    """The outcome row of a member that runs itself, checked: a dict of plain numbers, strings, booleans."""
+    row = member.outcome_row(at_days)
+    if not isinstance(row, dict) or not all(isinstance(k, str) and isinstance(v, (bool, int, float, str, np.bool_,
+                                                                                   np.floating, np.integer))
+                                            for k, v in row.items()):
+        raise EnsembleError(f"{type(member).__name__}.outcome_row expects to return a dict of plain numbers, strings "
+                            f"and booleans (units are the ensemble's outcome_units); got {row!r:.200}.")
+    return {k: (v.item() if isinstance(v, np.generic) else v) for k, v in row.items()}
 
 
 def failure_record(index, parameters, error):
@@ -111,7 +137,9 @@ def failure_record(index, parameters, error):
 
 
 def torque_free(scene):
-    """The member needs no integration: no perturbers and no orbit."""
+    """The member needs no integration: a Scene with no perturbers and no orbit."""
+    if runs_itself(scene):
+        return False
     return not scene.named and not scene.fixed and not scene.moving and scene.orbit is None
 
 
@@ -149,7 +177,8 @@ def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None,
     bits in any process or batch). With ``route="auto"`` (and no tables kept) the members that can
     share a plan run as groups by the batch route (:func:`spinorbit.ensemble.batch.run_group`, its
     batch integrators ``integrators``, default :data:`~spinorbit.ensemble.batch.BATCH_INTEGRATORS`);
-    every row records its route in ``ensemble_route`` ("batch", "scene" or "torque-free"). A group
+    every row records its route in ``ensemble_route`` ("batch", "scene", "torque-free", or "self-run" for a
+    member that runs itself). A group
     takes the plan of ``leader`` (the ensemble's (index, parameters) whose plan leads, planned once
     per process) when the leader would be in it, else its first member's; the members the leader's
     plan does not fit (its drops) are led by the first of them.
@@ -178,7 +207,7 @@ def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None,
     if route == "auto" and not keep_tables:
         groups, single = {}, []
         for member in built:
-            key = group_key(member[1], at_days)
+            key = None if runs_itself(member[1]) else group_key(member[1], at_days)
             (single.append(member) if key is None else
              groups.setdefault((sharing_key(member[1]), key), []).append(member))
         led = None
@@ -207,6 +236,9 @@ def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None,
         single.sort(key=lambda member: member[0])
     for index, scene, parameters in single:
         try:
+            if runs_itself(scene):
+                rows[index] = {**own_row(scene, at_days), "ensemble_route": "self-run"}
+                continue
             with scene.sharing_samples(samples_of(scene)):
                 result = scene.run()
             rows[index] = {**outcome_row(scene, result, at_days), "ensemble_route": "scene"}
@@ -224,7 +256,8 @@ class Ensemble:
     Parameters
     ----------
     make_scene : callable
-        ``make_scene(**parameters) -> Scene`` (one body). A module-level function, so that worker
+        ``make_scene(**parameters) -> Scene`` (one body), or a member that runs itself (an object with
+        ``outcome_row(at_days) -> dict``, module docstring). A module-level function, so that worker
         processes can import it; an expensive orbit it needs should be cached in its module
         (e.g. ``functools.cache``), so each process builds it once and members share its samples.
         Each member is built once, where its chunk runs. On an executor, this process builds the
@@ -253,6 +286,9 @@ class Ensemble:
         :func:`~spinorbit.core.integrators.batch_quaternion.integrate_quaternion_batch`'s signature
         (module-level, so that workers can import it); default
         :data:`~spinorbit.ensemble.batch.BATCH_INTEGRATORS`.
+    outcome_units : dict, optional
+        ``{column: astropy unit}`` of the numeric outcome columns of members that run themselves (their
+        rows hold plain numbers in these units); columns not named are plain numbers.
 
     Attributes
     ----------
@@ -265,7 +301,8 @@ class Ensemble:
         ``wall_seconds`` and ``executor`` of the last :meth:`run` or :meth:`rerun`.
     """
 
-    def __init__(self, make_scene, parameters, chunk_size=None, at=None, route="auto", batch_integrators=None):
+    def __init__(self, make_scene, parameters, chunk_size=None, at=None, route="auto", batch_integrators=None,
+                 outcome_units=None):
         if not callable(make_scene):
             raise EnsembleError(f"make_scene expects a callable returning a Scene; got {make_scene!r}.")
         if route not in ROUTES:
@@ -276,6 +313,11 @@ class Ensemble:
             raise EnsembleError(f"batch_integrators expects a dict {{plan integrator name: batch function}} (e.g. "
                                 f"{{'quaternion': integrate_quaternion_batch}}); got {batch_integrators!r}.")
         self.route, self.batch_integrators = route, batch_integrators
+        if outcome_units is not None and not (isinstance(outcome_units, dict) and all(
+                isinstance(k, str) and isinstance(v, u.UnitBase) for k, v in outcome_units.items())):
+            raise EnsembleError(f"outcome_units expects a dict {{column name: astropy unit}} (e.g. {{'period_change': "
+                                f"u.min}}); got {outcome_units!r}.")
+        self.outcome_units = dict(outcome_units or {})
         self.make_scene = make_scene
         self.parameters = _parameter_table(parameters)
         n = len(self.parameters)
@@ -292,11 +334,11 @@ class Ensemble:
 
     @classmethod
     def sampled(cls, make_scene, n, seed=None, chunk_size=None, at=None, route="auto", batch_integrators=None,
-                **distributions):
+                outcome_units=None, **distributions):
         """An ensemble of ``n`` members whose parameters are drawn, each from its own seed
         (:func:`~spinorbit.ensemble.samplers.sample_parameters`; the seeds are columns of the result)."""
         return cls(make_scene, sample_parameters(n, seed, **distributions), chunk_size=chunk_size, at=at, route=route,
-                   batch_integrators=batch_integrators)
+                   batch_integrators=batch_integrators, outcome_units=outcome_units)
 
     # ------------------------------------------------------------------------------------------
     @property
@@ -548,11 +590,17 @@ class Ensemble:
         names = list(TIMED_COLUMNS) if self.at_days is None else [f"{n}_t{k}" for k in timed for n in TIMED_COLUMNS]
         names += [*INITIAL_COLUMNS, *RUN_COLUMNS]
         present = {name for row in self._rows.values() for name in row}
-        return [name for name in names if name in present]
+        # then the columns of members that run themselves, in the order the first row holding each gives
+        own = []
+        for index in sorted(self._rows):
+            own += [name for name in self._rows[index] if name not in names and name not in own
+                    and name != "ensemble_route"]
+        return [name for name in names if name in present] + own
 
     def member_routes(self):
         """{route: members} of the members with a row: "batch" (planned as a group and integrated together,
-        :mod:`spinorbit.ensemble.batch`), "scene" (their own Scene run) or "torque-free" (vectorised)."""
+        :mod:`spinorbit.ensemble.batch`), "scene" (their own Scene run), "torque-free" (vectorised) or
+        "self-run" (a member that runs itself)."""
         counts = {}
         for row in self._rows.values():
             route = row.get("ensemble_route", "scene")
@@ -581,6 +629,8 @@ class Ensemble:
                 data = np.array([v if p else 0.0 for v, p in zip(values, present)], dtype=float)
                 if base in OUTCOME_UNITS:
                     data = data * OUTCOME_UNITS[base]
+                elif name in self.outcome_units:
+                    data = data * self.outcome_units[name]
                 table[name] = data if present.all() else Masked(data, mask=~present)
         errors = [f"{self._failures[i]['type']}: {self._failures[i]['message']}" if i in self._failures else ""
                   for i in range(n)]

@@ -12,7 +12,7 @@ from spinorbit.binary import propagate
 from spinorbit.data import dart
 from spinorbit.ensemble import Ensemble
 from spinorbit.ensemble.dart import DART_OUTCOME_UNITS, DartMember, dart_member, dart_parameters
-from spinorbit.ensemble.ensemble import runs_itself
+from spinorbit.ensemble.self_run import runs_itself
 
 
 class Doubling:

@@ -9,6 +9,7 @@ on any executor (``docs/ensembles.md``).
 - :mod:`~spinorbit.ensemble.outcomes` — a member's outcome row from its SceneResult;
 - :mod:`~spinorbit.ensemble.free` — torque-free members in one vectorised call of the exact free flow;
 - :mod:`~spinorbit.ensemble.apophis` — the Apophis 2029 encounter over phase and moment-ratio uncertainty;
+- :mod:`~spinorbit.ensemble.self_run` — members that run themselves (not Scenes);
 - :mod:`~spinorbit.ensemble.dart` — DART's period change over the published uncertainties (members that
   run themselves: full-two-body runs, not Scenes).
 """

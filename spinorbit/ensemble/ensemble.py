@@ -1,12 +1,9 @@
 """An ensemble of Scenes: one member per parameter row, run in fixed chunks on any executor, one outcome table.
 
 A member is a :class:`~spinorbit.scene.Scene` built by ``make_scene(**parameters)`` from one row of
-the parameter table (``docs/ensembles.md``), or a member that runs itself: any object with an
-``outcome_row(at_days)`` method returning its outcome as a dict of plain numbers, strings and booleans
-(:func:`runs_itself`; e.g. a binary asteroid's run, :mod:`spinorbit.ensemble.dart`). Such members
-take the chunks, executors, checkpoints, failures and reruns of Scenes; their outcome columns are
-their rows' keys, with the units the ensemble is given (``outcome_units``). The members are cut into chunks of consecutive indices
-whose size depends on the ensemble alone (its member count, or ``chunk_size``), never on the
+the parameter table (``docs/ensembles.md``), or a member that runs itself
+(:mod:`~spinorbit.ensemble.self_run`): same chunks, executors, checkpoints and reruns. The members are
+cut into chunks of consecutive indices whose size depends on the ensemble alone (its member count, or ``chunk_size``), never on the
 executor or the number of workers; a chunk runs in one process, its members sharing the perturber
 samples of one orbit (:meth:`Scene.sharing_samples`), so the table is the same bits whichever
 executor ran it. A worker builds its members' Scenes itself: only ``make_scene`` (picklable: a
@@ -47,9 +44,10 @@ from spinorbit.ensemble.outcomes import (
 from spinorbit.ensemble.free import torque_free_rows
 from spinorbit.ensemble.process_memo import clear_process_samplings, leader_plan, process_memo, sharing_key
 from spinorbit.ensemble.samplers import SEED_COLUMNS, sample_parameters
+from spinorbit.ensemble.self_run import own_row, runs_itself
 from spinorbit.ensemble.store import ChunkStore
 
-__all__ = ["ROUTES", "Ensemble", "run_chunk", "runs_itself", "torque_free"]
+__all__ = ["ROUTES", "Ensemble", "run_chunk", "torque_free"]
 
 #: Most members in a default chunk; the default is ceil(n / 32) up to this (chunks few enough to
 #: spread over many workers, large enough that a chunk's shared sampling pays).
@@ -97,13 +95,6 @@ def _fingerprint_text(value):
     return f"{type(value).__name__}{value!r}"
 
 
-def runs_itself(member):
-    """Whether ``member`` runs itself: not a Scene, but an object with ``outcome_row(at_days) -> dict``."""
-    from spinorbit.scene import Scene
-
-    return not isinstance(member, Scene) and callable(getattr(member, "outcome_row", None))
-
-
 def build_member(make_scene, parameters):
     """The member of one row: a single-body Scene or a member that runs itself (:func:`runs_itself`);
     EnsembleError when make_scene returns something else."""
@@ -117,17 +108,6 @@ def build_member(make_scene, parameters):
                             f"outcome_row(at_days) method; it returned "
                             f"{type(scene).__name__}{' of several bodies' if isinstance(scene, Scene) else ''}.")
     return scene
-
-
-def own_row(member, at_days):
-    """The outcome row of a member that runs itself, checked: a dict of plain numbers, strings, booleans."""
-    row = member.outcome_row(at_days)
-    if not isinstance(row, dict) or not all(isinstance(k, str) and isinstance(v, (bool, int, float, str, np.bool_,
-                                                                                   np.floating, np.integer))
-                                            for k, v in row.items()):
-        raise EnsembleError(f"{type(member).__name__}.outcome_row expects to return a dict of plain numbers, strings "
-                            f"and booleans (units are the ensemble's outcome_units); got {row!r:.200}.")
-    return {k: (v.item() if isinstance(v, np.generic) else v) for k, v in row.items()}
 
 
 def failure_record(index, parameters, error):

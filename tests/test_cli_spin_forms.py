@@ -215,3 +215,34 @@ def test_the_example_scene_s_pole_alternative_reads(tmp_path):
     form, values = spin_values(Options(), scene["spin"])
     state = spin_state(RigidBody(scene["body"]["moments"]), form, values, scene["spin"]["epoch"], "ecliptic")
     assert form == "pole" and state.sidereal_period.to_value(u.h) == pytest.approx(8.0, rel=1e-14)
+
+
+def test_the_spin_form_commands_in_the_docs_run(capsys):
+    """docs/cli.md, "Spin forms": each spinorbit command of its example block runs as printed."""
+    import re
+    import shlex
+    from pathlib import Path
+
+    page = (Path(__file__).resolve().parent.parent / "docs" / "cli.md").read_text()
+    section = page.split("### Spin forms", 1)[1].split("\n### ", 1)[0]
+    block = re.search(r"```bash\n(.*?)```", section, re.S)[1].replace("\\\n", " ")
+    commands = [shlex.split(line)[1:] for line in block.splitlines() if line.startswith("spinorbit ")]
+    assert len(commands) == 2
+    for argv in commands:
+        assert cli.main(argv) == 0, capsys.readouterr().err
+    out = capsys.readouterr().out
+    assert "P = 0.3333 d (sidereal, principal-axis rotator)" in out and "P_psi = 10.9583 d" in out
+
+
+def test_help_names_the_unit_of_every_quantity_option():
+    """Every option that takes a number with a unit says in --help what a number alone means."""
+    parser = cli.build_parser()
+    commands = parser._subparsers._group_actions[0].choices
+    unnamed = []
+    for name, sub in commands.items():
+        for action in sub._actions:
+            words = action.nargs == "+" and action.dest != "perturbers"
+            if words and not ("a number alone is" in action.help or "default deg" in action.help
+                              or "default h" in action.help or "unit" in action.help):
+                unnamed.append(f"{name} {action.option_strings[0]}")
+    assert unnamed == []

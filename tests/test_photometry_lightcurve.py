@@ -179,3 +179,16 @@ def test_body_frame_turns_by_the_attitude_matrix():
     vectors /= np.linalg.norm(vectors, axis=1)[:, None]
     expected = np.array([quat_to_attitude(q) @ v for q, v in zip(quaternions, vectors)])
     assert np.allclose(body_frame(vectors, quaternions), expected, rtol=0, atol=1e-15)
+
+
+def test_a_lightcurve_written_as_damit_keeps_its_geometry(tmp_path):
+    from spinorbit.photometry import read_damit, write_damit
+
+    table = lightcurve(spinning_state(), Ellipsoid([0.5, 0.35, 0.25] * u.km), circular_orbit(), times=TIMES[:6])
+    again = read_damit(write_damit(table, tmp_path / "lc.txt"))
+    assert np.max(np.abs((again["time"] - table["body_time"]).to_value(u.s))) < 1e-3  # JD to 8 decimals
+    assert np.allclose(again["sun_vector"].value, table["sun_vector"].value, atol=2e-12)  # 12 decimals, rotated
+    assert np.allclose(again["observer_vector"].value, table["observer_vector"].value, atol=2e-12)
+    assert np.allclose(again["brightness"], 10 ** (-0.4 * table["magnitude"].value), rtol=1e-10)
+    # The vectors are the geometry's: their lengths are r and Δ.
+    assert np.allclose(np.linalg.norm(again["sun_vector"].value, axis=1), table["r"].value, rtol=1e-11)

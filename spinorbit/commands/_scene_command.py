@@ -28,13 +28,14 @@ def add_scene_arguments(parser: argparse.ArgumentParser, span_default: str, pert
     run.add_argument("--end-only", action="store_true",
                      help="only the final state (the planner then asks for no dense output)")
     run.add_argument("--tolerance", nargs="+", default=["1", "arcsec"], metavar="ANGLE",
-                     help="attitude tolerance of the whole run, e.g. '1 arcsec' (default), '1e-6 rad'")
+                     help="attitude tolerance of the whole run, e.g. '1 arcsec' (default), '1e-6 rad' (a number alone is arcsec)")
     run.add_argument("--perturbers", nargs="+", default=list(perturbers_default), metavar="BODY",
                      help=f"bodies whose torque may act (default: {' '.join(perturbers_default)}); the planner "
                      "drops those that cannot matter and says why")
     run.add_argument("--pa-threshold", nargs="+", default=["1", "deg"], metavar="ANGLE",
                      help="wobble amplitude up to which a state is a principal-axis rotator (PA: one sidereal period; "
-                     "above it SAM/LAM with P_psi, P_phi), e.g. '0.1 deg'; default 1 deg (docs/design.md 'PA or NPA')")
+                     "above it SAM/LAM with P_psi, P_phi), e.g. '0.1 deg' (a number alone is deg); default 1 deg (docs/design.md "
+                     "'PA or NPA')")
     run.add_argument("--plan", action="store_true", help="print the plan (decisions and reasons) and stop")
     run.add_argument("--no-skip", action="store_true",
                      help="run the reference plan: every perturber, the orbits as given, nothing skipped")

@@ -89,10 +89,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     body.add_argument(
         "--pa-threshold", nargs="+", default=["1", "deg"], metavar="ANGLE",
         help="wobble amplitude up to which the state is a principal-axis rotator (PA: one sidereal period; above "
-        "it SAM/LAM with P_psi, P_phi), e.g. '0.1 deg'; default 1 deg (docs/design.md 'PA or NPA')",
+        "it SAM/LAM with P_psi, P_phi), e.g. '0.1 deg' (a number alone is deg); default 1 deg (docs/design.md "
+        "'PA or NPA')",
     )
     spacing = times.add_mutually_exclusive_group()
-    spacing.add_argument("--step", nargs="+", metavar="STEP", help="spacing of output times, e.g. '1 d' (default 1 d)")
+    spacing.add_argument("--step", nargs="+", metavar="STEP", help="spacing of output times, e.g. '1 d' (a number alone is days; default 1 d)")
     spacing.add_argument("--n-times", type=_count, metavar="N", help="number of evenly spaced output times instead")
     files = parser.add_argument_group("output files")
     files.add_argument("--output", metavar="FILE.ecsv", help="write the table (time, attitude, spin, pole, periods; "

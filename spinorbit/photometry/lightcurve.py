@@ -16,7 +16,8 @@ The table is an astropy ``TimeSeries``: ``time`` (the observation times), ``body
 (L, km²), ``phase_angle``, ``aspect_angle`` (between the angular momentum and the direction to the
 observer; for a principal-axis rotator the spin axis), ``solar_aspect_angle`` (the same to the Sun),
 ``observer_lon``, ``observer_lat``, ``sun_lon``, ``sun_lat`` (the directions in the body frame: the
-sub-observer and subsolar points, deg), ``r`` and ``delta`` (au). ``meta`` names the law, the phase
+sub-observer and subsolar points, deg), ``r`` and ``delta`` (au), ``sun_vector`` and ``observer_vector``
+(from the body to the Sun at the body's time and to the observer, ICRF, au: what DAMIT's files hold). ``meta`` names the law, the phase
 function, the observer and the shadowing decision with its reason.
 """
 
@@ -172,6 +173,8 @@ def lightcurve(source, shape, orbit, times=None, observer="earth", phase_functio
         table[f"{name}_lon"], table[f"{name}_lat"] = lon * u.deg, lat * u.deg
     table["r"] = r_au * u.au
     table["delta"] = delta_au * u.au
+    table["sun_vector"] = geometry.sun_icrf * r_au[:, None] * u.au
+    table["observer_vector"] = geometry.observer_icrf * delta_au[:, None] * u.au
     table.meta.update(law=law, lambert_weight=lambert_weight if law == "kaasalainen" else None,
                       phase_function=repr(phase_function), observer=observer if isinstance(observer, str) else
                       "positions given", shadowing=reason, shadowing_traced=traced,

@@ -22,7 +22,7 @@ type and message), its row masked, and :meth:`Ensemble.rerun` runs it again alon
 from __future__ import annotations
 
 import concurrent.futures
-import hashlib
+import contextlib
 import math
 import time as _time
 
@@ -42,6 +42,7 @@ from spinorbit.ensemble.outcomes import (
     outcome_row,
 )
 from spinorbit.ensemble.free import torque_free_rows
+from spinorbit.ensemble.identity import ensemble_fingerprint, ensemble_identity, value_text
 from spinorbit.ensemble.process_memo import clear_process_samplings, leader_plan, process_memo, sharing_key
 from spinorbit.ensemble.samplers import SEED_COLUMNS, sample_parameters
 from spinorbit.ensemble.self_run import own_row, runs_itself
@@ -85,14 +86,6 @@ def _parameter_table(parameters):
     if len(table) == 0:
         raise EnsembleError("parameters has no rows: an ensemble needs at least one member.")
     return table
-
-
-def _fingerprint_text(value):
-    if isinstance(value, u.Quantity):
-        return f"Q{np.asarray(value.value, dtype=float).tobytes().hex()}{value.unit}"
-    if isinstance(value, float):
-        return value.hex()
-    return f"{type(value).__name__}{value!r}"
 
 
 def build_member(make_scene, parameters):
@@ -192,7 +185,7 @@ def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None,
              groups.setdefault((sharing_key(member[1]), key), []).append(member))
         led = None
         if leader is not None and groups:
-            text = "|".join(f"{name}={_fingerprint_text(value)}" for name, value in leader[1].items())
+            text = "|".join(f"{name}={value_text(value)}" for name, value in leader[1].items())
             led = leader_plan(make_scene, leader, at_days, samples_of, integrators, build_member, text)
         for keys, group in groups.items():
             # the ensemble leader's plan where it fits the group (and could be made), else the first member's
@@ -356,21 +349,22 @@ class Ensemble:
 
     @property
     def fingerprint(self):
-        """SHA-256 of what fixes the results: make_scene's name, every parameter's bits, chunk size, times."""
-        digest = hashlib.sha256()
-        digest.update(f"{getattr(self.make_scene, '__module__', '')}.{getattr(self.make_scene, '__qualname__', '')}"
-                      f"|{self.chunk_size}|{self.n_members}|".encode())
-        if self.route != "auto" or self.batch_integrators is not None:  # the route decides the bits too
-            names = sorted((k, f"{getattr(f, '__module__', '')}.{getattr(f, '__qualname__', '')}")
-                           for k, f in (self.batch_integrators or {}).items())
-            digest.update(f"route={self.route}|{names}|".encode())
-        if self.at_days is not None:
-            digest.update(self.at_days.tobytes())
+        """SHA-256 of what fixes the results: make_scene's name, every parameter's bits, chunk size, times
+        (:func:`~spinorbit.ensemble.identity.ensemble_fingerprint`)."""
+        return ensemble_fingerprint(self, self._plain_columns())
+
+    @property
+    def identity(self):
+        """The fingerprint's content field by field (:func:`~spinorbit.ensemble.identity.ensemble_identity`),
+        kept in a checkpoint directory so that a refusal can say which field differs."""
+        return ensemble_identity(self, self._plain_columns())
+
+    def _chunk_store(self, checkpoint):
+        """The checkpoint directory taken for this ensemble (locked, its manifest checked), or no store."""
+        if checkpoint is None:
+            return contextlib.nullcontext(None)
         columns = self._plain_columns()
-        for index in range(self.n_members):
-            digest.update("|".join(f"{name}={_fingerprint_text(values[index])}"
-                                   for name, values in columns.items()).encode())
-        return digest.hexdigest()
+        return ChunkStore(checkpoint, ensemble_fingerprint(self, columns), ensemble_identity(self, columns))
 
     @property
     def failures(self):
@@ -451,9 +445,18 @@ class Ensemble:
         EnsembleInterrupted
             Chunks were lost to the executor (a killed worker, a broken pool); those completed are in
             the checkpoint and in memory: run again (with the same checkpoint) to run only the rest.
+        spinorbit.runs.checkpoint.CheckpointError
+            ``checkpoint`` holds another ensemble (the message names the fields that differ), is in
+            use by another running ensemble, or a file in it is corrupted.
+        KeyboardInterrupt
+            Ctrl-C (or the CLI's SIGTERM): the chunks not started are cancelled, the workers of an
+            executor made here stopped; ``last_run["members_complete"]`` members are kept.
         """
+        with self._chunk_store(checkpoint) as store:
+            return self._run(store, executor, checkpoint, progress, keep_tables)
+
+    def _run(self, store, executor, checkpoint, progress, keep_tables):
         clock = _time.perf_counter()
-        store = None if checkpoint is None else ChunkStore(checkpoint, self.fingerprint)
         restored = 0 if store is None else self._restore(store)
         pending = [c for c in range(self.n_chunks) if c not in self._complete]
         done = self.n_members - sum(len(self.chunk_members(c)) for c in pending)
@@ -552,7 +555,10 @@ class Ensemble:
         Their chunks must be complete (run or restored from ``checkpoint``); with ``checkpoint`` the
         chunk files are rewritten with the new rows.
         """
-        store = None if checkpoint is None else ChunkStore(checkpoint, self.fingerprint)
+        with self._chunk_store(checkpoint) as store:
+            return self._rerun(store, indices, executor)
+
+    def _rerun(self, store, indices, executor):
         if store is not None:
             self._restore(store)
         indices = sorted({int(i) for i in indices})

@@ -7,22 +7,24 @@ a 6-hour spin on an orbit of a = 1 au, e = 0.1. Sunlight's recoil (Rubincam's ze
 model, docs/thermal.md) changes the size Z of its angular momentum, its obliquity ε (cos ε = H/Z
 with the orbit normal as reference z) and its tumbling state (S/Z). A :class:`~spinorbit.scene.Scene`
 with ``thermal=`` plans the run: over 10⁶ years it takes the mean YORP route (the recoil averaged
-over the torus of the exact free motion and over the orbit) and says why, with its error estimate.
+over the torus of the exact free motion, and over the orbit in closed form from the facets themselves)
+and says why, with its error estimate.
 Nutation damping (Burns & Safronov's time scale) pulls the tumbler back toward rotation about its
 axis of largest moment; μQ = 10⁹ Pa and K₃² = 0.01 are illustrative values for a weak rubble pile.
-Each 10⁶-year run costs a few CPU seconds (docs/thermal.md, "Cost at matched accuracy"; the wall
-time printed below also carries the load of the machine it ran on); the full integration would take
-hours (the plan says how many).
+Each 10⁶-year run costs some tens of CPU seconds, its check at half the step included (docs/thermal.md,
+"Cost at matched accuracy"; the wall time printed below also carries the load of the machine it ran
+on); the full integration would take hours (the plan says how many).
 
 The attitude and spin of the :class:`~spinorbit.RotationState` are in the Scene's inertial frame
 (ICRS, equatorial), while :meth:`~spinorbit.scene.Orbit.kepler` takes ecliptic elements, so this
 orbit's plane is the ecliptic, tilted by 23.44° from the frame's equator: the spin starts at an
 obliquity of 21.0°. Before this example ran through the Scene, the same quaternion was given in the
 orbit frame itself (obliquity 31.0°), which is why its history then was different (Z/Z₀ 1.076 and
-ε → 74.5° after 10⁶ yr, against 1.291 and 66.8° now). The inputs differ on purpose, not the theory:
+ε → 74.5° after 10⁶ yr, against 1.278 and 66.7° now). The inputs differ on purpose, not the theory:
 the Scene's mean route is the core's ``propagate_mean_thermal`` on the Scene's starting elements
 (tests/test_scene_thermal.py), and the old orbit-frame model started at the Scene's elements gives
-the Scene's numbers.
+the Scene's numbers. Until the mean route averaged the facets exactly it averaged the degree-8
+harmonics, whose truncation gave 1.291 and 66.8° here (docs/thermal.md measures that truncation).
 """
 
 # %%

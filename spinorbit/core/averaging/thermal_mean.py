@@ -14,9 +14,13 @@ carry μ = 0, so only the thermal block's torque is left), averaged
   of s and z over 2π, as in :func:`spinorbit.core.averaging.mean_equations.torus_mean_rhs`. The
   momenta's rates are generalised forces, periodic on the torus, so the grid average converges
   geometrically;
-- and over the Sun's Keplerian orbit: n_orbit equally spaced times over one orbital period (the
-  representation of :mod:`spinorbit.core.model.thermal` has finite degree, so the integrand is smooth
-  in time and the trapezoidal rule converges geometrically too).
+- and over the Sun's Keplerian orbit. By default (:func:`exact_mean_thermal_rates`, ``average="exact"``)
+  this average is exact: the facet sum's orbit mean at a frozen attitude has a closed form
+  (:mod:`spinorbit.core.averaging.recoil_orbit_mean`), so no orbit grid and no representation enter.
+  The representation's average (:func:`mean_thermal_rates`, ``average="representation"``, the only one
+  for a shadowed fit) takes n_orbit equally spaced times over one orbital period of the degree-L
+  harmonics, smooth in time, but their truncation moves the mean torque by up to tens of per cent of
+  itself at degree 8 (docs/thermal.md).
 
 The grid point (s, z) fixes the attitude for all orbit times and (S, Z) the free motion for all grid
 points, and the rates are linear in the body torque at a fixed attitude

@@ -45,8 +45,10 @@ from spinorbit.core.model.thermal import (FACET_ARM_X, FACET_ARM_Y, FACET_ARM_Z,
 __all__ = ["orbit_mean_facet_sum_xyz", "orbit_mean_scale", "orbit_normal", "spin_mean_torque",
            "MEAN_SPIN_PHASES", "check_exact_average"]
 
-#: Rotation phases of :func:`spin_mean_torque` by default: on Gaussian random spheres σ = 0.1–0.3
-#: 64 phases leave at most ~2e-4 of each component, 128 ~4e-5 (docs/thermal.md, the convergence table).
+#: Rotation phases of :func:`spin_mean_torque` by default: on Gaussian random spheres σ = 0.1–0.3 and a
+#: bilobed body, against the brute-force reference (itself converged to 2e-4), 64 phases were within
+#: 1.2e-3 of each component and 128 within 4.1e-4, the worst being components ~1e-3 of the largest
+#: (docs/thermal.md, "The mean YORP torque against the brute-force reference").
 MEAN_SPIN_PHASES = 128
 
 

@@ -46,7 +46,7 @@ RECORDS = {
     "EncounterGeometry", "PublishedState", "OsculatingElements", "HeliocentricDirections",
     # Figure(...) is the record its constructors fill (ellipsoid, sphere, from_shape, from_inertia: walked);
     # its own fields carry their unit in their names (circumscribing_radius_m, semi_axes_m).
-    "Figure",
+    "Figure", "ViewingGeometry",
 }
 #: Methods that hand the core's plain arrays (rad/day, principal axes) between the fitter and an observation.
 CORE_HOOKS = {"residuals", "principal_quaternion"}
@@ -62,8 +62,10 @@ NOT_DIMENSIONAL_ANYWHERE = {
     "extra_forces", "non_gravitational", "element_set", "kind", "fit_moments", "observations", "first_guess",
     "multi_start", "centre", "relative", "shared", "what", "block", "rng", "distributions", "parameters", "ax",
     "batch_integrators", "chunk", "indices", "index", "sun", "initial", "stats", "times_of", "radius_function",
+    "torque", "data", "table", "metadata", "magnitude", "magnitude_error", "filter", "filters", "observer", "session",
+    "require_uncertainties", "calibrated", "phase_function", "digits",
     # times as astropy Time (their scale is checked where they are read)
-    "epoch", "time", "times", "start", "end", "at", "span",
+    "epoch", "time", "times", "start", "end", "at", "span", "body_times",
     # integers and counts
     "order", "subdivisions", "degree", "degree_max", "seed", "n", "q", "samples", "shadow_samples", "max_steps",
     "max_nfev", "chunk_size", "spawn_key", "entropy", "supported_order",
@@ -75,6 +77,7 @@ NOT_DIMENSIONAL_ANYWHERE = {
     "moments", "moment_ratios", "i1_i3", "i2_i3", "e", "eccentricity", "beta", "efficiency", "k3_squared", "albedo",
     "emissivity", "rtol", "sample_tolerance", "correlation_threshold", "condition_threshold", "fraction_of_p_psi",
     "fraction_about_momentum", "phase_psi", "phase_momentum", "lambert_weight", "nu", "low", "high", "mean",
+    "sphere_ratio",
 }
 #: Parameters dimensionless only in one callable (elsewhere the same name may be a Quantity).
 NOT_DIMENSIONAL_IN = {
@@ -84,13 +87,16 @@ NOT_DIMENSIONAL_IN = {
     "Scene.grid_of": {"tolerance"},
     "closest_approach": {"near"},  # an astropy Time
     "aligning_quaternion": {"v_body", "v_inertial"},  # directions
-    "ThermalModel": {"density", "mu_q"},  # the record from_shape fills (walked)
+    "ThermalModel": {"density", "mu_q", "torque", "mirror_planes"},  # the record from_shape fills (walked)
+    # a magnitude: astropy's mag is dimensionless (a logarithm of a flux ratio), and photometry writes it bare
+    "HG1G2": {"H", "G1", "G2"},
+    "LinearExponential": {"H", "amplitude"},
     "apophis_rotation_state": {"phase"},  # a fraction of P_psi in [0, 1)
     "Normal": {"sigma"},  # a sampler of numbers or Quantities, for the user's own make_scene
     "free_members_table": {"parameters"},
 }
 #: A unit in the parameter's own name: the number is in that unit, not guessed.
-UNIT_SUFFIX = re.compile(r"(^|_)(days?|au|km|m|s|kg|si|deg|rad|arcsec)$")
+UNIT_SUFFIX = re.compile(r"(^|_)(days?|au|km|km2|m|s|kg|si|deg|rad|arcsec)$")
 
 EPOCH = Time("2020-01-01T00:00:00", scale="tdb")
 
@@ -122,7 +128,7 @@ def _calls():
     from spinorbit.data.didymos import didymos_state
     from spinorbit.ensemble import free_members_table
     from spinorbit.fit import AttitudeObservation, AxisObservation, PeriodObservation, SpinRateObservation
-    from spinorbit.photometry import Ellipsoid
+    from spinorbit.photometry import Ellipsoid, LinearExponential
     from spinorbit.scene import EphemerisPerturber, FixedPerturber, Orbit, Scene, ThermalModel
     from spinorbit.shape import (box_shape, ellipsoid_shape, gaussian_random_sphere, icq_grid, rigid_body_from_shape,
                                  shape_mass_properties, voxel_shape)
@@ -196,6 +202,8 @@ def _calls():
                                   {"density": 2000.0, "mass": {"mass": 5e12, "density": None}}),
         "rigid_body_from_shape": (call(rigid_body_from_shape, shape=shape, density=2000 * u.kg / u.m**3),
                                   {"density": 2000.0, "mass": {"mass": 5e12, "density": None}}),
+        "LinearExponential": (call(LinearExponential, H=15 * u.mag, width=0.1 * u.rad, slope=-0.5 / u.rad),
+                              {"width": 0.1, "slope": -0.5}),
         "Ellipsoid": (call(Ellipsoid, semi_axes=[1.0, 0.8, 0.6] * u.km), {"semi_axes": [1.0, 0.8, 0.6]}),
         # scenes
         "Scene": (call(Scene, state=_state(), times=EPOCH + [1.0, 2.0] * u.day),
@@ -258,7 +266,7 @@ def _calls():
         "didymos_state": (call(didymos_state, libration=0.01 * u.rad), {"libration": 0.01}),
         "dart_system": (call(dart_system), {"separation": 1.206, "period": 11.92, "didymos_radii": [394.0, 290.0],
                                             "dimorphos_extents": [177.0, 174.0, 116.0], "density": 2.4}),
-        "dart_state": (call(dart_state, system=dart), {"separation": 1.206}),
+        "dart_state": (call(dart_state, system=dart), {"separation": 1.206, "libration": 0.01}),
         "along_track": (call(along_track, state=dart_state(dart), delta_v=-2.63 * u.mm / u.s), {"delta_v": -2.63}),
         # effects
         "yarkovsky_drift": (

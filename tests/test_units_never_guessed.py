@@ -63,7 +63,7 @@ NOT_DIMENSIONAL_ANYWHERE = {
     "multi_start", "centre", "relative", "shared", "what", "block", "rng", "distributions", "parameters", "ax",
     "batch_integrators", "chunk", "indices", "index", "sun", "initial", "stats", "times_of", "radius_function",
     "torque", "data", "table", "metadata", "magnitude", "magnitude_error", "filter", "filters", "observer", "session",
-    "require_uncertainties", "calibrated", "phase_function", "digits",
+    "require_uncertainties", "calibrated", "phase_function", "digits", "outcome_units",
     # times as astropy Time (their scale is checked where they are read)
     "epoch", "time", "times", "start", "end", "at", "span", "body_times",
     # integers and counts

@@ -1,8 +1,9 @@
 """An ensemble of Scenes: one member per parameter row, run in fixed chunks on any executor, one outcome table.
 
 A member is a :class:`~spinorbit.scene.Scene` built by ``make_scene(**parameters)`` from one row of
-the parameter table (``docs/ensembles.md``). The members are cut into chunks of consecutive indices
-whose size depends on the ensemble alone (its member count, or ``chunk_size``), never on the
+the parameter table (``docs/ensembles.md``), or a member that runs itself
+(:mod:`~spinorbit.ensemble.self_run`): same chunks, executors, checkpoints and reruns. The members are
+cut into chunks of consecutive indices whose size depends on the ensemble alone (its member count, or ``chunk_size``), never on the
 executor or the number of workers; a chunk runs in one process, its members sharing the perturber
 samples of one orbit (:meth:`Scene.sharing_samples`), so the table is the same bits whichever
 executor ran it. A worker builds its members' Scenes itself: only ``make_scene`` (picklable: a
@@ -44,6 +45,7 @@ from spinorbit.ensemble.free import torque_free_rows
 from spinorbit.ensemble.identity import ensemble_fingerprint, ensemble_identity, value_text
 from spinorbit.ensemble.process_memo import clear_process_samplings, leader_plan, process_memo, sharing_key
 from spinorbit.ensemble.samplers import SEED_COLUMNS, sample_parameters
+from spinorbit.ensemble.self_run import checked_units, own_columns, own_row, runs_itself
 from spinorbit.ensemble.store import ChunkStore
 
 __all__ = ["ROUTES", "Ensemble", "run_chunk", "torque_free"]
@@ -87,12 +89,16 @@ def _parameter_table(parameters):
 
 
 def build_member(make_scene, parameters):
-    """The single-body Scene of one member (EnsembleError when make_scene returns something else)."""
+    """The member of one row: a single-body Scene or a member that runs itself (:func:`runs_itself`);
+    EnsembleError when make_scene returns something else."""
     from spinorbit.scene import Scene
 
     scene = make_scene(**parameters)
+    if runs_itself(scene):
+        return scene
     if not isinstance(scene, Scene) or scene.members is not None:
-        raise EnsembleError(f"make_scene expects to return a single-body spinorbit.scene.Scene; it returned "
+        raise EnsembleError(f"make_scene expects to return a single-body spinorbit.scene.Scene or a member with an "
+                            f"outcome_row(at_days) method; it returned "
                             f"{type(scene).__name__}{' of several bodies' if isinstance(scene, Scene) else ''}.")
     return scene
 
@@ -104,7 +110,9 @@ def failure_record(index, parameters, error):
 
 
 def torque_free(scene):
-    """The member needs no integration: no perturbers and no orbit."""
+    """The member needs no integration: a Scene with no perturbers and no orbit."""
+    if runs_itself(scene):
+        return False
     return not scene.named and not scene.fixed and not scene.moving and scene.orbit is None
 
 
@@ -142,7 +150,8 @@ def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None,
     bits in any process or batch). With ``route="auto"`` (and no tables kept) the members that can
     share a plan run as groups by the batch route (:func:`spinorbit.ensemble.batch.run_group`, its
     batch integrators ``integrators``, default :data:`~spinorbit.ensemble.batch.BATCH_INTEGRATORS`);
-    every row records its route in ``ensemble_route`` ("batch", "scene" or "torque-free"). A group
+    every row records its route in ``ensemble_route`` ("batch", "scene", "torque-free", or "self-run" for a
+    member that runs itself). A group
     takes the plan of ``leader`` (the ensemble's (index, parameters) whose plan leads, planned once
     per process) when the leader would be in it, else its first member's; the members the leader's
     plan does not fit (its drops) are led by the first of them.
@@ -171,7 +180,7 @@ def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None,
     if route == "auto" and not keep_tables:
         groups, single = {}, []
         for member in built:
-            key = group_key(member[1], at_days)
+            key = None if runs_itself(member[1]) else group_key(member[1], at_days)
             (single.append(member) if key is None else
              groups.setdefault((sharing_key(member[1]), key), []).append(member))
         led = None
@@ -200,6 +209,9 @@ def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None,
         single.sort(key=lambda member: member[0])
     for index, scene, parameters in single:
         try:
+            if runs_itself(scene):
+                rows[index] = {**own_row(scene, at_days), "ensemble_route": "self-run"}
+                continue
             with scene.sharing_samples(samples_of(scene)):
                 result = scene.run()
             rows[index] = {**outcome_row(scene, result, at_days), "ensemble_route": "scene"}
@@ -217,7 +229,8 @@ class Ensemble:
     Parameters
     ----------
     make_scene : callable
-        ``make_scene(**parameters) -> Scene`` (one body). A module-level function, so that worker
+        ``make_scene(**parameters) -> Scene`` (one body), or a member that runs itself (an object with
+        ``outcome_row(at_days) -> dict``, module docstring). A module-level function, so that worker
         processes can import it; an expensive orbit it needs should be cached in its module
         (e.g. ``functools.cache``), so each process builds it once and members share its samples.
         Each member is built once, where its chunk runs. On an executor, this process builds the
@@ -246,6 +259,9 @@ class Ensemble:
         :func:`~spinorbit.core.integrators.batch_quaternion.integrate_quaternion_batch`'s signature
         (module-level, so that workers can import it); default
         :data:`~spinorbit.ensemble.batch.BATCH_INTEGRATORS`.
+    outcome_units : dict, optional
+        ``{column: astropy unit}`` of the numeric outcome columns of members that run themselves (their
+        rows hold plain numbers in these units); columns not named are plain numbers.
 
     Attributes
     ----------
@@ -258,7 +274,8 @@ class Ensemble:
         ``wall_seconds`` and ``executor`` of the last :meth:`run` or :meth:`rerun`.
     """
 
-    def __init__(self, make_scene, parameters, chunk_size=None, at=None, route="auto", batch_integrators=None):
+    def __init__(self, make_scene, parameters, chunk_size=None, at=None, route="auto", batch_integrators=None,
+                 outcome_units=None):
         if not callable(make_scene):
             raise EnsembleError(f"make_scene expects a callable returning a Scene; got {make_scene!r}.")
         if route not in ROUTES:
@@ -269,6 +286,7 @@ class Ensemble:
             raise EnsembleError(f"batch_integrators expects a dict {{plan integrator name: batch function}} (e.g. "
                                 f"{{'quaternion': integrate_quaternion_batch}}); got {batch_integrators!r}.")
         self.route, self.batch_integrators = route, batch_integrators
+        self.outcome_units = checked_units(outcome_units)
         self.make_scene = make_scene
         self.parameters = _parameter_table(parameters)
         n = len(self.parameters)
@@ -285,11 +303,11 @@ class Ensemble:
 
     @classmethod
     def sampled(cls, make_scene, n, seed=None, chunk_size=None, at=None, route="auto", batch_integrators=None,
-                **distributions):
+                outcome_units=None, **distributions):
         """An ensemble of ``n`` members whose parameters are drawn, each from its own seed
         (:func:`~spinorbit.ensemble.samplers.sample_parameters`; the seeds are columns of the result)."""
         return cls(make_scene, sample_parameters(n, seed, **distributions), chunk_size=chunk_size, at=at, route=route,
-                   batch_integrators=batch_integrators)
+                   batch_integrators=batch_integrators, outcome_units=outcome_units)
 
     # ------------------------------------------------------------------------------------------
     @property
@@ -581,11 +599,12 @@ class Ensemble:
         names = list(TIMED_COLUMNS) if self.at_days is None else [f"{n}_t{k}" for k in timed for n in TIMED_COLUMNS]
         names += [*INITIAL_COLUMNS, *RUN_COLUMNS]
         present = {name for row in self._rows.values() for name in row}
-        return [name for name in names if name in present]
+        return [name for name in names if name in present] + own_columns(self._rows, names)
 
     def member_routes(self):
         """{route: members} of the members with a row: "batch" (planned as a group and integrated together,
-        :mod:`spinorbit.ensemble.batch`), "scene" (their own Scene run) or "torque-free" (vectorised)."""
+        :mod:`spinorbit.ensemble.batch`), "scene" (their own Scene run), "torque-free" (vectorised) or
+        "self-run" (a member that runs itself)."""
         counts = {}
         for row in self._rows.values():
             route = row.get("ensemble_route", "scene")
@@ -614,6 +633,8 @@ class Ensemble:
                 data = np.array([v if p else 0.0 for v, p in zip(values, present)], dtype=float)
                 if base in OUTCOME_UNITS:
                     data = data * OUTCOME_UNITS[base]
+                elif name in self.outcome_units:
+                    data = data * self.outcome_units[name]
                 table[name] = data if present.all() else Masked(data, mask=~present)
         errors = [f"{self._failures[i]['type']}: {self._failures[i]['message']}" if i in self._failures else ""
                   for i in range(n)]

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from astropy import units as u
 
+from spinorbit.quantities import require_quantity
 from spinorbit.scene.errors import SceneError
 
 __all__ = ["ThermalModel", "ThermalInputError", "VanishingYorpWarning", "DEFAULT_K3_SQUARED", "MOMENT_RTOL",
@@ -45,6 +46,7 @@ class VanishingYorpWarning(UserWarning):
 
 
 def _positive(name, value, unit, example):
+    require_quantity(name, value, unit, example)
     if not isinstance(value, u.Quantity) or not value.isscalar or not value.unit.is_equivalent(unit):
         raise ThermalInputError(f"{name} expects a scalar Quantity in {unit} such as {example}; got {value!r}.")
     magnitude = float(value.to_value(unit))
@@ -167,7 +169,7 @@ class ThermalModel:
 
     def damping_time(self, spin_rate):
         """Burns & Safronov's τ_D = μQ/(ρ K₃² R² ω³) at a spin rate (angle/time Quantity), in years."""
-        omega = float(u.Quantity(spin_rate).to_value(u.rad / u.day))
+        omega = _positive("spin_rate", spin_rate, u.rad / u.day, "2 * u.cycle / u.day")
         if self.mu_q is None:
             raise ThermalInputError("damping_time needs the damping: give ThermalModel.from_shape(..., mu_q=1e9 * u.Pa).")
         return (self.damping_constant / omega**3 * u.day).to(u.yr)

@@ -12,6 +12,7 @@ another (:mod:`spinorbit.coupling.approaches`). Elements and frames: :mod:`spino
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -336,6 +337,29 @@ class Orbit:
             description += ", EIH 1PN + Earth J2"
         return cls("rebound", name, simulation=sim, description=description, de421_planets=True)
 
+    def __reduce__(self):
+        """Pickle to the orbit's description, never REBOUND's raw simulation (issue 36).
+
+        REBOUND pickles a simulation as its binary, which holds neither the compiled extra forces'
+        function pointer nor (rebound 5.2.2) names that outlive the simulation saved: a pickled
+        orbit would run without EIH and J2 and change the physics silently (REBOUND only warns).
+        A REBOUND orbit goes as a :class:`~spinorbit.coupling.rebound.snapshot.SimulationSnapshot`
+        (binary, names, the extra forces in effect) and is rebuilt with its forces reinstalled, so
+        the copy integrates bit for bit like the original (``tests/test_orbit_pickling.py``). A
+        simulation with forces spinorbit did not install cannot be carried: refused with SceneError.
+        """
+        fields = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        if self.simulation is not None:
+            from spinorbit.coupling.rebound import ForceInstallError, SimulationSnapshot
+
+            try:
+                snapshot = SimulationSnapshot.of(self.simulation)
+            except ForceInstallError as error:
+                raise SceneError(f"the orbit of {self.name!r} cannot be pickled (sent to another process): {error}") \
+                    from None
+            fields["simulation"] = (snapshot, int(self.simulation.exact_finish_time))
+        return (_orbit_from_description, (fields,))
+
     def check_span(self, *days):
         """EphemerisRangeError if an orbit built among DE421's planets is asked about times (TDB days
         since J2000) outside DE421's span: its planets start from DE421 and are compared with it."""
@@ -436,3 +460,13 @@ class Orbit:
                                 f"{end.tdb.iso} TDB: the distance only falls or only rises there. Widen the span.")
         best = int(np.argmin(table["distance"].value))
         return table["time"][best], table["distance"][best]
+
+
+def _orbit_from_description(fields):
+    """The :class:`Orbit` of :meth:`Orbit.__reduce__`'s fields, its REBOUND simulation rebuilt from its snapshot."""
+    if fields.get("simulation") is not None:
+        snapshot, exact_finish_time = fields["simulation"]
+        simulation = snapshot.build()  # the names set again, the extra forces reinstalled
+        simulation.exact_finish_time = exact_finish_time
+        fields = {**fields, "simulation": simulation}
+    return Orbit(**fields)

@@ -28,6 +28,7 @@ from itertools import product
 import numpy as np
 
 from spinorbit.core.errors import SpinorbitError, require_finite
+from spinorbit.core.model.self_intersection import intersecting_faces
 
 __all__ = [
     "InvalidMeshError", "check_closed_mesh", "face_geometry", "mass_properties", "principal_frame",
@@ -65,7 +66,8 @@ def check_closed_mesh(vertices, faces):
     InvalidMeshError
         Wrong shapes, indices out of range, repeated indices in a face, degenerate faces, an open
         or non-manifold surface (an edge not shared by exactly two faces), inconsistent orientation
-        (an edge traversed twice in the same direction), or inverted normals (negative volume).
+        (an edge traversed twice in the same direction), a surface that crosses itself (two faces
+        intersecting other than at their shared vertices and edge), or inverted normals (negative volume).
     NonFiniteError
         NaN or inf in the vertices.
     """
@@ -96,11 +98,30 @@ def check_closed_mesh(vertices, faces):
                                f"(below {DEGENERATE_AREA_FRACTION:g} of the size squared): their normals are "
                                "undefined. Remove or merge the collinear vertices.")
     _check_edges(faces)
-    volume = mass_properties(vertices, faces)[0]
+    _check_no_self_intersection(vertices, faces)
+    volume = float(mass_properties(vertices, faces)[0])
     if not volume > 0:
         raise InvalidMeshError(f"the mesh's signed volume is {volume!r} ≤ 0: its faces are ordered clockwise seen "
                                "from outside (inverted normals). Reverse the order of every face's vertices.")
     return vertices, faces
+
+
+#: Intersecting face pairs named in the message of a self-intersecting mesh.
+SHOWN_INTERSECTIONS = 5
+
+
+def _check_no_self_intersection(vertices, faces):
+    """Refuse a surface that crosses itself (:mod:`spinorbit.core.model.self_intersection`)."""
+    # One compiled signature: C-contiguous float64 and int64, whatever layout the caller's arrays have.
+    count, pairs = intersecting_faces(np.ascontiguousarray(vertices, dtype=np.float64),
+                                      np.ascontiguousarray(faces, dtype=np.int64), SHOWN_INTERSECTIONS)
+    if count:
+        shown = ", ".join(f"{int(i)} and {int(j)}" for i, j in pairs)
+        raise InvalidMeshError(
+            f"the surface crosses itself: {count} pairs of faces intersect (faces {shown}"
+            f"{', …' if count > len(pairs) else ''}; numbered from 0). Its volume and moments would count the "
+            "overlap twice. Repair the mesh: merge overlapping parts into one surface, or move the vertices that "
+            "poke through.")
 
 
 def _check_edges(faces):
@@ -119,7 +140,8 @@ def _check_edges(faces):
     _, uses = np.unique(undirected, axis=0, return_counts=True)
     if np.any(uses != 2):
         bad = int(np.sum(uses != 2))
-        raise InvalidMeshError(f"{bad} edges of the {count}-face mesh belong to {sorted(set(uses[uses != 2]))} faces "
+        counts = sorted({int(n) for n in uses[uses != 2]})
+        raise InvalidMeshError(f"{bad} edges of the {count}-face mesh belong to {counts} faces "
                                "instead of exactly two: the surface is open (holes) or not a manifold. Close the "
                                "holes before computing mass properties.")
 

@@ -26,6 +26,7 @@ _PUBLIC = {
     "SingularElementsError": ".core.errors",
     "SpinorbitError": ".core.errors",
     "NonFiniteError": ".core.errors",
+    "InputError": ".core.errors",
 }
 
 __all__ = [*_PUBLIC, "__version__"]

@@ -18,8 +18,9 @@ defines
 
 Error policy: a mistake in the user's input ends the run with exit status 2 and one line on stderr
 that says what was expected, what arrived and what to do — no traceback. These are
-:class:`CommandError` (raised by commands where they interpret input or write files) and the
-package's own validation errors (:class:`spinorbit.InvalidBodyError`,
+:class:`spinorbit.InputError` (every option and scene-file key is checked by the commands' one
+validation layer, ``spinorbit/commands/_inputs.py``, before any work), :class:`CommandError` (its
+subclass for checks of the whole command and for output files) and the package's own validation errors (:class:`spinorbit.InvalidBodyError`,
 :class:`spinorbit.InvalidStateError`, :class:`spinorbit.SpinorbitError`, astropy's
 ``UnitTypeError``). Anything else is a bug and keeps its traceback.
 """
@@ -34,6 +35,8 @@ import pkgutil
 import re
 import sys
 
+from spinorbit.core.errors import InputError
+
 __all__ = ["main", "console_main", "build_parser", "CommandError", "EXIT_USAGE"]
 
 #: Exit status for a run stopped by bad input (argparse's own convention).
@@ -44,8 +47,19 @@ EXIT_INTERRUPTED = 130
 EXIT_BROKEN_PIPE = 141
 
 
-class CommandError(Exception):
-    """A user-input or output problem, reported as one line and exit status 2."""
+class CommandError(InputError):
+    """A problem with the command line's input or its output files, reported as one line and exit status 2.
+
+    The :class:`spinorbit.InputError` of a check that needs the whole command (two options that
+    contradict each other, a file that cannot be written); its message is written whole.
+    """
+
+    def __init__(self, message):
+        Exception.__init__(self, message)
+        self.where = self.expected = self.got = self.advice = None
+
+    def __reduce__(self):
+        return type(self), (str(self),)
 
 
 # What argparse must read as a negative number, not an option. Its own pattern (Python < 3.13) misses

@@ -328,11 +328,12 @@ def test_toutatis_torque_free_when_the_tolerance_allows(capsys):
 
 
 @pytest.mark.parametrize("args, words", [
-    (["apophis", "--span", "-1", "d"], "--span expects a positive duration"),
+    (["apophis", "--span", "-1", "d"], "--span expects a time in (0, 730] d"),
     (["apophis", "--span", "1", "kg"], "--span expects a time"),
     (["toutatis", "--tolerance", "1", "m"], "--tolerance expects an angle"),
     (["toutatis", "--perturbers", "vulcan"], "vulcan"),
-    (["toutatis", "--n-times", "1"], "--n-times expects between 2"),
+    (["toutatis", "--n-times", "1"], "--n-times expects a whole number in [2, 100000]"),
+    (["toutatis", "--n-times", "4.5"], "--n-times expects a whole number in [2, 100000] such as 200; got '4.5'"),
 ])
 def test_scene_commands_bad_input_in_words(capsys, args, words):
     status = cli.main(args)
@@ -383,7 +384,7 @@ def test_asteroid_options_win_over_the_scene_file(capsys):
     ({"--elements": ["-2.2", "0.1", "4", "80", "30", "10"]}, "positive semi-major axis"),
     ({"--elements": ["2.2", "0.1", "200", "80", "30", "10"]}, "inc expects an inclination"),
     ({"--epoch": ["2250-01-01"]}, "DE421's span"),
-    ({"--epoch": ["yesterday"]}, "expects a TDB time"),
+    ({"--epoch": ["yesterday"]}, "expects a TDB date"),
     ({"--epoch": ["2190-01-01"], "--span": ["20", "yr"]}, "DE421's span"),
 ])
 def test_asteroid_bad_options_in_words(capsys, change, words):
@@ -404,7 +405,7 @@ def test_asteroid_bad_scene_files_in_words(capsys, tmp_path):
     missing = tmp_path / "missing.toml"
     missing.write_text('[orbit]\nepoch = "2020-01-01"\na = "2 au"\n')
     for path, words in ((typo, "unknown keys ['mean_anomally']"), (broken, "not valid TOML"),
-                        (missing, "[orbit] e is missing"), (tmp_path / "absent.toml", "cannot read")):
+                        (missing, "[orbit] e is missing"), (tmp_path / "absent.toml", "cannot be read")):
         status = cli.main(["asteroid", "--scene", str(path), "--plan"])
         _, err = capsys.readouterr()
         assert status == 2 and words in err and "Traceback" not in err, (path, err)

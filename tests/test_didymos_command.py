@@ -33,7 +33,7 @@ def test_report_and_table_with_an_impact(capsys, tmp_path):
 
 
 @pytest.mark.parametrize("args, message", [
-    (["--order", "5"], "--order: order: expected a whole number 0 ≤ order ≤ 4"),
+    (["--order", "5"], "--order expects a whole number in [0, 4]"),
     (["--per-orbit", "4"], "--per-orbit expects at least 8"),
     (["--orbits", "100000"], "more than 1000000"),
 ])

@@ -139,12 +139,13 @@ def test_cli_moon_refuses_a_span_past_the_model_range(capsys, tmp_path):
 
 
 @pytest.mark.parametrize(("arguments", "expected"), [
-    (["--start", "1899-06-01"], "--start expected a date between 1899-12-05"),
-    (["--start", "2200-03-01"], "--start expected a date between"),
+    (["--start", "1899-06-01"], "--start: expected a date between 1899-12-05"),
+    (["--start", "2200-03-01"], "--start: expected a date between"),
     (["--start", "2199-06-01", "--span", "1", "yr"], "past DE421's last usable date"),
-    (["--step", "10", "s"], "--step expected an output spacing from 1 min"),
-    (["--step", "2", "yr"], "--step expected an output spacing from 1 min"),
-    (["--start", "yesterday"], "--start expects an ISO date"),
+    (["--step", "10", "s"], "--step: expected an output spacing from 1 min"),
+    (["--step", "2", "yr"], "--step: expected an output spacing from 1 min"),
+    (["--start", "yesterday"], "--start expects a TDB date such as"),
+    (["--span", "1e9", "yr"], "--span: a run of 3.6525e+11 d from 2000-01-01 12:00:00.000 TDB ends at JD 3.65"),
 ])
 def test_cli_moon_bad_input_is_one_line_before_any_work(capsys, tmp_path, arguments, expected):
     import time

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from spinorbit.cli import CommandError
+from spinorbit.commands import _inputs as check
 from spinorbit.commands._common import Progress, plot_format, write_plot_output, write_table_output
 
 #: Most members the command accepts in one call (a larger study belongs in a script with a checkpoint).
@@ -12,20 +13,37 @@ MAX_MEMBERS = 1_000_000
 def add_ensemble_arguments(parser) -> None:
     """--members, --workers / --scheduler, --seed, --checkpoint-dir."""
     group = parser.add_argument_group("ensemble (the distribution over the unknown phase and the moment ratios)")
-    group.add_argument("--members", type=int, metavar="N",
+    group.add_argument("--members", metavar="N",
                        help="run N members, both rotation phases uniform and the moment ratios uniform between the two "
                        "published solutions; --output writes one row per member, --plot the histograms")
     where = group.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=int, metavar="K", help="K local worker processes (default: one per core)")
+    where.add_argument("--workers", metavar="K", help="K local worker processes (default: one per core)")
     where.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://10.0.0.1:8786")
-    group.add_argument("--seed", type=int, default=None, help="root seed of the members' draws (default: fresh entropy, "
+    group.add_argument("--seed", default=None, help="root seed of the members' draws (default: fresh entropy, "
                        "recorded in the output)")
     group.add_argument("--checkpoint-dir", metavar="DIR", help="keep completed chunks in DIR; run again with the same "
                        "DIR and options to run only the missing members")
 
 
+def check_ensemble_arguments(args) -> None:
+    """--members, --seed, --workers and --scheduler in range, before any work."""
+    if args.members is None:
+        if args.workers is not None or args.scheduler is not None or args.checkpoint_dir:
+            raise CommandError("--workers, --scheduler and --checkpoint-dir go with --members N (an ensemble); add "
+                               "--members.")
+        return
+    args.members = check.integer("--members", args.members, "200", low=1, high=MAX_MEMBERS)
+    if args.seed is not None:
+        args.seed = check.seed("--seed", args.seed)
+    if args.workers is not None:
+        args.workers = check.integer("--workers", args.workers, "2", low=1)
+    if args.scheduler is not None:
+        check.scheduler_address("--scheduler", args.scheduler)
+
+
 def _executor(args):
     if args.scheduler is not None:
+        check.scheduler_address("--scheduler", args.scheduler)
         from spinorbit.ensemble.executors import dask_client
 
         try:
@@ -46,8 +64,7 @@ def run_apophis_ensemble(args, span_days) -> int:
     from spinorbit.ensemble import Ensemble
     from spinorbit.ensemble.apophis import apophis_member, apophis_parameters
 
-    if not 1 <= args.members <= MAX_MEMBERS:
-        raise CommandError(f"--members expects between 1 and {MAX_MEMBERS} members; got {args.members}.")
+    check_ensemble_arguments(args)
     tolerance = float(args.tolerance_quantity.to_value("arcsec"))
     parameters = apophis_parameters(args.members, args.seed, span_days=span_days, orbit=args.orbit,
                                     perturbers=tuple(args.perturbers), tolerance_arcsec=tolerance)

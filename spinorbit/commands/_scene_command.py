@@ -7,7 +7,8 @@ import contextlib
 import threading
 
 from spinorbit.cli import CommandError
-from spinorbit.commands._common import Progress, plot_format, quantity, write_plot_output, write_table_output
+from spinorbit.commands import _inputs as check
+from spinorbit.commands._common import Progress, plot_format, write_plot_output, write_table_output
 
 #: Seconds of planning before its progress bar shows (issue 15: plans of long runs take tens of seconds).
 PLAN_PROGRESS_DELAY_S = 1.0
@@ -22,7 +23,7 @@ def add_scene_arguments(parser: argparse.ArgumentParser, span_default: str, pert
     run = parser.add_argument_group("scene")
     run.add_argument("--span", nargs="+", default=span_default.split(), metavar="SPAN",
                      help=f"how long to run, e.g. '4 d', '1 yr' (a number alone is days; default {span_default})")
-    run.add_argument("--n-times", type=int, default=200, metavar="N",
+    run.add_argument("--n-times", default=200, metavar="N",
                      help="number of evenly spaced output times (default 200)")
     run.add_argument("--end-only", action="store_true",
                      help="only the final state (the planner then asks for no dense output)")
@@ -41,39 +42,44 @@ def add_scene_arguments(parser: argparse.ArgumentParser, span_default: str, pert
                        "encounters marked (needs matplotlib; .png, .pdf or .svg)")
 
 
+def _where(args, option: str) -> str:
+    """The option's name, or the scene-file key it came from (``args.sources``, set by ``spinorbit asteroid``)."""
+    return getattr(args, "sources", {}).get(option, option)
+
+
+def check_run_options(args, max_days: float):
+    """(span, n_times): --tolerance, --span and --n-times checked before any work (no orbit built yet)."""
+    import astropy.units as u
+
+    tolerance(args)
+    span = check.quantity(_where(args, "--span"), args.span, "d", "4 d", default_unit="d", low=0.0, high=max_days,
+                          low_open=True)
+    days = span.to_value(u.day)
+    n_times = check.integer(_where(args, "--n-times"), args.n_times, "200", low=2, high=MAX_TIMES)
+    if days / n_times < MIN_SPACING_DAYS:
+        raise CommandError(f"--span {' '.join(args.span)} with --n-times {n_times} spaces the output times by "
+                           f"{days / n_times:.3g} d, below the {MIN_SPACING_DAYS:g} d that TDB days since J2000 resolve; "
+                           "give a longer --span or fewer --n-times.")
+    return span, n_times
+
+
 def span_and_times(args, start, max_days: float):
     """(span Quantity, output Time(s)) from --span, --n-times and --end-only, starting at ``start``."""
     import astropy.units as u
     import numpy as np
 
-    tolerance(args)  # before the orbit is built: a wrong tolerance costs no N-body run
-    span = quantity("--span", args.span, "d", "time", "4 d")
+    span, n_times = check_run_options(args, max_days)
     days = span.to_value(u.day)
-    if not 0 < days <= max_days:
-        raise CommandError(f"--span expects a positive duration up to {max_days:g} d; got {' '.join(args.span)}.")
-    if not 2 <= args.n_times <= MAX_TIMES:
-        raise CommandError(f"--n-times expects between 2 and {MAX_TIMES} output times; got {args.n_times}.")
-    if days / args.n_times < MIN_SPACING_DAYS:
-        raise CommandError(f"--span {' '.join(args.span)} with --n-times {args.n_times} spaces the output times by "
-                           f"{days / args.n_times:.3g} d, below the {MIN_SPACING_DAYS:g} d that TDB days since J2000 resolve; "
-                           "give a longer --span or fewer --n-times.")
     if args.end_only:
         return span, start + days * u.day
     # the first row is the start itself (the output schema), then evenly to the end
-    return span, start + np.linspace(0.0, days, args.n_times) * u.day
+    return span, start + np.linspace(0.0, days, n_times) * u.day
 
 
 def tolerance(args):
     """The --tolerance angle, in the range the Scene accepts (checked here, before the orbit is built)."""
-    from spinorbit.scene.inputs import SceneError, as_angle
-
-    value = quantity("--tolerance", args.tolerance, "arcsec", "angle", "1 arcsec")
-    try:
-        as_angle(value)
-    except SceneError:
-        raise CommandError(f"--tolerance expects an attitude angle between 1e-12 rad and 0.1 rad (2e-7 to 2e4 "
-                           f"arcsec); got '{' '.join(args.tolerance)}'.") from None
-    return value
+    return check.quantity(_where(args, "--tolerance"), args.tolerance, "rad", "1 arcsec", default_unit="arcsec",
+                          low=1e-12, high=0.1, advice="That is 2e-7 to 2e4 arcsec.")
 
 
 def run_scene(scene, args):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from spinorbit.commands._common import check_outputs
-from spinorbit.commands._ensemble_command import add_ensemble_arguments, run_apophis_ensemble
+from spinorbit.commands._ensemble_command import add_ensemble_arguments, check_ensemble_arguments, run_apophis_ensemble
 from spinorbit.commands._scene_command import (
     add_scene_arguments,
     run_and_report,
@@ -70,8 +70,7 @@ def run(args) -> int:
     from spinorbit.scene import Orbit
 
     check_outputs(args)
-    if args.members is None and (args.workers is not None or args.scheduler is not None or args.checkpoint_dir):
-        raise CommandError("--workers, --scheduler and --checkpoint-dir go with --members N (an ensemble); add --members.")
+    check_ensemble_arguments(args)
     if not 0.0 <= args.phase < 1.0:
         raise CommandError(f"--phase expects a fraction of P_psi in [0, 1); got {args.phase:g}.")
     days = span_and_times(args, APOPHIS_2029.time_tdb, MAX_SPAN_DAYS)[0].to_value(u.day)

@@ -6,7 +6,8 @@ import argparse
 import math
 
 from spinorbit.cli import CommandError
-from spinorbit.commands._common import Progress, check_outputs, number, write_plot_output, write_table_output
+from spinorbit.commands import _inputs as check
+from spinorbit.commands._common import Progress, check_outputs, write_plot_output, write_table_output
 
 NAME = "didymos"
 SUMMARY = "Didymos-Dimorphos full two-body problem (mutual potential to order 4) and a DART-like impact"
@@ -52,23 +53,23 @@ def _positive_count(text):
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of ``spinorbit didymos``."""
     model = parser.add_argument_group("model and run")
-    model.add_argument("--order", type=int, default=4, metavar="N",
+    model.add_argument("--order", default=4, metavar="N",
                        help="mutual-potential order 0..4 (default 4, the GUBAS case's; 2 = point mass + inertia tensors)")
     model.add_argument("--orbits", type=_positive_count, default=100, metavar="N",
                        help="span in mutual orbits of 11.92 h (default 100: enough to separate the libration lines)")
     model.add_argument("--per-orbit", type=_positive_count, default=40, metavar="N",
                        help="output times per orbit (default 40)")
-    model.add_argument("--rtol", type=number, default=1e-12, metavar="RTOL", help="DOP853 relative tolerance (default 1e-12)")
-    model.add_argument("--libration", type=number, default=0.0, metavar="DEG",
+    model.add_argument("--rtol", default=1e-12, metavar="RTOL", help="DOP853 relative tolerance (default 1e-12)")
+    model.add_argument("--libration", default=0.0, metavar="DEG",
                        help="Dimorphos turned this many degrees from the line to Didymos at the start (default 0)")
     impact = parser.add_argument_group("DART-like impact at t = 0")
     impact.add_argument("--impact", action="store_true", help="also run after an impulsive velocity change of Dimorphos")
-    impact.add_argument("--beta", type=number, default=3.61, metavar="BETA",
+    impact.add_argument("--beta", default=3.61, metavar="BETA",
                         help="momentum enhancement (default 3.61, Cheng et al. 2023)")
-    impact.add_argument("--impactor-mass", type=number, default=579.4, metavar="KG", help="impactor mass in kg (default 579.4)")
-    impact.add_argument("--impactor-speed", type=number, default=6.1449, metavar="KM_S",
+    impact.add_argument("--impactor-mass", default=579.4, metavar="KG", help="impactor mass in kg (default 579.4)")
+    impact.add_argument("--impactor-speed", default=6.1449, metavar="KM_S",
                         help="impactor speed in km/s (default 6.1449)")
-    impact.add_argument("--impact-elevation", type=number, default=0.0, metavar="DEG",
+    impact.add_argument("--impact-elevation", default=0.0, metavar="DEG",
                         help="angle of the impactor's velocity out of the orbit plane (default 0: in the plane, head-on)")
     files = parser.add_argument_group("output files")
     files.add_argument("--output", metavar="FILE.ecsv", help="write the run (time, relative orbit, libration, "
@@ -195,6 +196,20 @@ def _plot(runs, path):
     plt.close(figure)
 
 
+def check_options(args) -> None:
+    """Every number in range before any work (the validation layer, :mod:`spinorbit.commands._inputs`)."""
+    args.order = check.integer("--order", args.order, "4", low=0, high=4)
+    # DOP853 in double precision: the binary propagator's own range (spinorbit.core.binary.propagate)
+    args.rtol = check.number("--rtol", args.rtol, "1e-12", low=1e-15, high=1.0, high_open=True,
+                             advice="Double precision cannot do better than 1e-15.")
+    args.libration = check.number("--libration", args.libration, "10", low=-180.0, high=180.0)
+    args.beta = check.number("--beta", args.beta, "3.61", low=0.0,
+                             advice="beta is the momentum enhancement, ≥ 1 in practice.")
+    args.impactor_mass = check.number("--impactor-mass", args.impactor_mass, "579.4", low=0.0, low_open=True)
+    args.impactor_speed = check.number("--impactor-speed", args.impactor_speed, "6.1449", low=0.0, low_open=True)
+    args.impact_elevation = check.number("--impact-elevation", args.impact_elevation, "30", low=-90.0, high=90.0)
+
+
 def run(args) -> int:
     """Run ``spinorbit didymos``; return the exit status."""
     import astropy.units as u
@@ -205,6 +220,7 @@ def run(args) -> int:
     from spinorbit.data.didymos import RELATIVE_SPEED, SEPARATION, didymos_state
 
     check_outputs(args)
+    check_options(args)
     rows = args.orbits * args.per_orbit + 1
     if rows > MAX_ROWS:
         raise CommandError(f"--orbits {args.orbits} with --per-orbit {args.per_orbit} gives {rows} output rows, more than "

@@ -8,6 +8,7 @@ import os
 import sys
 
 from spinorbit.cli import CommandError
+from spinorbit.commands import _inputs as check
 from spinorbit.commands._common import (Progress, check_output_path, check_outputs, number, plot_format, quantity,
                                         write_plot_output, write_table_output)
 
@@ -46,6 +47,8 @@ examples:
 exit status: 0 on success; 2 with a one-line message if the input is wrong or an output file
 cannot be written (nothing is left half-written)."""
 
+#: The options that stand for check_run's arguments (its messages name them).
+OPTION_NAMES = {"model": "--model", "start": "--start", "span": "--span", "step": "--step"}
 #: Most comparison times (rows) a run may have (50 yr at a 0.1 d step). Each is an integration stop
 #: and a DE421 evaluation; more is refused before the run (with the count and the knob, --step).
 MAX_COMPARISON_TIMES = 200_000
@@ -84,25 +87,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def start_day(text: str) -> float:
     """``--start`` as TDB days since J2000: an ISO date/time (TDB) or a Julian date number."""
-    from astropy.time import Time
-
     from spinorbit.time import tdb_day_and_fraction
 
-    try:
-        time = Time(float(text), format="jd", scale="tdb") if _is_number(text) else Time(text, scale="tdb")
-    except ValueError:
-        raise CommandError(f"--start expects an ISO date such as '1969-07-20' or a Julian date such as "
-                           f"'2440423.5' (TDB), got '{text}'.") from None
-    day, fraction = tdb_day_and_fraction(time)
+    day, fraction = tdb_day_and_fraction(check.time("--start", text, julian=True))
     return float(day) + float(fraction)
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
 
 
 def plot_comparison(comparison, path: str, title: str) -> None:
@@ -173,11 +161,10 @@ def run(args) -> int:
     step = quantity("--step", args.step, "d", "time", "1 d").to_value("d")
     span_days = span.to_value("d")
     start = start_day(args.start)
-    try:
-        check_run(args.model, start, span_days, step)
+    try:  # the checks are the API's, written with the options' names
+        check_run(args.model, start, span_days, step, names=OPTION_NAMES)
     except (EphemerisRangeError, OutputStepError, ValueError) as error:
-        option = str(error).split(":", 1)[0]
-        raise CommandError(f"--{option} {str(error).split(':', 1)[1].strip()}") from None
+        raise CommandError(str(error)) from None
     count = int(span_days / step + 1e-9) + 1
     if count > MAX_COMPARISON_TIMES:
         raise CommandError(f"--span {' '.join(args.span)} with --step {' '.join(args.step)} gives {count:.3g} "

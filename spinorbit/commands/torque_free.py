@@ -6,6 +6,7 @@ import argparse
 import math
 
 from spinorbit.cli import CommandError
+from spinorbit.commands import _inputs as check
 from spinorbit.commands._common import (Progress, check_output_paths, number, plot_format, quantity, unit,
                                         write_plot_output, write_table_output)
 
@@ -57,12 +58,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="principal moments of inertia about the body x, y, z axes (kg m^2 or ratios; any order)",
     )
     body.add_argument(
-        "--omega", nargs=3, type=number, required=True, metavar=("WX", "WY", "WZ"),
-        help="body angular velocity components along x, y, z (unit: --omega-unit)",
+        "--omega", nargs="+", required=True, metavar="RATE",
+        help="body angular velocity components WX WY WZ along x, y, z, then optionally their unit: "
+        "'14.51 33.529 -98.709' (deg/day, or --omega-unit), '1e-4 0 3e-4 rad/s'",
     )
     body.add_argument(
-        "--omega-unit", default="deg/day", metavar="UNIT",
-        help="unit of --omega, any astropy angular-velocity unit: deg/day (default), rad/s, deg/h, ...",
+        "--omega-unit", metavar="UNIT",
+        help="unit of --omega's numbers when they have none, any astropy angular-velocity unit: deg/day "
+        "(default), rad/s, deg/h, cycle/d, ...",
     )
     body.add_argument(
         "--euler313", nargs=3, type=number, default=(0.0, 0.0, 0.0), metavar=("PHI", "THETA", "PSI"),
@@ -109,14 +112,13 @@ def _offsets(args):
     return math.copysign(step, span) * np.arange(count)
 
 
-def _epoch(text):
-    """The --epoch Time (TDB)."""
-    from astropy.time import Time
-
-    try:
-        return Time(text, scale="tdb")
-    except ValueError:
-        raise CommandError(f"--epoch expects an ISO date such as 2000-01-01T12:00:00 (TDB); got '{text}'.") from None
+def _epoch(text, offsets):
+    """The --epoch Time (TDB), checked with the last output time: both must be dates the table can hold."""
+    epoch = check.time("--epoch", text)
+    end = epoch.jd1 + epoch.jd2 + float(offsets[-1])
+    check.check_date("--span", end, f"a last output time {offsets[-1]:.6g} d from --epoch",
+                     "Shorten --span: the table's time column holds dates as ISO text.")
+    return epoch
 
 
 def _state(args):
@@ -124,15 +126,23 @@ def _state(args):
 
     from spinorbit import InvalidBodyError, RigidBody, RotationState
 
-    omega_unit = unit("--omega-unit", args.omega_unit, "angular velocity", "deg/day or rad/s")
-    if not any(args.omega):
+    has_unit = len(args.omega) > 3
+    if has_unit and args.omega_unit is not None:
+        raise CommandError(f"--omega '{' '.join(args.omega)}' has its unit and --omega-unit gives another; "
+                           "give the unit once.")
+    omega_unit = unit("--omega-unit", "deg/day" if args.omega_unit is None else args.omega_unit, "angular velocity",
+                      "deg/day or rad/s")
+    omega = check.vector("--omega", args.omega, "rad / d", "14.51 33.529 -98.709 deg/day",
+                         default_unit=omega_unit.to_string())
+    omega_unit = omega.unit
+    if not any(omega.value):
         raise CommandError("--omega expects a non-zero angular velocity; got 0 0 0 (a body at rest has no rotation).")
     try:
         body = RigidBody(args.moments)
     except InvalidBodyError as error:
         raise CommandError(f"--moments: {error}") from None
     phi, theta, psi = (angle * u.deg for angle in args.euler313)
-    return RotationState.from_euler313(body, phi, theta, psi, args.omega * omega_unit), omega_unit
+    return RotationState.from_euler313(body, phi, theta, psi, omega), omega_unit
 
 
 def _summary(state) -> list[str]:
@@ -195,7 +205,7 @@ def _table(args, state, epoch, offsets, quaternions, omegas, omega_unit):
         "software": f"spinorbit {__version__} torque-free",
         "moments_xyz": list(args.moments),
         "euler313_deg": list(args.euler313),
-        "omega_xyz": list(args.omega),
+        "omega_xyz": [float(value) for value in args.omega[:3]],
         "omega_unit": omega_unit.to_string(),
         "mode": state.mode,
         "sense": state.sense,
@@ -232,7 +242,7 @@ def run(args) -> int:
     if args.plot is not None:
         _require_matplotlib()
     offsets = _offsets(args)
-    epoch = _epoch(args.epoch)
+    epoch = _epoch(args.epoch, offsets)
     state, omega_unit = _state(args)
     for line in _summary(state):
         print(line)

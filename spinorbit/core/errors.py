@@ -20,6 +20,33 @@ class NonFiniteError(SpinorbitError, ValueError):
     """
 
 
+class InputError(SpinorbitError, ValueError):
+    """A value given on the command line or in a scene file of the wrong type, unit or range.
+
+    Raised before any work is done. The message names the option or key (``where``: ``"--rtol"``,
+    ``"[spin] period"``), says what was expected and what arrived, and what to do; the parts are kept
+    as attributes for programs that read them.
+
+    Parameters
+    ----------
+    where : str
+        The option or scene-file key, as the user wrote it.
+    expected : str
+        What it takes ("a positive number such as 1e-12").
+    got : str
+        What arrived, described in words ("the string 'sun'"), never another exception's text.
+    advice : str, optional
+        What to do instead.
+    """
+
+    def __init__(self, where, expected, got, advice=""):
+        self.where, self.expected, self.got, self.advice = where, expected, got, advice
+        super().__init__(f"{where} expects {expected}; got {got}." + (f" {advice}" if advice else ""))
+
+    def __reduce__(self):  # the four parts, not the message, rebuild it (process pools pickle errors)
+        return type(self), (self.where, self.expected, self.got, self.advice)
+
+
 class WorkLimitError(SpinorbitError, ValueError):
     """A run whose estimated work (steps, output rows) exceeds its documented cap, refused before it starts."""
 

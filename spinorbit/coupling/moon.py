@@ -106,10 +106,13 @@ class OutputStepError(ValueError):
 
 
 def _iso_tdb(day: float) -> str:
+    """The date as ISO text, or as a Julian date where ERFA has no calendar date for it (far past 9999)."""
+    if not -2.0e6 < day < 2.9e6:  # about the years -3500 .. 9900, well inside ERFA's calendar
+        return f"JD {day + J2000_JD_TDB:.6g}"
     return time_from_tdb_days(day).tdb.iso
 
 
-def check_run(model: str, start_day: float, span_days: float, step_days: float) -> None:
+def check_run(model: str, start_day: float, span_days: float, step_days: float, names=None) -> None:
     """Check a Moon run before any work; raise one specific error whose message says what to do.
 
     Parameters
@@ -118,6 +121,9 @@ def check_run(model: str, start_day: float, span_days: float, step_days: float) 
         One of :data:`MOON_MODELS`.
     start_day, span_days, step_days : float
         Start (TDB days since J2000), span and output spacing (days).
+    names : dict, optional
+        The caller's names of the arguments, by "model", "start", "span", "step" (the command line's
+        ``--span``), so that its messages are written with them (default: the names above).
 
     Raises
     ------
@@ -128,25 +134,26 @@ def check_run(model: str, start_day: float, span_days: float, step_days: float) 
     OutputStepError
         A spacing that is not positive, finer than :data:`MIN_STEP_DAYS` or longer than the span.
     """
+    name = {key: key for key in ("model", "start", "span", "step")} | dict(names or {})
     if model not in MOON_MODELS:
-        raise ValueError(f"model: expected one of {MOON_MODELS}, got {model!r}.")
+        raise ValueError(f"{name['model']}: expected one of {MOON_MODELS}, got {model!r}.")
     first = DE421_SPAN_JD_TDB[0] - J2000_JD_TDB + RANGE_MARGIN_DAYS
     last = DE421_SPAN_JD_TDB[1] - J2000_JD_TDB - RANGE_MARGIN_DAYS
     if not (np.isfinite(start_day) and first <= start_day <= last):
         shown = _iso_tdb(start_day) if np.isfinite(start_day) else repr(start_day)
         raise EphemerisRangeError(
-            f"start: expected a date between {_iso_tdb(first)} and {_iso_tdb(last)} TDB (DE421's span less "
+            f"{name['start']}: expected a date between {_iso_tdb(first)} and {_iso_tdb(last)} TDB (DE421's span less "
             f"{RANGE_MARGIN_DAYS:g} d at each end), got {shown}; choose a start inside it.")
     if not (np.isfinite(span_days) and span_days > 0.0):
-        raise ValueError(f"span: expected a positive number of days, got {float(span_days)!r} d.")
+        raise ValueError(f"{name['span']}: expected a positive number of days, got {float(span_days)!r} d.")
     if start_day + span_days > last:
         raise EphemerisRangeError(
-            f"span: a run of {span_days:g} d from {_iso_tdb(start_day)} TDB ends at {_iso_tdb(start_day + span_days)}, "
+            f"{name['span']}: a run of {span_days:g} d from {_iso_tdb(start_day)} TDB ends at {_iso_tdb(start_day + span_days)}, "
             f"past DE421's last usable date {_iso_tdb(last)} TDB; shorten the span to at most "
             f"{last - start_day:.1f} d or start earlier.")
     if not (np.isfinite(step_days) and MIN_STEP_DAYS * (1.0 - 1e-9) <= step_days <= span_days):
         raise OutputStepError(
-            f"step: expected an output spacing from 1 min ({MIN_STEP_DAYS:.6g} d) up to the span "
+            f"{name['step']}: expected an output spacing from 1 min ({MIN_STEP_DAYS:.6g} d) up to the span "
             f"({span_days:g} d), got {float(step_days)!r} d; the models resolve nothing finer than a minute.")
 
 

@@ -235,6 +235,9 @@ def validate_perturbers(perturbers, orbit):
     if orbit is not None and not isinstance(orbit, Orbit):
         raise SceneError(f"orbit expects a spinorbit.scene.Orbit (Orbit.de421, Orbit.ephemeris, Orbit.rebound); "
                          f"got {type(orbit).__name__}.")
+    if isinstance(perturbers, str):  # iterating it would read 'sun' as the bodies 's', 'u', 'n'
+        raise SceneError(f"perturbers expects a sequence of body names such as ('sun', 'earth'); got the string "
+                         f"{perturbers!r}. Write a sequence, even of one name: ({perturbers!r},).")
     fixed = tuple(p for p in perturbers if isinstance(p, FixedPerturber))
     moving = tuple(p for p in perturbers if isinstance(p, EphemerisPerturber))
     named = [p for p in perturbers if not isinstance(p, (FixedPerturber, EphemerisPerturber))]

@@ -198,9 +198,9 @@ def test_bad_input_is_refused_with_a_specific_message(label, call, error, patter
 # --- spinorbit moon: words, not tracebacks; exit status 2; nothing written
 MOON_CASES = [
     ("span in kg", ["--span", "3", "kg"], "--span expects a time"),
-    ("negative span", ["--span", "-1", "yr"], "--span expected a positive number of days, got -365.25 d"),
+    ("negative span", ["--span", "-1", "yr"], "--span: expected a positive number of days, got -365.25 d"),
     ("span past DE421", ["--span", "201", "yr"], "past DE421's last usable date 2200-01-31"),
-    ("start before DE421", ["--start", "1899-01-01"], "--start expected a date between 1899-12-05"),
+    ("start before DE421", ["--start", "1899-01-01"], "--start: expected a date between 1899-12-05"),
     ("step longer than span", ["--span", "2", "d", "--step", "3", "d"], "up to the span (2 d), got 3.0 d"),
     ("step under a minute", ["--step", "1", "s"], "from 1 min"),
     ("unknown model", ["--model", "jelly"], "invalid choice: 'jelly'"),

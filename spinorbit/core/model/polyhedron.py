@@ -140,8 +140,7 @@ def _check_edges(faces):
     _, uses = np.unique(undirected, axis=0, return_counts=True)
     if np.any(uses != 2):
         bad = int(np.sum(uses != 2))
-        counts = sorted({int(n) for n in uses[uses != 2]})
-        raise InvalidMeshError(f"{bad} edges of the {count}-face mesh belong to {counts} faces "
+        raise InvalidMeshError(f"{bad} edges of the {count}-face mesh belong to {sorted(set(uses[uses != 2].tolist()))} faces "
                                "instead of exactly two: the surface is open (holes) or not a manifold. Close the "
                                "holes before computing mass properties.")
 

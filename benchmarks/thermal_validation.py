@@ -112,10 +112,11 @@ def mass_section():
                      f"{np.abs(np.diag(inertia) / moments - 1).max():.2e} | {abs(stokes[2, 0] / s20 - 1):.2e} | "
                      f"{abs(stokes[4, 0] / (15 / 7 * (s20**2 + 2 * s22**2)) - 1):.2e} | "
                      f"{abs(stokes[4, 4] / (5 / 28 * s22**2) - 1):.2e} |")
-    radius = lambda d: 1 / np.sqrt((d[:, 0] / a) ** 2 + (d[:, 1] / b) ** 2 + (d[:, 2] / cc) ** 2)  # noqa: E731
+    radius = lambda d: 1 / np.sqrt((d[:, 0] / a) ** 2 + (d[:, 1] / b) ** 2 + (d[:, 2] / cc) ** 2) * u.km  # noqa: E731
     icq = []
     for q in (8, 16, 32):
         vertices, faces = icq_mesh(icq_grid(radius, q))
+        vertices = vertices.to_value(u.km)
         icq.append(f"q = {q}: {abs(mass_properties(vertices, faces)[0] / (4 / 3 * math.pi * a * b * cc) - 1):.2e}")
     lines += ["", "The same ellipsoid as an ICQ grid, volume error: " + ", ".join(icq) + "."]
     return lines

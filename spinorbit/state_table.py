@@ -3,8 +3,9 @@
 A run's table (:class:`spinorbit.scene.scene.SceneResult`, :func:`spinorbit.coupling.one_way.propagate_one_way`)
 reports for every row what the row's RotationState would: its unit quaternion, angular velocity, spin
 pole (RA, Dec; λ, β), the obliquity when the orbit normals are given and, with "periods", the mode,
-E/E0, P_ψ, P_φ and sidereal period of its torque-free motion — as scalar columns of the one output
-schema (``docs/conventions.md``, "Output tables").
+E/E0, P_ψ, P_φ, sidereal period and wobble amplitude of its torque-free motion and its rotation class
+(PA, SAM, LAM; :func:`classify_rows`) — as scalar columns of the one output schema
+(``docs/conventions.md``, "Output tables").
 Building one RotationState per row cost ~0.1 ms a row (validation, Quantities, one compiled call per
 property), far more than the exact flow behind it; here the columns come from array operations and
 one compiled loop (:func:`spinorbit.core.free_motion.summary.motion_summary_many`, the kernels the
@@ -20,14 +21,17 @@ from __future__ import annotations
 
 import numpy as np
 from astropy import units as u
+from astropy.utils.masked import Masked
 
 from spinorbit import pole as _pole
+from spinorbit import spin_forms as _spin_forms
 from spinorbit.core.free_motion import summary as _summary
+from spinorbit.core.free_motion import wobble as _wobble
 from spinorbit.core.math.rotations import attitude_to_quat_many, quat_to_attitude_many
 from spinorbit.state import MODE_NAMES, QUATERNION_NORM_TOLERANCE, InvalidStateError, RotationState
 
-__all__ = ["MOTION_COLUMNS", "OMEGA_COLUMNS", "PERIOD_UNIT", "POLE_COLUMNS", "QUATERNION_COLUMNS", "add_obliquity",
-           "from_principal", "omega_array", "pole_directions", "quaternion_array", "schema_meta", "table_columns",
+__all__ = ["CLASS_COLUMNS", "MOTION_COLUMNS", "OMEGA_COLUMNS", "PERIOD_UNIT", "POLE_COLUMNS", "QUATERNION_COLUMNS", "add_obliquity",
+           "classify_rows", "from_principal", "omega_array", "pole_directions", "quaternion_array", "schema_meta", "table_columns",
            "as_schema_time", "time_column", "unit_quaternions"]
 
 
@@ -62,6 +66,9 @@ POLE_COLUMNS = ("pole_ra", "pole_dec", "pole_lon", "pole_lat")
 
 #: Names of the motion columns, in order (``docs/conventions.md``, "Output tables").
 MOTION_COLUMNS = ("mode", "energy_ratio", "P_psi", "P_phi", "sidereal_period")
+#: Names of the columns that say whether a row is a principal-axis rotator, after the motion columns: the wobble
+#: amplitude (deg; docs/conventions.md, "Wobble and rotation class") and the class at the table's threshold.
+CLASS_COLUMNS = ("wobble_amplitude", "rotation_class")
 #: Unit of the period columns of every output table (the one output schema: hours).
 PERIOD_UNIT = u.h
 
@@ -75,7 +82,10 @@ def _motion_columns(body, omegas):
     modes, ratios = np.empty(n, dtype=np.int64), np.empty(n)
     p_psi, p_phi, p_sidereal = np.empty(n), np.empty(n), np.empty(n)
     _summary.motion_summary_many(momenta, *body.principal_moments, modes, ratios, p_psi, p_phi, p_sidereal)
-    return (_mode_names(modes), ratios, *((p * u.day).to(PERIOD_UNIT) for p in (p_psi, p_phi, p_sidereal)))
+    amplitudes = np.empty(n)
+    _wobble.wobble_amplitude_many(momenta, *body.principal_moments, amplitudes)
+    return (_mode_names(modes), ratios, *((p * u.day).to(PERIOD_UNIT) for p in (p_psi, p_phi, p_sidereal)),
+            np.degrees(amplitudes) * u.deg)
 
 
 def _mode_names(codes):
@@ -92,7 +102,8 @@ def _constant_motion_columns(state, n):
     """The same columns for ``n`` rows of the torque-free motion of ``state``: its values, repeated."""
     p_psi, p_phi = state.periods
     periods = (p.to_value(PERIOD_UNIT) for p in (p_psi, p_phi, state.sidereal_period))
-    return (np.full(n, state.mode), np.full(n, state.energy_ratio), *(np.full(n, p) * PERIOD_UNIT for p in periods))
+    return (np.full(n, state.mode), np.full(n, state.energy_ratio), *(np.full(n, p) * PERIOD_UNIT for p in periods),
+            np.full(n, state.wobble_amplitude.to_value(u.deg)) * u.deg)
 
 
 def pole_directions(body, quaternions, omegas):
@@ -120,7 +131,8 @@ def table_columns(body, quaternions, omegas, omega=True, motion=None, orbit_norm
     """Columns of a rotation table, in the order of the output schema (``docs/conventions.md``, "Output tables").
 
     ``q_w, q_x, q_y, q_z``, [``omega_x, omega_y, omega_z``], ``pole_ra, pole_dec, pole_lon, pole_lat``,
-    [``obliquity``], [``mode, energy_ratio, P_psi, P_phi, sidereal_period``].
+    [``obliquity``], [``mode, energy_ratio, P_psi, P_phi, sidereal_period, wobble_amplitude``]; the table's
+    maker adds ``rotation_class`` and masks P_ψ, P_φ of the PA rows (:func:`classify_rows`).
 
     Parameters
     ----------
@@ -133,7 +145,7 @@ def table_columns(body, quaternions, omegas, omega=True, motion=None, orbit_norm
     omega : bool
         Include the ``omega_*`` columns (Quantity, rad/day).
     motion : None, "rows" or RotationState
-        None: no motion columns; "rows": each row's own (osculating) mode, E/E0 and periods;
+        None: no motion columns; "rows": each row's own (osculating) mode, E/E0, periods and wobble amplitude;
         a RotationState: those of its torque-free motion for every row (a torque-free run from it).
     orbit_normals : None or ndarray, shape (N, 3) or (3,)
         ICRF normals of the body's current heliocentric orbit plane: adds ``obliquity`` (deg).
@@ -141,8 +153,8 @@ def table_columns(body, quaternions, omegas, omega=True, motion=None, orbit_norm
     Returns
     -------
     dict
-        Column name → ndarray, str array (``mode``) or Quantity (``omega_*`` rad/day, pole and
-        obliquity deg, periods h).
+        Column name → ndarray, str array (``mode``) or Quantity (``omega_*`` rad/day, pole,
+        obliquity and wobble amplitude deg, periods h).
     """
     quaternions = unit_quaternions(np.atleast_2d(np.asarray(quaternions, dtype=float)))
     omegas = np.atleast_2d(np.asarray(omegas, dtype=float))
@@ -161,8 +173,38 @@ def table_columns(body, quaternions, omegas, omega=True, motion=None, orbit_norm
         values = _motion_columns(body, omegas)
     else:
         raise ValueError(f"motion expects None, 'rows' or a RotationState; got {motion!r}.")
-    columns.update(zip(MOTION_COLUMNS, values))
+    columns.update(zip((*MOTION_COLUMNS, CLASS_COLUMNS[0]), values))
     return columns
+
+
+def classify_rows(table, threshold=_spin_forms.PA_MAX_WOBBLE):
+    """Add ``rotation_class`` to a table with motion columns, mask P_ψ, P_φ of its PA rows, note the threshold.
+
+    A row whose ``wobble_amplitude`` is at most ``threshold`` (an angle in [0°, 90°); default
+    :data:`spinorbit.spin_forms.PA_MAX_WOBBLE`, 1°) is "PA": a principal-axis rotator, reported by its
+    ``sidereal_period``; its P_ψ, P_φ (the split of one rotation into a wobble of that size and a spin) are
+    masked, so the ECSV and CSV leave them empty. The other rows are "SAM", "LAM" or "separatrix" with their
+    P_ψ, P_φ. When any row is PA the period columns become MaskedQuantity (the values stay underneath,
+    ``column.unmasked``), else they stay Quantity, as astropy's readers do. ``table.meta["pa_threshold"]``
+    records the threshold. Applying it again with another threshold re-classifies (the table is changed in
+    place; one without motion columns is left as it is).
+    """
+    if CLASS_COLUMNS[0] not in table.colnames:
+        return table
+    limit = _spin_forms.wobble_threshold_deg(threshold, "pa_threshold")
+    classes = _spin_forms.rotation_classes(u.Quantity(table[CLASS_COLUMNS[0]]).to_value(u.deg),
+                                           np.asarray(table["mode"]).astype(str), limit * u.deg)
+    principal = classes == "PA"
+    for name in ("P_psi", "P_phi"):
+        values = getattr(table[name], "unmasked", table[name])
+        table[name] = Masked(values, mask=principal) if principal.any() else values
+    if CLASS_COLUMNS[1] in table.colnames:
+        table[CLASS_COLUMNS[1]] = classes
+    else:
+        table.add_column(classes, name=CLASS_COLUMNS[1], index=table.colnames.index(CLASS_COLUMNS[0]) + 1)
+    table.meta["pa_threshold"] = f"{limit:g} deg"
+    table.meta.setdefault("columns", {}).update({name: COLUMN_DESCRIPTIONS[name] for name in CLASS_COLUMNS})
+    return table
 
 
 def time_column(days):
@@ -199,9 +241,12 @@ COLUMN_DESCRIPTIONS = {
     "obliquity": "angle between the angular momentum and the osculating heliocentric orbit normal",
     "mode": "SAM, LAM, separatrix or permanent rotation of the osculating torque-free motion",
     "energy_ratio": "E/E0 = 2TC/G^2",
-    "P_psi": "rotation period of the tumbling (Pravec et al. 2005); inf for permanent rotation",
-    "P_phi": "precession period (Pravec et al. 2005); 2 pi/|omega| for permanent rotation",
+    "P_psi": "rotation period of the tumbling (Pravec et al. 2005); inf for permanent rotation; masked for PA rows",
+    "P_phi": "precession period (Pravec et al. 2005); 2 pi/|omega| for permanent rotation; masked for PA rows",
     "sidereal_period": "2 pi/|omega| for principal-axis rotation; 1/(1/P_phi -+ 1/P_psi) for SAM/LAM tumblers",
+    "wobble_amplitude": "largest angle between the circulation axis (C in SAM, A in LAM) and the angular momentum "
+                        "over the free motion",
+    "rotation_class": "PA if wobble_amplitude <= meta['pa_threshold'], else SAM, LAM or separatrix",
 }
 
 

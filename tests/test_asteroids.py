@@ -119,8 +119,8 @@ def test_propagate_one_way_returns_a_table_with_periods():
     # the one output schema (docs/conventions.md, "Output tables"); the samples hold the Sun: obliquity
     assert table.colnames == ["time", "q_w", "q_x", "q_y", "q_z", "omega_x", "omega_y", "omega_z", "pole_ra", "pole_dec",
                               "pole_lon", "pole_lat", "obliquity", "mode", "energy_ratio", "P_psi", "P_phi",
-                              "sidereal_period"]
-    assert len(table) == 3 and set(table["mode"]) == {"LAM"}
+                              "sidereal_period", "wobble_amplitude", "rotation_class"]
+    assert len(table) == 3 and set(table["mode"]) == {"LAM"} and set(table["rotation_class"]) == {"LAM"}
     assert table["P_psi"].unit == u.h and table["obliquity"].unit == u.deg
     assert np.allclose(np.linalg.norm(quaternion_array(table), axis=1), 1.0, atol=1e-14)
     assert table.meta["frame"] == "ICRF" and table.meta["epoch"] == start.tdb.isot

@@ -28,7 +28,7 @@ P_PSI_D, P_PHI_D = 5.369, 7.412
 PERIOD_TOLERANCE_D = 1e-3  # the published periods are given to 1e-3 d
 # The one output schema (docs/conventions.md, "Output tables"), the same as the API's torque-free table.
 COLUMNS = ["time", "q_w", "q_x", "q_y", "q_z", "omega_x", "omega_y", "omega_z", "pole_ra", "pole_dec", "pole_lon",
-           "pole_lat", "mode", "energy_ratio", "P_psi", "P_phi", "sidereal_period"]
+           "pole_lat", "mode", "energy_ratio", "P_psi", "P_phi", "sidereal_period", "wobble_amplitude", "rotation_class"]
 # The first row is the input state itself: the exact flow at t = 0 must return it to rounding.
 INITIAL_STATE_TOLERANCE = 1e-12
 
@@ -370,6 +370,22 @@ def test_asteroid_from_options_writes_ecsv_starting_at_the_spin_epoch(capsys, tm
     start = Time("2020-01-01", scale="tdb")
     assert abs((Time(table["time"][0]) - start).to_value(u.day)) < 1e-6  # the first row is the start (the schema)
     assert abs((Time(table["time"][-1]) - start).to_value(u.day) - 5.0) < 1e-6
+    # an 8 h spin about C under the Sun's torque: a principal-axis rotator in every row (issue 35)
+    assert re.search(r"^first .* TDB  PA, P = 8\.0000 h  wobble", out, re.M), out
+    assert re.search(r"^last  .* TDB  PA, P = 8\.0000 h  wobble", out, re.M), out
+    assert set(table["rotation_class"]) == {"PA"} and table.meta["pa_threshold"] == "1 deg"
+    assert np.all(np.ma.getmaskarray(table["P_psi"])) and table["wobble_amplitude"].unit == u.deg
+
+
+def test_asteroid_pa_threshold_zero_reports_the_hair_of_wobble_as_sam(capsys):
+    status = cli.main([*OWN_ASTEROID, "--span", "5", "d", "--n-times", "3", "--pa-threshold", "0", "deg"])
+    out, err = capsys.readouterr()
+    assert status == 0, err
+    assert re.search(r"^first .* TDB  PA, P = 8\.0000 h", out, re.M)  # exactly about C: amplitude 0
+    assert re.search(r"^last  .* TDB  SAM, P_psi = .* h, P_phi = .* h, P_sid = +8\.0000 h  wobble", out, re.M), out
+    status = cli.main([*OWN_ASTEROID, "--span", "5", "d", "--pa-threshold", "90", "deg"])
+    _, err = capsys.readouterr()
+    assert status == 2 and "--pa-threshold expects an angle in [0, 90) deg" in err
 
 
 def test_asteroid_options_win_over_the_scene_file(capsys):

@@ -14,7 +14,7 @@ from astropy.time import Time
 
 from spinorbit import RigidBody, RotationState
 from spinorbit.scene import FixedPerturber, Orbit, Scene
-from spinorbit.state_table import MOTION_COLUMNS, OMEGA_COLUMNS, POLE_COLUMNS, QUATERNION_COLUMNS
+from spinorbit.state_table import CLASS_COLUMNS, MOTION_COLUMNS, OMEGA_COLUMNS, POLE_COLUMNS, QUATERNION_COLUMNS
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ["time", *QUATERNION_COLUMNS, *OMEGA_COLUMNS, *POLE_COLUMNS]
@@ -30,7 +30,7 @@ def test_torque_free_scene_table_starts_at_the_epoch_with_the_schema():
     times = EPOCH + np.linspace(0.0, 10.0, 11) * u.day
     result = Scene(_state(), EPOCH, times).run()
     table = result.table
-    assert table.colnames == [*SCHEMA, *MOTION_COLUMNS]
+    assert table.colnames == [*SCHEMA, *MOTION_COLUMNS, *CLASS_COLUMNS]
     assert table["time"].scale == "tdb" and table["time"][0] == EPOCH
     # the first row is the state itself
     assert np.allclose(np.stack([table[c] for c in QUATERNION_COLUMNS], axis=1)[0] * np.sign(table["q_w"][0]),
@@ -157,36 +157,42 @@ def test_command_ecsv_has_the_api_columns(tmp_path):
     assert cli.main(["torque-free", "--moments", "1", "2", "3", "--omega", "1", "2", "30", "--span", "3", "d",
                      "--epoch", "2024-05-01T00:00:00", "--output", str(path)]) == 0
     table = Table.read(path)
-    assert table.colnames == [*SCHEMA, *MOTION_COLUMNS]
+    assert table.colnames == [*SCHEMA, *MOTION_COLUMNS, *CLASS_COLUMNS]
     assert isinstance(table["time"], Time) and table["time"][0] == Time("2024-05-01T00:00:00", scale="tdb")
     assert table.meta["epoch"] == "2024-05-01T00:00:00.000" and table.meta["frame"] == "ICRF"
 
 
 def test_a_principal_axis_rotator_through_a_scene_keeps_its_8_h():
     """Issue 15's case end to end: spin about the short axis C, 8 h. Torque-free, every row is a permanent
-    rotation (P_ψ = ∞, P_φ = P_sid = 8 h); under a weak torque the rows leave the axis by a hair and become
-    tumblers with that wobble (finite P_ψ: the definition, docs/conventions.md), while the sidereal period
-    stays 8 h to the size of the torque's effect."""
+    rotation (P_sid = 8 h); under a weak torque the rows leave the axis by a hair, mathematically tumblers with
+    that wobble (finite P_ψ: the definition, docs/conventions.md), but reported as what an observer sees: PA
+    with P_sid = 8 h to the size of the torque's effect, the P_ψ/P_φ split masked (issue 35). At threshold 0
+    the rows are SAM with the small-wobble limits."""
     spin = 2 * np.pi * u.rad / (8 * u.h)
     state = RotationState(RigidBody([0.61, 0.965, 1.0]), [1, 0, 0, 0], [0, 0, 1] * spin)
     times = EPOCH + np.linspace(0.0, 5.0, 6) * u.day
     scene = Scene(state, EPOCH, times)
     assert "exactly along the A or C axis" in str(scene.plan())
     table = scene.run().table
-    assert set(table["mode"]) == {"permanent rotation"} and np.all(np.isinf(table["P_psi"]))
-    assert np.allclose(table["P_phi"].to_value(u.h), 8.0, rtol=1e-14)
+    assert set(table["mode"]) == {"permanent rotation"} and set(table["rotation_class"]) == {"PA"}
+    assert np.all(table["P_psi"].mask) and np.all(np.isinf(table["P_psi"].unmasked))
+    assert np.allclose(table["P_phi"].unmasked.to_value(u.h), 8.0, rtol=1e-14)
     assert np.allclose(table["sidereal_period"].to_value(u.h), 8.0, rtol=1e-14)
     near = FixedPerturber("companion", 1e-12 * u.au**3 / u.day**2, [0.01, 0.003, 0.002] * u.au)
     torqued = Scene(state, EPOCH, times, perturbers=(near,), tolerance=1e-3 * u.arcsec).run().table
     assert torqued["mode"][0] == "permanent rotation" and set(torqued["mode"][1:]) == {"SAM"}
+    assert set(torqued["rotation_class"]) == {"PA"} and np.all(torqued["P_psi"].mask)
+    assert np.all(torqued["wobble_amplitude"][1:].to_value(u.rad) < 1e-9)
+    exact = Scene(state, EPOCH, times, perturbers=(near,), tolerance=1e-3 * u.arcsec, pa_threshold=0 * u.deg).run().table
+    assert list(exact["rotation_class"]) == ["PA", *["SAM"] * 5] and not np.any(exact["P_psi"].mask[1:])
     # off the axis by ≤ 2.5e-10 rad (measured): P_sid stays 8 h to the rounding of |ω| (measured 1.2e-14
     # relative), while P_ψ, P_φ are the small-wobble limits about C, 2π/ν₀ and 2π/(|ω| + ν₀) with
     # ν₀ = |ω| C √((a − c)(b − c)) (52.54 h, 6.943 h here), to (wobble)² ~ 1e-19
-    assert np.allclose(torqued["sidereal_period"].to_value(u.h), 8.0, rtol=1e-12)
+    assert np.allclose(exact["sidereal_period"].to_value(u.h), 8.0, rtol=1e-12)
     a, b, c = (1 / m for m in (0.61, 0.965, 1.0))
     nu0 = np.sqrt((a - c) * (b - c))  # ν₀/|ω|, since G = C|ω| with C = 1
-    assert np.allclose(torqued["P_psi"][1:].to_value(u.h), 8.0 / nu0, rtol=1e-12)
-    assert np.allclose(torqued["P_phi"][1:].to_value(u.h), 8.0 / (1 + nu0), rtol=1e-12)
+    assert np.allclose(exact["P_psi"][1:].unmasked.to_value(u.h), 8.0 / nu0, rtol=1e-12)
+    assert np.allclose(exact["P_phi"][1:].unmasked.to_value(u.h), 8.0 / (1 + nu0), rtol=1e-12)
 
 
 def test_command_planning_shows_a_progress_bar_on_a_terminal(monkeypatch):

@@ -22,6 +22,7 @@ from spinorbit.core.model.polyhedron import (
     simplex_rule,
     stokes_coefficients,
 )
+from spinorbit.quantities import QuantityInputError
 from spinorbit.shape import (
     InertiaMismatchError,
     box_shape,
@@ -171,9 +172,28 @@ def test_obj_round_trip_is_exact(tmp_path):
     shape = gaussian_random_sphere(1.0 * u.km, 0.1, seed=5, subdivisions=2)
     path = tmp_path / "body.obj"
     write_obj(path, shape)
-    back = read_obj(path)
+    back = read_obj(path, u.km)
     np.testing.assert_array_equal(back.vertices_km, shape.vertices_km)
     np.testing.assert_array_equal(back.faces, shape.faces)
+
+
+def test_shape_files_take_their_unit_explicitly(tmp_path):
+    # OBJ and ICQ state no unit: the readers refuse to guess one, and read metres as metres.
+    shape = box_shape([1.5, 1.0, 0.7] * u.km)
+    path = tmp_path / "box.obj"
+    write_obj(path, shape, unit=u.m)
+    assert "1500.0" in path.read_text() and path.read_text().startswith("# box: 8 vertices, 12 faces, m")
+    with pytest.raises(QuantityInputError, match=r"read_obj expects the length unit .*read_obj\(path, unit=u.km\)"):
+        read_obj(path)
+    with pytest.raises(QuantityInputError, match="unit: expected a Quantity in length units"):
+        read_obj(path, u.s)
+    # 700 m × 0.001 km/m is 0.7000000000000001 km: one rounding of the conversion
+    np.testing.assert_allclose(read_obj(path, "m").vertices_km, shape.vertices_km, rtol=2 ** -52, atol=0)
+    grid = icq_grid(lambda d: np.ones(d.shape[0]) * u.km, 2)
+    write_icq(tmp_path / "sphere.icq", grid)
+    with pytest.raises(QuantityInputError, match="read_icq expects the length unit"):
+        read_icq(tmp_path / "sphere.icq")
+    assert read_icq(tmp_path / "sphere.icq", u.m).vertices_km.max() == pytest.approx(1e-3, rel=1e-15)
 
 
 def test_obj_reader_takes_quads_slashes_and_negative_indices(tmp_path):
@@ -185,22 +205,22 @@ def test_obj_reader_takes_quads_slashes_and_negative_indices(tmp_path):
     text += "".join(f"f {q[0] + 1}/1/1 {q[1] + 1}//1 {q[2] - 8} {q[3] + 1}\n" for q in quads)
     path = tmp_path / "cube.obj"
     path.write_text(text)
-    shape = read_obj(path)
+    shape = read_obj(path, u.km)
     assert len(shape) == 12
     assert mass_properties(shape.vertices_km, shape.faces)[0] == pytest.approx(8.0, rel=BOX_RTOL)
 
 
 def test_icq_round_trip_and_ellipsoid(tmp_path):
     a, b, c = SEMI_AXES
-    radius = lambda d: 1.0 / np.sqrt((d[:, 0] / a) ** 2 + (d[:, 1] / b) ** 2 + (d[:, 2] / c) ** 2)  # noqa: E731
+    radius = lambda d: 1.0 / np.sqrt((d[:, 0] / a) ** 2 + (d[:, 1] / b) ** 2 + (d[:, 2] / c) ** 2) * u.km  # noqa: E731
     volumes = []
     for q in (8, 16, 32):
         grid = icq_grid(radius, q)
         path = tmp_path / f"ellipsoid_{q}.icq"
         write_icq(path, grid)
-        shape = read_icq(path)
+        shape = read_icq(path, u.km)
         vertices, faces = icq_mesh(grid)
-        np.testing.assert_array_equal(shape.vertices_km, vertices)
+        np.testing.assert_array_equal(shape.vertices_km, vertices.to_value(u.km))
         np.testing.assert_array_equal(shape.faces, faces)
         assert shape.vertices_km.shape[0] == 6 * q * q + 2 and len(shape) == 12 * q * q
         volumes.append(mass_properties(shape.vertices_km, shape.faces)[0])
@@ -209,10 +229,10 @@ def test_icq_round_trip_and_ellipsoid(tmp_path):
 
 
 def test_icq_mirrored_file_is_reoriented(tmp_path):
-    grid = icq_grid(lambda d: np.ones(d.shape[0]), 4)
+    grid = icq_grid(lambda d: np.ones(d.shape[0]) * u.km, 4)
     mirrored = grid * np.array([1.0, 1.0, -1.0])
     vertices, faces = icq_mesh(mirrored)
-    assert check_closed_mesh(vertices, faces)[1].shape == faces.shape
+    assert check_closed_mesh(vertices.to_value(u.km), faces)[1].shape == faces.shape
 
 
 @pytest.mark.parametrize("text, message", [
@@ -226,7 +246,7 @@ def test_bad_obj_files(tmp_path, text, message):
     path = tmp_path / "bad.obj"
     path.write_text(text)
     with pytest.raises(ShapeFileError, match=message):
-        read_obj(path)
+        read_obj(path, u.km)
 
 
 @pytest.mark.parametrize("text, message", [
@@ -239,16 +259,16 @@ def test_bad_icq_files(tmp_path, text, message):
     path = tmp_path / "bad.icq"
     path.write_text(text)
     with pytest.raises(ShapeFileError, match=message):
-        read_icq(path)
+        read_icq(path, u.km)
 
 
 def test_icq_with_mismatched_edges_is_refused(tmp_path):
-    grid = icq_grid(lambda d: np.ones(d.shape[0]), 3)
-    grid[1, 0, 1] += 1e-3  # a shared edge vertex of cube face 1 no longer matches face 0
+    grid = icq_grid(lambda d: np.ones(d.shape[0]) * u.km, 3)
+    grid[1, 0, 1] += 1e-3 * u.km  # a shared edge vertex of cube face 1 no longer matches face 0
     path = tmp_path / "torn.icq"
     write_icq(path, grid)
     with pytest.raises(InvalidMeshError, match="distinct vertices"):
-        read_icq(path)
+        read_icq(path, u.km)
 
 
 def test_open_inverted_and_degenerate_meshes_are_refused():

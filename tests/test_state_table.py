@@ -17,12 +17,14 @@ from spinorbit.state import InvalidStateError
 from spinorbit.state_table import from_principal, omega_array, quaternion_array, table_columns
 
 COLUMNS = ["q_w", "q_x", "q_y", "q_z", "omega_x", "omega_y", "omega_z", "pole_ra", "pole_dec", "pole_lon", "pole_lat",
-           "mode", "energy_ratio", "P_psi", "P_phi", "sidereal_period"]
+           "mode", "energy_ratio", "P_psi", "P_phi", "sidereal_period", "wobble_amplitude"]
 #: A pole angle from directions that differ by ≤ 4 ulps (see momentum directions below), in degrees:
 #: atan2/asin of unit components move by ≤ 4 ulps / cos, a few 1e-14 deg at the latitudes used here.
 POLE_ATOL_DEG = 1e-12
 
 EPS = np.finfo(float).eps
+#: θ_max of the propagated momentum against the initial one's, in ulps (× 1/cos θ_max near the separatrix).
+WOBBLE_ULPS = 8
 
 
 def _states():
@@ -78,6 +80,7 @@ def test_columns_are_each_rows_rotation_state(name, state):
     assert np.array_equal(columns["P_phi"].to_value(u.h), [s.periods[1].to_value(u.h) for s in rows])
     assert np.array_equal(columns["sidereal_period"].to_value(u.h), [s.sidereal_period.to_value(u.h) for s in rows])
     assert columns["P_psi"].unit == columns["P_phi"].unit == columns["sidereal_period"].unit == u.h
+    assert np.array_equal(columns["wobble_amplitude"].to_value(u.deg), [s.wobble_amplitude.to_value(u.deg) for s in rows])
 
 
 @pytest.mark.parametrize("name, state", STATES, ids=[n for n, _ in STATES])
@@ -98,6 +101,11 @@ def test_torque_free_constants_are_the_rows_values_to_rounding(name, state):
     # b/|b − d| (~1e7 near the separatrix here; K ~ ln(1/(1 − m)) damps it): measured 6.1e-11 relative
     # there, so 1e-9; ≤ 2.5 ulps elsewhere, so 8 ulps.
     tolerance = 1e-9 if name == "near separatrix" else 8 * EPS
+    # θ_max of a rounded momentum: a few ulps, amplified near the separatrix by 1/cos θ_max (the rounding ε of M
+    # moves cos² θ_max by ~ε; measured 3.6e-13 rad at cos θ_max = 4e-4, i.e. ~0.7 ulp × 1/cos θ_max).
+    wobble = np.abs(constant["wobble_amplitude"] - each["wobble_amplitude"]).to_value(u.rad)
+    amplification = 1.0 / max(math.cos(constant["wobble_amplitude"][0].to_value(u.rad)), 1e-3)
+    assert wobble.max() <= WOBBLE_ULPS * EPS * amplification, wobble.max()
     for key in ("P_psi", "P_phi", "sidereal_period"):
         a, b = constant[key].to_value(u.day), each[key].to_value(u.day)
         finite = np.isfinite(a)
@@ -161,3 +169,34 @@ def test_one_way_table_rows_are_their_rotation_states_and_osculate():
     assert np.array_equal(table["P_phi"].to_value(u.h), [s.periods[1].to_value(u.h) for s in rows])
     assert np.array_equal(table["sidereal_period"].to_value(u.h), [s.sidereal_period.to_value(u.h) for s in rows])
     assert np.ptp(table["P_psi"].to_value(u.day)) > 1e-6 * table["P_psi"][0].to_value(u.day)  # they do vary
+
+
+def test_classify_rows_masks_the_periods_of_principal_axis_rows_and_reclassifies(tmp_path):
+    """PA rows keep P_sid and lose the P_ψ/P_φ split (masked, empty in ECSV and CSV); a new threshold re-classifies."""
+    from astropy.table import QTable
+
+    from spinorbit.spin_forms import SpinFormError
+    from spinorbit.state_table import classify_rows
+
+    body = RigidBody([1.0, 1.2, 1.5])
+    tilts = np.radians([0.0, 1e-6, 0.5, 3.0])  # wobble amplitudes 0, 1.4e-6°, 0.707°, 4.24° (× √2 along x)
+    omegas = np.stack([np.sin(tilts), np.zeros(4), 1.5 * np.cos(tilts)], axis=1) / body.moment_values * 3.0
+    table = QTable(table_columns(body, np.tile([1.0, 0, 0, 0], (4, 1)), omegas, motion="rows"))
+    classify_rows(table)
+    assert list(table["rotation_class"]) == ["PA", "PA", "PA", "SAM"] and table.meta["pa_threshold"] == "1 deg"
+    assert table.colnames[-2:] == ["wobble_amplitude", "rotation_class"]
+    assert list(table["P_psi"].mask) == list(table["P_phi"].mask) == [True, True, True, False]
+    tumbler = RotationState(body, [1.0, 0, 0, 0], omegas[3] * u.rad / u.day)
+    assert table["P_psi"][3] == tumbler.periods[0].to(u.h) and table["P_phi"][3] == tumbler.periods[1].to(u.h)
+    for path in (tmp_path / "t.ecsv", tmp_path / "t.csv"):
+        table.write(path)
+        back = QTable.read(path)
+        assert list(np.ma.getmaskarray(back["P_psi"])) == [True, True, True, False]
+        assert list(back["rotation_class"]) == ["PA", "PA", "PA", "SAM"]
+    classify_rows(table, 0.1 * u.deg)  # the values stay under the mask: a smaller threshold brings them back
+    assert list(table["rotation_class"]) == ["PA", "PA", "SAM", "SAM"]
+    assert list(table["P_psi"].mask) == [True, True, False, False] and table.meta["pa_threshold"] == "0.1 deg"
+    classify_rows(table, 0 * u.deg)
+    assert list(table["rotation_class"]) == ["PA", "SAM", "SAM", "SAM"]  # 1e-6° of wobble is a SAM at 0°
+    with pytest.raises(SpinFormError, match="pa_threshold expects a wobble amplitude in"):
+        classify_rows(table, 90 * u.deg)

@@ -32,6 +32,9 @@ def add_scene_arguments(parser: argparse.ArgumentParser, span_default: str, pert
     run.add_argument("--perturbers", nargs="+", default=list(perturbers_default), metavar="BODY",
                      help=f"bodies whose torque may act (default: {' '.join(perturbers_default)}); the planner "
                      "drops those that cannot matter and says why")
+    run.add_argument("--pa-threshold", nargs="+", default=["1", "deg"], metavar="ANGLE",
+                     help="wobble amplitude up to which a state is a principal-axis rotator (PA: one sidereal period; "
+                     "above it SAM/LAM with P_psi, P_phi), e.g. '0.1 deg'; default 1 deg (docs/design.md 'PA or NPA')")
     run.add_argument("--plan", action="store_true", help="print the plan (decisions and reasons) and stop")
     run.add_argument("--no-skip", action="store_true",
                      help="run the reference plan: every perturber, the orbits as given, nothing skipped")
@@ -52,6 +55,7 @@ def check_run_options(args, max_days: float):
     import astropy.units as u
 
     tolerance(args)
+    pa_threshold(args)
     span = check.quantity(_where(args, "--span"), args.span, "d", "4 d", default_unit="d", low=0.0, high=max_days,
                           low_open=True)
     days = span.to_value(u.day)
@@ -80,6 +84,14 @@ def tolerance(args):
     """The --tolerance angle, in the range the Scene accepts (checked here, before the orbit is built)."""
     return check.quantity(_where(args, "--tolerance"), args.tolerance, "rad", "1 arcsec", default_unit="arcsec",
                           low=1e-12, high=0.1, advice="That is 2e-7 to 2e4 arcsec.")
+
+
+def pa_threshold(args):
+    """The --pa-threshold angle, checked to lie in [0°, 90°) (before the orbit is built): at 90° the separatrix
+    would be PA."""
+    return check.quantity(_where(args, "--pa-threshold"), getattr(args, "pa_threshold", ["1", "deg"]), "deg", "1 deg",
+                          default_unit="deg", low=0.0, high=90.0, high_open=True,
+                          advice="It is the wobble amplitude up to which a state is a principal-axis rotator.")
 
 
 def run_scene(scene, args):
@@ -143,7 +155,8 @@ def run_and_report(args, state, start, times, orbit, name: str, title: str, peri
     """Build the Scene from the shared options, run it (or print its plan), print the summary, write files."""
     from spinorbit.scene import Scene
 
-    scene = Scene(state, start, times, perturbers=tuple(args.perturbers), orbit=orbit, tolerance=tolerance(args))
+    scene = Scene(state, start, times, perturbers=tuple(args.perturbers), orbit=orbit, tolerance=tolerance(args),
+                  pa_threshold=pa_threshold(args))
     result = run_scene(scene, args)
     if result is not None:
         for line in summary(result, period_unit, args.plan_seconds):
@@ -159,13 +172,9 @@ def summary(result, period_unit: str, plan_seconds: float = 0.0) -> list[str]:
     plan, table = result.plan, result.table
     lines = [f"plan               {plan.route}, orbits from {plan.orbit_source}, integrator {plan.integrator}",
              f"perturbers         kept {', '.join(plan.kept) or 'none'}; dropped {', '.join(plan.dropped) or 'none'}"]
-    if "P_psi" in table.colnames:
+    if "rotation_class" in table.colnames:
         for label, row in (("first", table[0]), ("last", table[-1])):
-            lines.append(f"{label:5s} {row['time'].tdb.iso[:16]} TDB  {row['mode']:3s}  "
-                         f"P_psi = {row['P_psi'].to_value(period_unit):9.4f} {period_unit}  "
-                         f"P_phi = {row['P_phi'].to_value(period_unit):9.4f} {period_unit}  "
-                         f"P_sid = {row['sidereal_period'].to_value(period_unit):9.4f} {period_unit}  "
-                         f"E/E0 = {row['energy_ratio']:.5f}")
+            lines.append(f"{label:5s} {row['time'].tdb.iso[:16]} TDB  {motion_line(row, period_unit)}")
     parts = ", ".join(f"{k} {v.to_value(u.arcsec):.2g}" for k, v in result.error_parts.items())
     lines.append(f"wall time          {plan_seconds + result.wall_seconds:.2f} s (plan {plan_seconds:.2f} s, "
                  f"run {result.wall_seconds:.2f} s)")
@@ -175,6 +184,31 @@ def summary(result, period_unit: str, plan_seconds: float = 0.0) -> list[str]:
                      f"{result.plan.tolerance_rad * 206264.80624709636:.3g} arcsec (long spans: the integration "
                      "error of double precision grows with the number of rotations); loosen --tolerance or shorten --span")
     return lines
+
+
+def motion_line(row, period_unit: str) -> str:
+    """A table row's motion as an observer reports it: "PA, P = 8.0000 h" for a principal-axis rotator, else
+    "SAM, P_psi = …, P_phi = …, P_sid = …"; then the wobble amplitude and E/E0."""
+    import astropy.units as u
+
+    def hours(name):
+        return f"{u.Quantity(getattr(row[name], 'unmasked', row[name])).to_value(period_unit):.4f} {period_unit}"
+
+    if row["rotation_class"] == "PA":
+        periods = f"PA, P = {hours('sidereal_period')}"
+    else:
+        periods = (f"{row['rotation_class']}, P_psi = {hours('P_psi')}, P_phi = {hours('P_phi')}, "
+                   f"P_sid = {hours('sidereal_period')}")
+    wobble = u.Quantity(row["wobble_amplitude"]).to_value(u.deg)
+    return f"{periods}  wobble {wobble:.3g} deg  E/E0 = {row['energy_ratio']:.5f}"
+
+
+def state_motion_line(state, threshold, period_unit: str) -> str:
+    """:func:`motion_line` of a RotationState (the state a command starts from), at ``threshold``."""
+    p_psi, p_phi = state.periods
+    return motion_line({"rotation_class": state.rotation_class(threshold), "sidereal_period": state.sidereal_period,
+                        "P_psi": p_psi, "P_phi": p_phi, "wobble_amplitude": state.wobble_amplitude,
+                        "energy_ratio": state.energy_ratio}, period_unit)
 
 
 def ecsv_table(result, name: str, period_unit: str = "h"):

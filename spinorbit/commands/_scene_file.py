@@ -66,6 +66,8 @@ SCHEMA = {
         "end_only": check.boolean,
         "perturbers": lambda where, value: check.names(where, value, "['sun', 'earth']"),
         "tolerance": lambda where, value: check.quantity(where, value, "arcsec", "1 arcsec", low=0.0, low_open=True),
+        "pa_threshold": lambda where, value: check.quantity(where, value, "deg", "1 deg", low=0.0, high=90.0,
+                                                            high_open=True),
         "output": lambda where, value: check.text(where, value, "example_nea.ecsv"),
         "plot": lambda where, value: check.text(where, value, "example_nea.png"),
     },

@@ -13,7 +13,8 @@ import argparse
 from spinorbit.commands import _inputs as check
 from spinorbit.commands._common import check_outputs, number
 from spinorbit.commands._scene_file import read_scene_file
-from spinorbit.commands._scene_command import add_scene_arguments, check_run_options, run_and_report, span_and_times
+from spinorbit.commands._scene_command import (add_scene_arguments, check_run_options, pa_threshold, run_and_report,
+                                               span_and_times, state_motion_line)
 
 NAME = "asteroid"
 SUMMARY = "your own asteroid: orbit from elements, moments, spin state at an epoch (planned scene, TOML or options)"
@@ -44,7 +45,7 @@ MAX_SPAN_DAYS = 50 * 365.25
 #: Options read as plain numbers and their units (the TOML file takes any astropy unit instead).
 ELEMENT_UNITS = ("au", "", "deg", "deg", "deg", "deg")
 #: The [run] keys and the options they stand for (an option given on the command line wins).
-RUN_OPTIONS = ("span", "n_times", "end_only", "perturbers", "tolerance", "output", "plot")
+RUN_OPTIONS = ("span", "n_times", "end_only", "perturbers", "tolerance", "pa_threshold", "output", "plot")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -139,7 +140,7 @@ def _apply_run_table(args, parser_defaults, run_table):
         if key not in run_table or getattr(args, key) != parser_defaults.get(key):
             continue  # not in the file, or given on the command line
         value = run_table[key]
-        if key in ("span", "tolerance"):
+        if key in ("span", "tolerance", "pa_threshold"):
             value = [repr(float(value.value)), *value.unit.to_string().split()]
         setattr(args, key, value)
         args.sources[f"--{key.replace('_', '-')}"] = f"[run] {key}"
@@ -156,8 +157,7 @@ def run(args) -> int:
     name, orbit, state, epoch, start = scene_inputs(args, scene)
     span, times = span_and_times(args, start, MAX_SPAN_DAYS)
     print(f"orbit              {orbit.description}")
-    print(f"spin state         at {epoch.tdb.iso[:19]} TDB: mode {state.mode}, "
-          f"P_psi = {state.periods[0].to_value('h'):.4f} h, P_phi = {state.periods[1].to_value('h'):.4f} h")
+    print(f"spin state         at {epoch.tdb.iso[:19]} TDB: {state_motion_line(state, pa_threshold(args), 'h')}")
     from spinorbit.cli import CommandError
     from spinorbit.ephemeris import EphemerisRangeError
 

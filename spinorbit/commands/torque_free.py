@@ -16,8 +16,9 @@ DESCRIPTION = """\
 Propagate the free rotation of a rigid body exactly (Fukushima's canonical elements: no numerical
 integration, no step-size error). Give the principal moments about the body x, y, z axes (kg m^2 or
 plain ratios, any order), the body angular velocity, and optionally the attitude as 3-1-3 Euler
-angles. Prints the rotation mode (SAM/LAM), its sense, the periods P_psi (rotation) and P_phi
-(precession) and E/E0; writes the attitude and spin at each output time to an ECSV table.
+angles. Prints the rotation mode (SAM/LAM), its sense, the rotation class (PA when the wobble
+amplitude is at most --pa-threshold: then one sidereal period P; else the periods P_psi (rotation)
+and P_phi (precession)) and E/E0; writes the attitude and spin at each output time to an ECSV table.
 
 Conventions (docs/conventions.md): quaternions are scalar first (w, x, y, z) and take body axes to
 inertial axes; Euler angles are passive 3-1-3, R = R3(psi) R1(theta) R3(phi), inertial -> body."""
@@ -80,6 +81,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--span", nargs="+", default=["100", "d"], metavar="SPAN",
         help="how long to propagate, e.g. '100 d', '2 yr', '36 h' (a number alone is days; default 100 d); "
         "negative goes back in time",
+    )
+    body.add_argument(
+        "--pa-threshold", nargs="+", default=["1", "deg"], metavar="ANGLE",
+        help="wobble amplitude up to which the state is a principal-axis rotator (PA: one sidereal period; above "
+        "it SAM/LAM with P_psi, P_phi), e.g. '0.1 deg'; default 1 deg (docs/design.md 'PA or NPA')",
     )
     spacing = times.add_mutually_exclusive_group()
     spacing.add_argument("--step", nargs="+", metavar="STEP", help="spacing of output times, e.g. '1 d' (default 1 d)")
@@ -145,18 +151,26 @@ def _state(args):
     return RotationState.from_euler313(body, phi, theta, psi, omega), omega_unit
 
 
-def _summary(state) -> list[str]:
-    p_psi, p_phi = state.periods
+def _summary(state, threshold) -> list[str]:
     big_a, big_b, big_c = state.body.principal_moments
-    return [
+    rotation_class = state.rotation_class(threshold)
+    lines = [
         f"principal moments  A, B, C = {big_a:.6g}, {big_b:.6g}, {big_c:.6g}",
         f"mode               {state.mode}, sense {state.sense}",
-        f"periods            P_psi = {p_psi.to_value('d'):.4f} d (rotation), "
-        f"P_phi = {p_phi.to_value('d'):.4f} d (precession)",
-        f"sidereal period    {state.sidereal_period.to_value('d'):.4f} d (2π/|ω| for principal-axis rotation; "
-        "docs/conventions.md, 'Periods')",
-        f"E/E0               {state.energy_ratio:.6f}",
+        f"rotation class     {rotation_class}: wobble amplitude {state.wobble_amplitude.to_value('deg'):.4g} deg "
+        f"({'at most' if rotation_class == 'PA' else 'more than'} --pa-threshold {threshold:g}; docs/conventions.md, "
+        "'Wobble and rotation class')",
     ]
+    if rotation_class == "PA":  # one rotation: its split into a wobble below the threshold and a spin is not reported
+        lines.append(f"period             P = {state.sidereal_period.to_value('d'):.4f} d (sidereal, principal-axis "
+                     "rotator)")
+    else:
+        p_psi, p_phi = state.periods
+        lines += [f"periods            P_psi = {p_psi.to_value('d'):.4f} d (rotation), "
+                  f"P_phi = {p_phi.to_value('d'):.4f} d (precession)",
+                  f"sidereal period    {state.sidereal_period.to_value('d'):.4f} d (docs/conventions.md, 'Periods')"]
+    lines.append(f"E/E0               {state.energy_ratio:.6f}")
+    return lines
 
 
 def _propagate(state, offsets):
@@ -186,13 +200,20 @@ def _continuous(quaternions):
     return quaternions
 
 
-def _table(args, state, epoch, offsets, quaternions, omegas, omega_unit):
+def _pa_threshold(args):
+    """The --pa-threshold angle, checked to lie in [0°, 90°) (at 90° the separatrix would be PA)."""
+    return check.quantity("--pa-threshold", args.pa_threshold, "deg", "1 deg", default_unit="deg", low=0.0, high=90.0,
+                          high_open=True, advice="It is the wobble amplitude up to which a state is a principal-axis "
+                          "rotator.")
+
+
+def _table(args, state, epoch, offsets, quaternions, omegas, omega_unit, threshold):
     """The output schema's table (docs/conventions.md, "Output tables") of the run, with the inputs in meta."""
     import astropy.units as u
     from astropy.table import Table
 
     from spinorbit import __version__
-    from spinorbit.state_table import as_schema_time, schema_meta, table_columns
+    from spinorbit.state_table import as_schema_time, classify_rows, schema_meta, table_columns
 
     p_psi, p_phi = state.periods
     table = Table()
@@ -201,6 +222,7 @@ def _table(args, state, epoch, offsets, quaternions, omegas, omega_unit):
     for name, column in columns.items():
         table[name] = column
     table.meta.update(schema_meta(epoch, "exact torque-free rotation (Fukushima's canonical elements, paper eq. 12)"))
+    classify_rows(table, threshold)
     table.meta.update({
         "software": f"spinorbit {__version__} torque-free",
         "moments_xyz": list(args.moments),
@@ -212,6 +234,8 @@ def _table(args, state, epoch, offsets, quaternions, omegas, omega_unit):
         "P_psi_d": float(p_psi.to_value(u.day)),
         "P_phi_d": float(p_phi.to_value(u.day)),
         "sidereal_period_d": float(state.sidereal_period.to_value(u.day)),
+        "wobble_amplitude_deg": float(state.wobble_amplitude.to_value(u.deg)),
+        "rotation_class": state.rotation_class(threshold),
         "E_over_E0": state.energy_ratio,
         "conventions": (
             "quaternion scalar first (w, x, y, z), body axes -> inertial (ICRF), sign continuous in time; "
@@ -244,10 +268,11 @@ def run(args) -> int:
     offsets = _offsets(args)
     epoch = _epoch(args.epoch, offsets)
     state, omega_unit = _state(args)
-    for line in _summary(state):
+    threshold = _pa_threshold(args)
+    for line in _summary(state, threshold):
         print(line)
     quaternions, omegas = _propagate(state, offsets)
-    table = _table(args, state, epoch, offsets, quaternions, omegas, omega_unit)
+    table = _table(args, state, epoch, offsets, quaternions, omegas, omega_unit, threshold)
     span = f"{offsets[-1]:g} d"
     if args.output is not None:
         write_table_output(args.output, table, f"{len(table)} rows over {span}")

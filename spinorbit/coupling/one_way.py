@@ -27,7 +27,9 @@ from astropy.table import QTable
 from spinorbit.core.dynamics.equations import make_model
 from spinorbit.core.integrators.quaternion import integrate_quaternion
 from spinorbit.state import RotationState
-from spinorbit.state_table import from_principal, schema_meta, table_columns, time_column, unit_quaternions
+from spinorbit.spin_forms import PA_MAX_WOBBLE
+from spinorbit.state_table import (classify_rows, from_principal, schema_meta, table_columns, time_column,
+                                   unit_quaternions)
 from spinorbit.time import tdb_days
 
 __all__ = ["DEFAULT_RTOL", "INTEGRATORS", "closest_approaches", "heliocentric_normals", "integrate_one_way",
@@ -76,7 +78,7 @@ def closest_approaches(samples):
 
 
 def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=True, integrator="quaternion",
-                      extra_sources=(), orbit_normals=None):
+                      extra_sources=(), orbit_normals=None, pa_threshold=PA_MAX_WOBBLE):
     """Integrate the rotation of ``state`` under the sampled perturbers' torques.
 
     Parameters
@@ -95,8 +97,8 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
         Local tolerance of the integrator: DOP853's rtol ("quaternion", "elements") or the Taylor
         method's ``tol`` ("taylor"; both are local errors per step, relative per component group).
     periods : bool
-        Also compute the instantaneous (osculating, torque-free) P_ψ, P_φ, mode and E/E0 of every
-        output state.
+        Also compute the instantaneous (osculating, torque-free) P_ψ, P_φ, mode, E/E0, wobble amplitude
+        and rotation class of every output state.
     integrator : {"quaternion", "elements", "taylor"}
         :func:`~spinorbit.core.integrators.quaternion.integrate_quaternion` (default; non-singular),
         :func:`~spinorbit.core.integrators.elements.integrate_elements` (canonical elements, paper
@@ -109,6 +111,9 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
     orbit_normals : ndarray (N, 3), optional
         ICRF normals of the body's heliocentric orbit plane at ``times`` for the ``obliquity`` column;
         by default :func:`heliocentric_normals` of ``samples`` when they hold the Sun (else no column).
+    pa_threshold : Quantity
+        Wobble amplitude (angle) up to which a row is a principal-axis rotator, "PA", with P_ψ, P_φ masked
+        (:func:`spinorbit.state_table.classify_rows`; default 1°, ``docs/design.md``, "PA or NPA").
 
     Returns
     -------
@@ -117,7 +122,8 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
         :func:`spinorbit.state_table.table_columns`): ``time`` (Time, TDB), ``q_w, q_x, q_y, q_z``
         (scalar first, user body axes → ICRF), ``omega_x, omega_y, omega_z`` (rad/day, user body axes),
         ``pole_ra, pole_dec, pole_lon, pole_lat`` (deg), ``obliquity`` (deg, with orbit normals); with
-        ``periods``: ``mode``, ``energy_ratio`` (E/E0), ``P_psi``, ``P_phi``, ``sidereal_period`` (h).
+        ``periods``: ``mode``, ``energy_ratio`` (E/E0), ``P_psi``, ``P_phi``, ``sidereal_period`` (h),
+        ``wobble_amplitude`` (deg), ``rotation_class``.
         ``table.meta`` names ``epoch``, ``frame``, ``model`` and ``spinorbit_version``, and holds the
         integrator statistics and the sampling error estimate: DOP853's
         ``accepted``, ``rejected``, ``rhs_calls``; the Taylor method's ``steps``, ``order`` and
@@ -129,7 +135,8 @@ def propagate_one_way(state, epoch, times, samples, rtol=DEFAULT_RTOL, periods=T
         raise TypeError(f"state must be a spinorbit.RotationState, got {type(state).__name__}.")
     t0, t_out = one_way_days(epoch, times)
     ys, stats = integrate_one_way(state, t0, t_out, samples, rtol, integrator, extra_sources)
-    return one_way_table(state.body, epoch, t_out, ys, stats, samples, rtol, integrator, periods, orbit_normals)
+    return one_way_table(state.body, epoch, t_out, ys, stats, samples, rtol, integrator, periods, orbit_normals,
+                         pa_threshold)
 
 
 def one_way_days(epoch, times):
@@ -180,7 +187,8 @@ def one_way_quaternions(body, ys):
     return unit_quaternions(np.atleast_2d(np.asarray(quaternions, dtype=float)))
 
 
-def one_way_table(body, epoch, t_out, ys, stats, samples, rtol, integrator, periods=True, orbit_normals=None):
+def one_way_table(body, epoch, t_out, ys, stats, samples, rtol, integrator, periods=True, orbit_normals=None,
+                  pa_threshold=PA_MAX_WOBBLE):
     """:func:`propagate_one_way`'s table of the core rows ``ys`` at ``t_out`` (from :func:`integrate_one_way`)."""
     if orbit_normals is None:
         orbit_normals = heliocentric_normals(samples, t_out)
@@ -190,6 +198,7 @@ def one_way_table(body, epoch, t_out, ys, stats, samples, rtol, integrator, peri
                                  orbit_normals=orbit_normals))
     table = QTable(columns)  # all columns in one go: astropy's per-column insertion costs ~30 µs a column
     table.meta.update(schema_meta(epoch, f"one-way rotation under sampled torques ({integrator})"))
+    classify_rows(table, pa_threshold)
     table.meta.update(stats)
     table.meta["rtol"] = rtol
     table.meta["integrator"] = integrator

@@ -54,6 +54,7 @@ from spinorbit.scene.plan import Plan
 from spinorbit.scene.planning import plan_scene
 from spinorbit.scene.routes import run_coupled, run_one_way, run_torque_free, scene_orbit_normals
 from spinorbit.scene.sampling import SharedSamples, grid_of_samples, sample_perturbers
+from spinorbit.spin_forms import PA_MAX_WOBBLE, SpinFormError, wobble_threshold_deg
 
 __all__ = ["Scene", "SceneResult"]
 
@@ -88,7 +89,8 @@ class SceneResult:
         (rad/day, user body axes), ``pole_ra, pole_dec`` (deg, ICRF), ``pole_lon, pole_lat`` (deg,
         ecliptic J2000), ``obliquity`` (deg, to the osculating heliocentric orbit plane; with an
         orbit); with "periods" asked: ``mode``, ``energy_ratio``, ``P_psi``, ``P_phi``,
-        ``sidereal_period`` (h). ``table.meta`` names ``epoch``, ``frame``, ``model``,
+        ``sidereal_period`` (h), ``wobble_amplitude`` (deg) and ``rotation_class`` ("PA" rows have P_psi,
+        P_phi masked; ``pa_threshold``). ``table.meta`` names ``epoch``, ``frame``, ``model``,
         ``spinorbit_version`` and ``columns``. Only the quantities asked for are filled in beyond
         time, attitude and pole. Each row holds what its RotationState would give
         (:func:`spinorbit.state_table.table_columns`, all rows at once); on the torque-free route
@@ -169,6 +171,10 @@ class Scene:
     thermal_route : {"auto", "full", "mean"}
         "auto" lets the planner choose between the full integration and the mean YORP run; the
         others force one.
+    pa_threshold : Quantity
+        Wobble amplitude (an angle in [0°, 90°)) up to which a row of the table is a principal-axis
+        rotator: ``rotation_class`` "PA", P_ψ and P_φ masked (:func:`spinorbit.state_table.classify_rows`).
+        Default 1° (:data:`spinorbit.spin_forms.PA_MAX_WOBBLE`; why: ``docs/design.md``, "PA or NPA").
 
     Raises
     ------
@@ -178,16 +184,21 @@ class Scene:
 
     def __init__(self, state, epoch=None, times=None, perturbers=(), orbit=None, tolerance=1 * u.arcsec,
                  quantities=QUANTITIES, integrator="auto", sample_tolerance=1e-10, thermal=None,
-                 thermal_route="auto"):
+                 thermal_route="auto", pa_threshold=PA_MAX_WOBBLE):
         self.members, self._cache = None, None  # _cache: the SharedSamples of the plan() / run() under way
         self._report_planning = None  # plan()'s progress callback while it plans
         self.thermal, self.thermal_route = thermal, thermal_route
+        try:  # refused here, not after the run
+            wobble_threshold_deg(pa_threshold, "pa_threshold")
+        except SpinFormError as error:
+            raise SceneError(str(error)) from None
+        self.pa_threshold = pa_threshold
         if isinstance(state, (list, tuple, dict)):
             from spinorbit.scene import many
 
             def make(member_state, member_orbit):
                 return Scene(member_state, epoch, times, perturbers, member_orbit, tolerance, quantities, integrator,
-                             sample_tolerance, thermal, thermal_route)
+                             sample_tolerance, thermal, thermal_route, pa_threshold)
 
             self.members = many.members(state, orbit, make)
             self.epoch, self.times, self.tolerance_rad, self.output_days, self.epoch_day = (
@@ -216,7 +227,8 @@ class Scene:
 
             def make(leg_state, leg_epoch, leg_times, leg_perturbers, leg_orbit):
                 return Scene(leg_state, leg_epoch, leg_times, leg_perturbers, leg_orbit, tolerance,
-                             tuple(dict.fromkeys(("omega", *self.quantities))), integrator, sample_tolerance)
+                             tuple(dict.fromkeys(("omega", *self.quantities))), integrator, sample_tolerance,
+                             pa_threshold=pa_threshold)
 
             epochs.split_legs(self, make, perturbers, orbit)
 
@@ -325,7 +337,7 @@ class Scene:
 
     def _complete_table(self, table, plan):
         """The output schema's obliquity (when the run has an orbit) and metadata, whatever the route."""
-        from spinorbit.state_table import add_obliquity, schema_meta
+        from spinorbit.state_table import add_obliquity, classify_rows, schema_meta
 
         if self.orbit is not None and "obliquity" not in table.colnames:
             normals, why_not = scene_orbit_normals(self, plan)
@@ -337,6 +349,7 @@ class Scene:
         meta = schema_meta(self.epoch, f"Scene, route {plan.route}, orbits from {plan.orbit_source}, "
                                        f"integrator {plan.integrator}, torques of {kept}")
         table.meta.update({k: v for k, v in meta.items() if k not in table.meta or k in ("model", "epoch")})
+        classify_rows(table, self.pa_threshold)
         if "obliquity" in table.colnames and "mode" in table.colnames:  # the schema's order: before the motion
             column = table["obliquity"]
             table.remove_column("obliquity")

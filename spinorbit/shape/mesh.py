@@ -42,7 +42,7 @@ class Shape:
     Parameters
     ----------
     vertices : Quantity, shape (n, 3)
-        Vertex positions (length; plain numbers are read in km).
+        Vertex positions, a length Quantity (``vertices_km * u.km``; a bare array is refused).
     faces : array_like of int, shape (m, 3)
         Vertex indices (from 0) of each triangle, counter-clockwise seen from outside.
     name : str, optional
@@ -60,7 +60,7 @@ class Shape:
     _vertices_km: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        values = value_in("vertices", self.vertices, u.km, "np.array([[x, y, z], ...]) * u.km", plain_unit=u.km)
+        values = value_in("vertices", self.vertices, u.km, "np.array([[x, y, z], ...]) * u.km")
         vertices, faces = check_closed_mesh(values, self.faces)
         vertices.flags.writeable = False
         faces.flags.writeable = False
@@ -127,8 +127,9 @@ def _midpoint(vertices, cache, i, j):
 
 
 def directions_to_shape(directions, faces, radii, name=None):
-    """A star-shaped Shape: vertex k at radii[k] · directions[k] (km)."""
-    return Shape(directions * np.asarray(radii, dtype=float)[..., None] * u.km, faces, name=name)
+    """A star-shaped Shape: vertex k at radii[k] · directions[k] (unit ``directions``, ``radii`` a length Quantity)."""
+    lengths = value_in("radii", radii, u.km, "np.ones(len(directions)) * u.km")
+    return Shape(directions * np.asarray(lengths, dtype=float)[..., None] * u.km, faces, name=name)
 
 
 def box_shape(half_sides, name=None):
@@ -145,7 +146,7 @@ def box_shape(half_sides, name=None):
         Vertex k at (±h_x, ±h_y, ±h_z) with the signs of the bits of k (4: x, 2: y, 1: z); faces 2j
         and 2j + 1 are the two triangles (c0, c1, c2), (c0, c2, c3) of the box's j-th side c0..c3.
     """
-    half = value_in("half_sides", half_sides, u.km, "[1.5, 1.0, 0.7] * u.km", plain_unit=u.km, shape=(3,))
+    half = value_in("half_sides", half_sides, u.km, "[1.5, 1.0, 0.7] * u.km", shape=(3,))
     if np.any(half <= 0):
         raise ValueError(f"half_sides: expected three positive lengths; got {half.tolist()} km.")
     signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
@@ -180,7 +181,7 @@ def ellipsoid_shape(semi_axes, subdivisions=3, name=None):
     Shape
         Vertices on the ellipsoid; symmetric under x → −x, y → −y and z → −z.
     """
-    axes = value_in("semi_axes", semi_axes, u.km, "[1.0, 0.8, 0.6] * u.km", plain_unit=u.km, shape=(3,))
+    axes = value_in("semi_axes", semi_axes, u.km, "[1.0, 0.8, 0.6] * u.km", shape=(3,))
     if np.any(axes <= 0):
         raise ValueError(f"semi_axes: expected three positive lengths; got {axes.tolist()} km.")
     directions, faces = icosphere(subdivisions)
@@ -210,7 +211,7 @@ def gaussian_random_sphere(radius, sigma, seed, nu=4.0, degree_max=10, subdivisi
     -------
     Shape
     """
-    mean_radius = value_in("radius", radius, u.km, "1.0 * u.km", plain_unit=u.km, shape=())
+    mean_radius = value_in("radius", radius, u.km, "1.0 * u.km", shape=())
     if not (mean_radius > 0 and sigma > 0 and degree_max >= 2):
         raise ValueError(f"gaussian_random_sphere: expected radius > 0, sigma > 0 and degree_max ≥ 2; got radius "
                          f"{mean_radius!r} km, sigma {sigma!r}, degree_max {degree_max!r}.")
@@ -233,7 +234,7 @@ def gaussian_random_sphere(radius, sigma, seed, nu=4.0, degree_max=10, subdivisi
             if m > 0:
                 field_values += spread * norm * rng.standard_normal() * sin_part[n, m]
     radii = mean_radius * np.exp(field_values - 0.5 * beta2)
-    return directions_to_shape(directions, faces, radii, name=name or f"gaussian random sphere (seed {seed})")
+    return directions_to_shape(directions, faces, radii * u.km, name=name or f"gaussian random sphere (seed {seed})")
 
 
 def voxel_shape(occupied, pitch, name=None):
@@ -262,7 +263,7 @@ def voxel_shape(occupied, pitch, name=None):
     if grid.ndim != 3 or grid.dtype != bool or not grid.any():
         raise ValueError(f"occupied: expected a 3-d boolean array with at least one True voxel; got shape "
                          f"{grid.shape}, dtype {grid.dtype}.")
-    size = value_in("pitch", pitch, u.km, "0.1 * u.km", plain_unit=u.km, shape=())
+    size = value_in("pitch", pitch, u.km, "0.1 * u.km", shape=())
     if not size > 0:
         raise ValueError(f"pitch: expected a positive length; got {size!r} km.")
     padded = np.pad(grid, 1)

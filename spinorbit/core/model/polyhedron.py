@@ -38,6 +38,10 @@ __all__ = [
 #: A face whose area is below this fraction of the mesh's squared size is degenerate: its normal is
 #: rounding noise (a sliver with area ~1e-16 L² has no direction).
 DEGENERATE_AREA_FRACTION = 1e-14
+#: Sizes and coordinates a mesh may have (in its own length unit): its second moments are fifth powers of
+#: its size and its degree-4 Stokes sums seventh powers, which stay inside double precision for sizes
+#: within 1e±40 (1e280 ≪ 1.8e308); nothing physical in any length unit comes near either end.
+MESH_SIZE_RANGE = (1e-40, 1e40)
 #: Degree of the tetrahedron rule; 5 ≥ 4, the highest Stokes degree, so every integral is exact.
 RULE_DEGREE = 5
 
@@ -90,8 +94,15 @@ def check_closed_mesh(vertices, faces):
     if repeated.size:
         raise InvalidMeshError(f"faces {repeated[:5].tolist()} repeat a vertex: a triangle needs three distinct "
                                "vertices. Remove them from the mesh.")
+    scale = float(np.ptp(vertices, axis=0).max())
+    reach = float(np.abs(vertices).max())
+    if not (MESH_SIZE_RANGE[0] <= scale and reach <= MESH_SIZE_RANGE[1]):
+        raise InvalidMeshError(
+            f"vertices: the mesh spans {scale:.4g} with coordinates up to {reach:.4g} (its length unit), outside "
+            f"[{MESH_SIZE_RANGE[0]:g}, {MESH_SIZE_RANGE[1]:g}]: its second moments (size⁵) and Stokes sums would "
+            "overflow or underflow double precision. Give the vertices in a length unit that makes them "
+            "ordinary numbers (a Shape takes any length Quantity).")
     _, areas, _ = face_geometry(vertices, faces)
-    scale = np.ptp(vertices, axis=0).max()
     degenerate = np.nonzero(areas <= DEGENERATE_AREA_FRACTION * scale * scale)[0]
     if degenerate.size:
         raise InvalidMeshError(f"faces {degenerate[:5].tolist()} ({degenerate.size} in all) have zero area "

@@ -9,7 +9,7 @@ Regenerates the section "accuracy_photometry" of ``docs/photometry.md``:
 3. the ray-traced facet sum of two non-convex shapes against brute force (every sample point's rays
    against every triangle, numpy) and an L-shaped block's shadow against its closed form.
 
-Run: ``python benchmarks/accuracy_photometry.py`` (≈ 1 min).
+Run: ``PYTHONPATH=$PWD python benchmarks/accuracy_photometry.py [--no-write]`` (≈ 1 min).
 """
 
 from __future__ import annotations
@@ -117,6 +117,12 @@ def markdown():
 
 
 if __name__ == "__main__":
+    import argparse
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--no-write", action="store_true", help="print only, do not touch docs/photometry.md")
+    args = parser.parse_args()
     text = markdown()
     print(text)
-    print(f"wrote {write_section('accuracy_photometry', text, page='photometry.md')}")
+    if not args.no_write:
+        print(f"wrote {write_section('accuracy_photometry', text, page='photometry.md')}")

@@ -9,6 +9,7 @@ numbers in those sections come from this script only.
 Usage::
 
     PYTHONPATH=$PWD python benchmarks/cli_examples.py            # ≈ 60 s
+    PYTHONPATH=$PWD python benchmarks/cli_examples.py --only didymos   # one command's section
 """
 
 from __future__ import annotations
@@ -40,35 +41,52 @@ def printed(argv):
 
 
 def main():
-    write = "--no-write" not in sys.argv[1:] and "--quick" not in sys.argv[1:]  # --quick: print only
+    import argparse
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--no-write", action="store_true", help="print only")
+    parser.add_argument("--quick", action="store_true", help="print only, with a short didymos run")
+    parser.add_argument("--only", choices=("apophis", "asteroid", "toutatis", "didymos"), default=None,
+                        help="run and write one command's section only")
+    args = parser.parse_args()
+    write = not (args.no_write or args.quick)
+    wanted = {"apophis", "asteroid", "toutatis", "didymos"} if args.only is None else {args.only}
     scene = ROOT / "examples" / "asteroid_scene.toml"
     with tempfile.TemporaryDirectory() as work:
         here = os.getcwd()
         os.chdir(work)  # the scene file's outputs land here, not in the checkout
         try:
-            apophis = [(span, printed(["apophis", "--span", span, "d"])) for span in ("4", "4.1", "6", "10")]
-            asteroid = printed(["asteroid", "--scene", str(scene)])
-            toutatis = printed(["toutatis", "--plan", "--span", "0.01", "d", "--tolerance", "100", "arcsec"])
-            didymos = printed(["didymos", "--impact"] + ([] if write else ["--orbits", "10"]))
+            apophis = ([(span, printed(["apophis", "--span", span, "d"])) for span in ("4", "4.1", "6", "10")]
+                       if "apophis" in wanted else [])
+            asteroid = printed(["asteroid", "--scene", str(scene)]) if "asteroid" in wanted else None
+            toutatis = (printed(["toutatis", "--plan", "--span", "0.01", "d", "--tolerance", "100", "arcsec"])
+                        if "toutatis" in wanted else None)
+            didymos = (printed(["didymos", "--impact"] + ([] if write else ["--orbits", "10"]))
+                       if "didymos" in wanted else None)
         finally:
             os.chdir(here)
     blocks = [machine_line(), "`PYTHONPATH=$PWD python benchmarks/cli_examples.py`:", ""]
     for span, text in apophis:
         blocks += [f"```text\n$ spinorbit apophis --span {span} d\n{text}\n```", ""]
-    print("\n".join(blocks))
-    print(asteroid)
+    for text in ("\n".join(blocks) if apophis else None, asteroid, toutatis, didymos):
+        if text is not None:
+            print(text)
     if not write:
         return
-    write_section("cli_apophis", "\n".join(blocks), page="cli.md")
-    write_section("cli_asteroid", "\n".join([machine_line(), "`PYTHONPATH=$PWD python benchmarks/cli_examples.py`:", "",
-                                             f"```text\n$ spinorbit asteroid --scene examples/asteroid_scene.toml\n"
-                                             f"{asteroid}\n```"]), page="cli.md")
-    write_section("cli_toutatis_plan", "\n".join([
-        machine_line(), "`PYTHONPATH=$PWD python benchmarks/cli_examples.py`:", "",
-        f"```text\n$ spinorbit toutatis --plan --span 0.01 d --tolerance 100 arcsec\n{toutatis}\n```"]), page="cli.md")
-    write_section("cli_didymos", "\n".join([
-        machine_line(), "`PYTHONPATH=$PWD python benchmarks/cli_examples.py`:", "",
-        f"```text\n$ spinorbit didymos --impact\n{didymos}\n```"]), page="cli.md")
+    if apophis:
+        write_section("cli_apophis", "\n".join(blocks), page="cli.md")
+    if asteroid is not None:
+        write_section("cli_asteroid", "\n".join([machine_line(), "`PYTHONPATH=$PWD python benchmarks/cli_examples.py`:",
+                                                 "", f"```text\n$ spinorbit asteroid --scene examples/asteroid_scene.toml\n"
+                                                 f"{asteroid}\n```"]), page="cli.md")
+    if toutatis is not None:
+        write_section("cli_toutatis_plan", "\n".join([
+            machine_line(), "`PYTHONPATH=$PWD python benchmarks/cli_examples.py`:", "",
+            f"```text\n$ spinorbit toutatis --plan --span 0.01 d --tolerance 100 arcsec\n{toutatis}\n```"]), page="cli.md")
+    if didymos is not None:
+        write_section("cli_didymos", "\n".join([
+            machine_line(), "`PYTHONPATH=$PWD python benchmarks/cli_examples.py --only didymos`:", "",
+            f"```text\n$ spinorbit didymos --impact\n{didymos}\n```"]), page="cli.md")
 
 
 if __name__ == "__main__":

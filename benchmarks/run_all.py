@@ -48,6 +48,7 @@ BENCHMARKS = (
     Benchmark("bench_rebound_forces.py", quick=("--no-write",)),
     Benchmark("bench_elliptic.py"),
     Benchmark("accuracy_elliptic.py"),
+    Benchmark("accuracy_photometry.py", quick=("--no-write",)),
     Benchmark("accuracy_symmetric_permanent.py", quick=("--no-write",)),
     Benchmark("accuracy_torque_free.py"),
     Benchmark("bench_torque_free.py"),

@@ -28,21 +28,26 @@ subclass for checks of the whole command and for output files) and the package's
 from __future__ import annotations
 
 import argparse
+import contextlib
 import gc
 import importlib
 import os
 import pkgutil
 import re
+import signal
 import sys
+import threading
 
 from spinorbit.core.errors import InputError
 
-__all__ = ["main", "console_main", "build_parser", "CommandError", "EXIT_USAGE"]
+__all__ = ["main", "console_main", "build_parser", "CommandError", "Terminated", "EXIT_USAGE"]
 
 #: Exit status for a run stopped by bad input (argparse's own convention).
 EXIT_USAGE = 2
 #: Exit status after Ctrl-C (128 + SIGINT), as shells report it.
 EXIT_INTERRUPTED = 130
+#: Exit status after SIGTERM (128 + SIGTERM), as shells report it.
+EXIT_TERMINATED = 143
 #: Exit status when stdout is closed early (128 + SIGPIPE), as shells report it.
 EXIT_BROKEN_PIPE = 141
 
@@ -60,6 +65,33 @@ class CommandError(InputError):
 
     def __reduce__(self):
         return type(self), (str(self),)
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM during a command, raised as an interrupt so that the command stops as after Ctrl-C.
+
+    A ``KeyboardInterrupt`` subclass: every clean-up that runs for Ctrl-C (an ensemble stopping its
+    workers, keeping its finished chunks) runs for SIGTERM too, and ``except Exception`` does not
+    swallow it.
+    """
+
+
+def _raise_terminated(signum, frame):
+    raise Terminated
+
+
+@contextlib.contextmanager
+def _sigterm_raises():
+    """SIGTERM raises :class:`Terminated` in the main thread for the length of the block (else the
+    process would die at once, leaving its worker processes and unfinished files)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 # What argparse must read as a negative number, not an option. Its own pattern (Python < 3.13) misses
@@ -153,22 +185,24 @@ def main(argv=None) -> int:
     Returns
     -------
     int
-        0 on success, 2 for bad input or an output that cannot be written, 130 after Ctrl-C, 141 if
-        stdout was closed early.
+        0 on success, 2 for bad input or an output that cannot be written, 130 after Ctrl-C (SIGINT),
+        143 after SIGTERM, 141 if stdout was closed early.
     """
     args = build_parser().parse_args(argv)
     from spinorbit.commands._compile_notice import compile_notice
 
     try:
-        with compile_notice():
+        with _sigterm_raises(), compile_notice():
             return args._run(args)
     except BrokenPipeError:
         # stdout was closed early (`spinorbit ... | head`): stop quietly, as Unix tools do on SIGPIPE.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return EXIT_BROKEN_PIPE
-    except KeyboardInterrupt:
-        print(f"{args._prog}: interrupted; no output was written for the unfinished run.", file=sys.stderr)
-        return EXIT_INTERRUPTED
+    except KeyboardInterrupt as interrupt:
+        how = "terminated (SIGTERM)" if isinstance(interrupt, Terminated) else "interrupted"
+        kept = f" {interrupt}" if str(interrupt) else ""  # what a command kept (an ensemble's finished chunks)
+        print(f"{args._prog}: {how}; no output was written for the unfinished run.{kept}", file=sys.stderr)
+        return EXIT_TERMINATED if isinstance(interrupt, Terminated) else EXIT_INTERRUPTED
     except Exception as error:
         if not isinstance(error, _input_errors()):
             raise

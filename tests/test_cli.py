@@ -162,7 +162,7 @@ BAD_INPUT = {
     "negative step": ([*VALID, "--step", "-1", "d"], "positive spacing"),
     "too many times": ([*VALID, "--span", "1e9", "d"], "output times"),
     "step and n-times": ([*VALID, "--step", "1", "--n-times", "5"], "not allowed with"),
-    "missing omega": (["--moments", "1", "2", "2.5"], "required: --omega"),
+    "missing omega": (["--moments", "1", "2", "2.5"], "the spin state is missing: give --euler313 with --omega"),
 }
 
 

@@ -89,6 +89,35 @@ def test_plot_shows_dates_periods_pole_obliquity_and_encounters(tmp_path, extens
             assert words in text or words.replace(" ", "") in text.replace(" ", ""), words
 
 
+def test_plot_of_a_principal_axis_rotator_shows_what_changed(tmp_path):
+    """Every row PA: pole drift (arcsec east and north of the start), obliquity change, period residual, wobble."""
+    pytest.importorskip("matplotlib")
+    from spinorbit.commands._outputs import plot_rotation, pole_offsets_arcsec
+
+    spin = 2 * np.pi * u.rad / (8 * u.h)
+    state = RotationState(RigidBody([0.61, 0.965, 1.0]), [0.8, 0.6, 0, 0], [0, 0, 1] * spin)
+    near = FixedPerturber("companion", 1e-9 * u.au**3 / u.day**2, [0.01, 0.003, 0.002] * u.au)
+    times = EPOCH + np.linspace(0.0, 5.0, 30) * u.day
+    table = Scene(state, EPOCH, times, perturbers=(near,), tolerance=1e-2 * u.arcsec).run().table
+    assert set(table["rotation_class"]) == {"PA"}
+    table["obliquity"] = np.linspace(30, 30.001, len(table)) * u.deg
+    east, north = pole_offsets_arcsec(table)
+    # the offsets are the pole's angle from the start to first order: |(east, north)| = the angle
+    start = np.radians([table["pole_lon"][0].to_value(u.deg), table["pole_lat"][0].to_value(u.deg)])
+    lon, lat = (table[name].to(u.rad).value for name in ("pole_lon", "pole_lat"))
+    haversine = np.sin((lat - start[1]) / 2) ** 2 + np.cos(lat) * np.cos(start[1]) * np.sin((lon - start[0]) / 2) ** 2
+    angle = np.degrees(2 * np.arcsin(np.sqrt(haversine))) * 3600  # accurate at small angles, unlike arccos
+    assert abs(east[0]) < 1e-9 and abs(north[0]) < 1e-9 and np.max(angle) > 0.01
+    # tangent-plane offsets against the great-circle angle: equal to (angle)² ~ 1e-14 relative here
+    assert np.allclose(np.hypot(east, north), angle, rtol=1e-9, atol=1e-9)
+    path = tmp_path / "pa.svg"
+    plot_rotation(table, str(path), "PA", "svg")
+    text = path.read_text().replace(" ", "")
+    for words in ("pole drift [arcsec]", "obliquity − 30.0000°", "[ms]", "wobble", "PA in every row", "date (TDB)"):
+        assert words.replace(" ", "") in text, words
+    assert "period[h]" not in text
+
+
 def test_compile_notice_on_a_cold_cache_only(tmp_path):
     """A fresh NUMBA_CACHE_DIR: the first run says it compiles, the second (warm) says nothing; a stream
     that is not a terminal (a pipe, a log) never hears it."""

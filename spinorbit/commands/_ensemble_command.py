@@ -74,6 +74,8 @@ def run_apophis_ensemble(args, span_days) -> int:
     try:
         table = ensemble.run(executor=executor, checkpoint=args.checkpoint_dir,
                              progress=lambda done, total: progress.advance(done - progress.done))
+    except KeyboardInterrupt as interrupt:  # Ctrl-C or SIGTERM: say what is kept (the CLI prints it)
+        raise type(interrupt)(_kept(ensemble, args)) from None
     finally:
         progress.close()
         if hasattr(executor, "close"):
@@ -85,6 +87,16 @@ def run_apophis_ensemble(args, span_days) -> int:
     if args.plot is not None:
         write_plot_output(args.plot, lambda temporary: histograms(table, temporary, plot_format(args.plot)))
     return 0 if not ensemble.failures else 1
+
+
+def _kept(ensemble, args) -> str:
+    """What an interrupted run leaves: the members of its finished chunks, and where."""
+    done = ensemble.last_run.get("members_complete", 0)
+    if args.checkpoint_dir is None:
+        return (f"{done} of {ensemble.n_members} members had finished; without --checkpoint-dir they are not "
+                "kept (add it to keep finished chunks on disk).")
+    return (f"{done} of {ensemble.n_members} members are kept in '{args.checkpoint_dir}'; run the same command "
+            "again to run only the rest.")
 
 
 def _values(table, name):

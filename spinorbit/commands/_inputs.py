@@ -241,7 +241,7 @@ def _unit_advice(value, kind: str) -> str:
     if kind == "angular velocity" and _unit_kind(given) == "frequency":
         return ("A frequency is ambiguous for a rotation (astropy reads 1 Hz as 1 rad/s; one turn per second is "
                 "2π rad/s): write turns per time as cycle/d, or an angle per time such as deg/d.")
-    return f"{given} is a unit of {_unit_kind(given)}."
+    return f"{given} is a unit of {_unit_kind(given)}." if _unit_kind(given) != kind else ""
 
 
 def vector(where: str, value, unit: str, example: str, *, count: int = 3, default_unit: str | None = None):

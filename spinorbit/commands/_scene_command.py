@@ -28,21 +28,23 @@ def add_scene_arguments(parser: argparse.ArgumentParser, span_default: str, pert
     run.add_argument("--end-only", action="store_true",
                      help="only the final state (the planner then asks for no dense output)")
     run.add_argument("--tolerance", nargs="+", default=["1", "arcsec"], metavar="ANGLE",
-                     help="attitude tolerance of the whole run, e.g. '1 arcsec' (default), '1e-6 rad'")
+                     help="attitude tolerance of the whole run, e.g. '1 arcsec' (default), '1e-6 rad' (a number alone is arcsec)")
     run.add_argument("--perturbers", nargs="+", default=list(perturbers_default), metavar="BODY",
                      help=f"bodies whose torque may act (default: {' '.join(perturbers_default)}); the planner "
                      "drops those that cannot matter and says why")
     run.add_argument("--pa-threshold", nargs="+", default=["1", "deg"], metavar="ANGLE",
                      help="wobble amplitude up to which a state is a principal-axis rotator (PA: one sidereal period; "
-                     "above it SAM/LAM with P_psi, P_phi), e.g. '0.1 deg'; default 1 deg (docs/design.md 'PA or NPA')")
+                     "above it SAM/LAM with P_psi, P_phi), e.g. '0.1 deg' (a number alone is deg); default 1 deg (docs/design.md "
+                     "'PA or NPA')")
     run.add_argument("--plan", action="store_true", help="print the plan (decisions and reasons) and stop")
     run.add_argument("--no-skip", action="store_true",
                      help="run the reference plan: every perturber, the orbits as given, nothing skipped")
     files = parser.add_argument_group("output files")
     files.add_argument("--output", metavar="FILE.ecsv", help="write the result table (time, attitude, spin, pole, "
                        "obliquity, periods; docs/conventions.md 'Output tables') as ECSV (FILE.ecsv) or CSV (FILE.csv)")
-    files.add_argument("--plot", metavar="FILE.png", help="plot periods, pole, obliquity and mode against the date, "
-                       "encounters marked (needs matplotlib; .png, .pdf or .svg)")
+    files.add_argument("--plot", metavar="FILE.png", help="plot against the date, encounters marked: a tumbler's "
+                       "periods, pole, obliquity and class; a principal-axis rotator's pole drift (arcsec), obliquity "
+                       "change, period residual and wobble (needs matplotlib; .png, .pdf or .svg)")
 
 
 def _where(args, option: str) -> str:

@@ -10,6 +10,7 @@ names the key as ``[table] key``. docs/cli.md shows a complete file (``examples/
 from __future__ import annotations
 
 from spinorbit.commands import _inputs as check
+from spinorbit.commands._spin_options import FORMS, read_spin_key
 from spinorbit.core.errors import InputError
 
 #: Most output times a scene accepts (as spinorbit.commands._scene_command.MAX_TIMES).
@@ -53,11 +54,10 @@ SCHEMA = {
         "non_gravitational": _non_gravitational,
     },
     "body": {"moments": _moments},
-    "spin": {
+    "spin": {  # the spin forms' keys: spinorbit.commands._spin_options
         "epoch": check.time,
-        "euler313": lambda where, value: check.vector(where, value, "deg", "30 20 0 deg"),
-        "omega": lambda where, value: check.vector(where, value, "deg / d", "0 0 45 deg / h"),
         "frame": lambda where, value: check.choice(where, value, SPIN_FRAMES),
+        **{key: (lambda where, value, key=key: read_spin_key(key, value)) for keys in FORMS.values() for key in keys},
     },
     "run": {
         "start": check.time,

@@ -15,6 +15,7 @@ from spinorbit.commands._common import check_outputs, number
 from spinorbit.commands._scene_file import read_scene_file
 from spinorbit.commands._scene_command import (add_scene_arguments, check_run_options, pa_threshold, run_and_report,
                                                span_and_times, state_motion_line)
+from spinorbit.commands._spin_options import add_spin_arguments, spin_state, spin_values
 
 NAME = "asteroid"
 SUMMARY = "your own asteroid: orbit from elements, moments, spin state at an epoch (planned scene, TOML or options)"
@@ -60,14 +61,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                        help="what the elements' angles refer to (default ecliptic: J2000 as JPL SBDB and the MPC give elements; ecliptic-iau2006: astropy's)")
     spin = parser.add_argument_group("body and spin state")
     spin.add_argument("--moments", nargs=3, type=number, metavar=("A", "B", "C"), help="principal moments (ratios)")
-    spin.add_argument("--euler313", nargs="+", metavar="ANGLE",
-                      help="attitude: passive 3-1-3 Euler angles PHI THETA PSI of the body relative to --spin-frame, "
-                      "then a unit (default deg), e.g. '10 40 70 deg'")
-    spin.add_argument("--omega", nargs="+", metavar="RATE",
-                      help="body angular velocity WX WY WZ in the moments' axes, then a unit (default deg/day), "
-                      "e.g. '0 0 1080 deg/day', '0 0 45 deg/h'")
+    add_spin_arguments(spin)
     spin.add_argument("--spin-epoch", metavar="TIME", help="the spin state's epoch, TDB (default: the elements')")
-    spin.add_argument("--spin-frame", choices=("ecliptic", "icrf"), help="the attitude's frame (default ecliptic)")
+    spin.add_argument("--spin-frame", choices=("ecliptic", "icrf"),
+                      help="the frame of the spin's angles (attitude, pole, momentum direction): ecliptic J2000 "
+                      "(default) or ICRF")
     parser.add_argument("--start", metavar="TIME", help="first output time's origin, TDB (default: the spin epoch)")
     add_scene_arguments(parser, "30 d", ("sun", "earth"))
 
@@ -88,10 +86,9 @@ def scene_inputs(args, scene=None):
     """
     import astropy.units as u
 
-    from spinorbit import RigidBody, RotationState
+    from spinorbit import RigidBody
     from spinorbit.cli import CommandError
     from spinorbit.ephemeris import EphemerisRangeError
-    from spinorbit.frames import icrf_to_ecliptic_matrix
     from spinorbit.scene import Orbit
 
     scene = scene if scene is not None else (read_scene_file(args.scene) if args.scene else {})
@@ -105,28 +102,19 @@ def scene_inputs(args, scene=None):
         elements = [_required(f"[orbit] {key}", orbit_table.get(key)) for key in keys]
     epoch = check.time("--epoch", args.epoch) if args.epoch is not None else \
         _required("the elements' epoch (--epoch or [orbit] epoch)", orbit_table.get("epoch"))
+    moments = args.moments or _required("the moments (--moments or [body] moments)", scene.get("body", {}).get("moments"))
+    body = RigidBody(list(moments), name=name)
+    spin_epoch = check.time("--spin-epoch", args.spin_epoch) if args.spin_epoch is not None else \
+        spin_table.get("epoch", epoch)
+    form, values = spin_values(args, spin_table)
+    state = spin_state(body, form, values, spin_epoch, args.spin_frame or spin_table.get("frame", "ecliptic"))
+    start = check.time("--start", args.start) if args.start is not None else run_table.get("start", spin_epoch)
+    # the spin state and the times checked first: the orbit's set-up integrates it
     try:
         orbit = Orbit.from_elements(*elements, epoch, frame=args.frame or orbit_table.get("frame", "ecliptic"),
                                     name=name, non_gravitational=orbit_table.get("non_gravitational") or None)
     except EphemerisRangeError as error:
         raise CommandError(str(error)) from None
-    moments = args.moments or _required("the moments (--moments or [body] moments)", scene.get("body", {}).get("moments"))
-    body = RigidBody(list(moments), name=name)
-    if args.euler313 is not None:
-        angles = check.vector("--euler313", args.euler313, "deg", "10 40 70 deg", default_unit="deg")
-    else:
-        angles = _required("the attitude (--euler313 or [spin] euler313)", spin_table.get("euler313"))
-    if args.omega is not None:
-        omega = check.vector("--omega", args.omega, "deg / d", "0 0 1080 deg/day", default_unit="deg/day")
-    else:
-        omega = _required("the angular velocity (--omega or [spin] omega)", spin_table.get("omega"))
-    spin_epoch = check.time("--spin-epoch", args.spin_epoch) if args.spin_epoch is not None else \
-        spin_table.get("epoch", epoch)
-    frame = args.spin_frame or spin_table.get("frame", "ecliptic")
-    state = RotationState.from_euler313(body, *angles, omega)
-    if frame == "ecliptic":  # v_body = R_ecl v_ecl = R_ecl E v_icrf
-        state = RotationState.from_matrix(body, state.attitude_matrix @ icrf_to_ecliptic_matrix(), omega)
-    start = check.time("--start", args.start) if args.start is not None else run_table.get("start", spin_epoch)
     return name, orbit, state, spin_epoch, start
 
 

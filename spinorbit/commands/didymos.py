@@ -1,4 +1,4 @@
-"""``spinorbit didymos``: Didymos and Dimorphos in the full two-body problem, with a DART-like impact."""
+"""``spinorbit didymos``: Didymos and Dimorphos from the published system, and DART's period change."""
 
 from __future__ import annotations
 
@@ -10,28 +10,32 @@ from spinorbit.commands import _inputs as check
 from spinorbit.commands._common import Progress, check_outputs, write_plot_output, write_table_output
 
 NAME = "didymos"
-SUMMARY = "Didymos-Dimorphos full two-body problem (mutual potential to order 4) and a DART-like impact"
+SUMMARY = "Didymos-Dimorphos from the published system (full two-body problem) and DART's period change"
 DESCRIPTION = """\
 Propagate the binary asteroid (65803) Didymos - Dimorphos as two rigid figures that feel each
 other (mutual potential by inertia integrals to --order, Hou, Scheeres & Xin 2017): the relative
-orbit, both attitudes and both spins, with DOP853. The set-up is the GUBAS example case
-(../shared/data/didymos_gubas_case.json; docs/binary.md says which number is derived and why):
-Dimorphos a 103.16 x 79.35 x 66.13 m ellipsoid, synchronous, 1.20 km from a spherical Didymos
-spinning in 2.260 h, density 2.2031 g/cm^3.
+orbit, both attitudes and both spins, with DOP853. The set-up is the published system
+(spinorbit.data.dart; docs/binary.md): Didymos the oblate spheroid of Naidu et al. 2024 (394 m
+equatorial, 290 m polar radius), Dimorphos the 177 x 174 x 116 m ellipsoid of Daly et al. 2023 at
+2.4 g/cm^3, synchronous on a circular orbit at 1.206 km, the system's mass fitted so that the
+full model goes round in the measured 11.921473 h.
 
-Prints the mutual orbit period, Dimorphos's free and forced libration (periods with the run's
-resolution P^2/T, and amplitudes, from the periodogram of its libration angle), its rotation mode in
-Fukushima's canonical elements, and the energy and angular-momentum drift. A run too short to
-resolve the two libration lines (about 26 orbits are needed) says so and prints no lines; a pair
-that the impact unbinds is reported as unbound, with no period. With --impact the same run is repeated after an
-impulsive change of Dimorphos's velocity, dv = beta m v / M_Dimorphos, against its orbital motion
-(DART: 579.4 kg at 6.1449 km/s, beta = 3.61 by default), and the excited libration or tumbling is
-reported."""
+Prints the mutual orbit (mean sidereal period, eccentricity, apsidal precession), Dimorphos's free
+and forced libration (periods with the run's resolution P^2/T, and amplitudes, from the periodogram
+of its libration angle), its rotation mode in Fukushima's canonical elements, and the energy and
+angular-momentum drift. A run too short to resolve the two libration lines (about 45 orbits are
+needed: the free libration takes ~51 h) says so and prints no lines; a pair that the impact unbinds
+is reported as unbound, with no period. With
+--impact the same run is repeated after DART's impulse on Dimorphos and the line 'period change
+<value> min' gives the mean sidereal period after it minus 11.921473 h. The impulse is the
+along-track velocity change --dv (default -2.63 mm/s, Naidu et al. 2024), or, with --beta, the
+momentum beta m U / M of DART's mass and speed along --impact-elevation (Cheng et al. 2023's eq. 1
+with the ejecta's recoil along U)."""
 EXAMPLES = """\
 examples:
-  spinorbit didymos                                  # 100 orbits, order 4
-  spinorbit didymos --impact --beta 3.61 --orbits 200 --output didymos.ecsv --plot didymos.png
-  spinorbit didymos --impact --impact-elevation 30 --order 2
+  spinorbit didymos --impact                         # Naidu et al. 2024's dv = -2.63 mm/s, 100 orbits
+  spinorbit didymos --impact --dv -2.70 mm/s --orbits 20
+  spinorbit didymos --impact --beta 3.61 --impact-elevation 30 --output didymos.ecsv --plot didymos.png
 
 exit status: 0 on success; 2 with a one-line message if the input is wrong or an output file
 cannot be written (nothing is left half-written)."""
@@ -54,23 +58,29 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of ``spinorbit didymos``."""
     model = parser.add_argument_group("model and run")
     model.add_argument("--order", default=4, metavar="N",
-                       help="mutual-potential order 0..4 (default 4, the GUBAS case's; 2 = point mass + inertia tensors)")
+                       help="mutual-potential order 0..4 (default 4; 2 = point masses + inertia tensors)")
     model.add_argument("--orbits", type=_positive_count, default=100, metavar="N",
-                       help="span in mutual orbits of 11.92 h (default 100: enough to separate the libration lines)")
+                       help="span in mutual orbits of 11.921473 h (default 100: enough to separate the libration lines)")
     model.add_argument("--per-orbit", type=_positive_count, default=40, metavar="N",
                        help="output times per orbit (default 40)")
     model.add_argument("--rtol", default=1e-12, metavar="RTOL", help="DOP853 relative tolerance (default 1e-12)")
     model.add_argument("--libration", default=0.0, metavar="DEG",
                        help="Dimorphos turned this many degrees from the line to Didymos at the start (default 0)")
-    impact = parser.add_argument_group("DART-like impact at t = 0")
+    impact = parser.add_argument_group("DART's impact at t = 0")
     impact.add_argument("--impact", action="store_true", help="also run after an impulsive velocity change of Dimorphos")
-    impact.add_argument("--beta", default=3.61, metavar="BETA",
-                        help="momentum enhancement (default 3.61, Cheng et al. 2023)")
-    impact.add_argument("--impactor-mass", default=579.4, metavar="KG", help="impactor mass in kg (default 579.4)")
-    impact.add_argument("--impactor-speed", default=6.1449, metavar="KM_S",
-                        help="impactor speed in km/s (default 6.1449)")
+    impulse = impact.add_mutually_exclusive_group()
+    impulse.add_argument("--dv", nargs="+", default=None, metavar="DV",
+                         help="Dimorphos's along-track velocity change, e.g. '-2.63 mm/s' (a number alone is mm/s; "
+                              "negative: against its motion; default -2.63 mm/s, Naidu et al. 2024)")
+    impulse.add_argument("--beta", default=None, metavar="BETA",
+                         help="momentum enhancement instead of --dv: dv = beta m U / M with DART's mass and speed "
+                              "(3.61: Cheng et al. 2023 for 2.4 g/cm^3)")
+    impact.add_argument("--impactor-mass", default=None, metavar="KG",
+                        help="with --beta: impactor mass in kg (default 579.4, Cheng et al. 2023)")
+    impact.add_argument("--impactor-speed", default=None, metavar="KM_S",
+                        help="with --beta: impactor speed relative to Dimorphos in km/s (default 6.1449)")
     impact.add_argument("--impact-elevation", default=0.0, metavar="DEG",
-                        help="angle of the impactor's velocity out of the orbit plane (default 0: in the plane, head-on)")
+                        help="angle of the impulse out of the orbit plane (default 0: in the plane, against the motion)")
     files = parser.add_argument_group("output files")
     files.add_argument("--output", metavar="FILE.ecsv", help="write the run (time, relative orbit, libration, "
                        "Dimorphos's canonical elements and mode) as ECSV or CSV")
@@ -102,7 +112,7 @@ def _report(label, run):
 
 
 def _orbit_lines(run):
-    """The mutual period and the libration lines, each with its resolution, or why the run cannot give them."""
+    """The mean mutual orbit and the libration lines, each with its resolution, or why the run cannot give them."""
     import astropy.units as u
 
     from spinorbit.core.binary.errors import UnresolvedPeriodError
@@ -111,14 +121,19 @@ def _orbit_lines(run):
         # A run too short for a period: say so and how long it must be, instead of printing the wrong line.
         hint = ""
         if error.required_span is not None:
-            hint = f" Here: --orbits {math.ceil(error.required_span / _nominal_period_s())} or more."
+            # (rounded up, less a hair: a span of exactly 3 periods asks for 3 orbits, not 4)
+            hint = f" Here: --orbits {math.ceil(error.required_span / _nominal_period_s() - 1e-6)} or more."
         return f"  not resolved             {error}{hint}"
 
     try:
-        period = run.mutual_period()
+        orbit = run.mutual_orbit()
     except UnresolvedPeriodError as error:
         return [short(error)]
-    lines = [f"  mutual orbit period      {period.to_value(u.h):.5f} h"]
+    apsides = ("circular" if orbit.apsidal_rate is None else
+               f"eccentricity {orbit.eccentricity:.4f}, apsidal precession {orbit.apsidal_rate.to_value(u.deg / u.day):.2f} "
+               "deg/day")
+    lines = [f"  mutual orbit             mean sidereal period {orbit.sidereal_period.to_value(u.h):.6f} h, mean "
+             f"separation {orbit.mean_separation.to_value(u.m):.1f} m, {apsides}"]
     try:
         parts = run.libration_components()
     except UnresolvedPeriodError as error:
@@ -136,12 +151,49 @@ def _orbit_lines(run):
 
 
 def _nominal_period_s():
-    """The nominal mutual period of the set-up (s): the unit of --orbits."""
+    """The pre-impact mutual period (s): the unit of --orbits."""
     import astropy.units as u
 
-    from spinorbit.data.didymos import RELATIVE_SPEED, SEPARATION
+    from spinorbit.data.dart import PERIOD_BEFORE
 
-    return (2 * math.pi * SEPARATION / RELATIVE_SPEED).to_value(u.s)
+    return PERIOD_BEFORE.to_value(u.s)
+
+
+def _impulse(args, state):
+    """(Δv Quantity (3,) on the inertial axes, its description) from --dv or --beta and --impact-elevation."""
+    import astropy.units as u
+    import numpy as np
+
+    from spinorbit.binary import momentum_impulse
+    from spinorbit.data.dart import DART_MASS, DART_SPEED, DV_NAIDU
+
+    if args.beta is None and (args.impactor_mass is not None or args.impactor_speed is not None):
+        raise CommandError("--impactor-mass and --impactor-speed make the impulse from --beta: add --beta (3.61: "
+                           "Cheng et al. 2023), or give the velocity change itself with --dv.")
+    velocity = state.velocity.to_value(u.m / u.s)
+    along = velocity / np.linalg.norm(velocity)
+    elevation = math.radians(args.impact_elevation)
+    # against the motion, tilted by the elevation towards the orbit normal (+z)
+    backwards = -along * math.cos(elevation) + np.array([0.0, 0.0, math.sin(elevation)])
+    if args.beta is None:
+        dv = DV_NAIDU if args.dv is None else args.dv
+        size = dv.to_value(u.m / u.s)
+        if size > 0 and args.impact_elevation != 0.0:
+            raise CommandError(f"--dv expects the along-track change, negative against the motion, with "
+                               f"--impact-elevation; got {dv:g} with an elevation of {args.impact_elevation:g} deg. "
+                               "Give a negative --dv (the impulse's size is |dv| / cos(elevation)).")
+        # the along-track component is the given dv; out of the plane the impulse is longer by 1/cos
+        delta_v = abs(size) / math.cos(elevation) * (backwards if size < 0 else along) * u.m / u.s
+        source = " (Naidu et al. 2024)" if args.dv is None else ""
+        text = f"along-track dv = {size * 1e3:.4f} mm/s{source}, elevation {args.impact_elevation:g} deg"
+    else:
+        mass = DART_MASS.to_value(u.kg) if args.impactor_mass is None else args.impactor_mass
+        speed = DART_SPEED.to_value(u.km / u.s) if args.impactor_speed is None else args.impactor_speed
+        delta_v = momentum_impulse(mass * u.kg, backwards * speed * u.km / u.s, args.beta, state.system.secondary.mass)
+        text = (f"beta {args.beta:g}, {mass:g} kg at {speed:g} km/s, elevation "
+                f"{args.impact_elevation:g} deg: |dv| = {np.linalg.norm(delta_v.to_value(u.mm / u.s)):.4f} mm/s, "
+                f"along-track {float(np.dot(delta_v.to_value(u.mm / u.s), along)):.4f} mm/s")
+    return delta_v, text
 
 
 def _table(runs):
@@ -203,11 +255,17 @@ def check_options(args) -> None:
     args.rtol = check.number("--rtol", args.rtol, "1e-12", low=1e-15, high=1.0, high_open=True,
                              advice="Double precision cannot do better than 1e-15.")
     args.libration = check.number("--libration", args.libration, "10", low=-180.0, high=180.0)
-    args.beta = check.number("--beta", args.beta, "3.61", low=0.0,
-                             advice="beta is the momentum enhancement, ≥ 1 in practice.")
-    args.impactor_mass = check.number("--impactor-mass", args.impactor_mass, "579.4", low=0.0, low_open=True)
-    args.impactor_speed = check.number("--impactor-speed", args.impactor_speed, "6.1449", low=0.0, low_open=True)
-    args.impact_elevation = check.number("--impact-elevation", args.impact_elevation, "30", low=-90.0, high=90.0)
+    if args.dv is not None:
+        args.dv = check.quantity("--dv", args.dv, "mm/s", "-2.63 mm/s", default_unit="mm/s")
+    if args.beta is not None:
+        args.beta = check.number("--beta", args.beta, "3.61", low=0.0,
+                                 advice="beta is the momentum enhancement, ≥ 1 in practice.")
+    if args.impactor_mass is not None:
+        args.impactor_mass = check.number("--impactor-mass", args.impactor_mass, "579.4", low=0.0, low_open=True)
+    if args.impactor_speed is not None:
+        args.impactor_speed = check.number("--impactor-speed", args.impactor_speed, "6.1449", low=0.0, low_open=True)
+    args.impact_elevation = check.number("--impact-elevation", args.impact_elevation, "30", low=-90.0, high=90.0,
+                                         high_open=True, low_open=True)
 
 
 def run(args) -> int:
@@ -215,9 +273,10 @@ def run(args) -> int:
     import astropy.units as u
     import numpy as np
 
-    from spinorbit.binary import momentum_impulse, propagate
+    from spinorbit.binary import propagate
+    from spinorbit.binary.system import G_SI
     from spinorbit.core.errors import SpinorbitError
-    from spinorbit.data.didymos import RELATIVE_SPEED, SEPARATION, didymos_state
+    from spinorbit.data.dart import PERIOD_BEFORE, PERIOD_CHANGE_INITIAL_NAIDU, PERIOD_CHANGE_THOMAS, dart_state, dart_system
 
     check_outputs(args)
     check_options(args)
@@ -228,27 +287,28 @@ def run(args) -> int:
     if args.per_orbit < 8:
         raise CommandError(f"--per-orbit expects at least 8 output times per orbit to resolve the libration, got "
                            f"{args.per_orbit}.")
+    if not args.impact and (args.dv is not None or args.beta is not None):
+        raise CommandError("--dv and --beta describe the impact: add --impact to run it.")
     try:
-        state = didymos_state(order=args.order, libration=args.libration * u.deg)
+        system = dart_system(order=args.order)
     except SpinorbitError as error:
         raise CommandError(f"--order: {error}") from None
-    system = state.system
-    period = (2 * math.pi * SEPARATION / RELATIVE_SPEED).to(u.s)
-    times = np.linspace(0.0, args.orbits, rows) * period
-    print(f"Didymos            sphere, radius {system.primary.semi_axes_m[0]:.1f} m, mass {system.primary.mass.value:.4e} kg")
-    print(f"Dimorphos          ellipsoid {' x '.join(f'{a:g}' for a in system.secondary.semi_axes_m)} m, mass "
-          f"{system.secondary.mass.value:.4e} kg")
+    state = dart_state(system, libration=args.libration * u.deg)
+    times = np.linspace(0.0, args.orbits, rows) * PERIOD_BEFORE.to(u.s)
+    equatorial, _, polar = system.primary.semi_axes_m
+    print(f"Didymos            oblate spheroid {equatorial:g} x {polar:g} m (Naidu et al. 2024), mass "
+          f"{system.primary.mass.value:.4e} kg (fitted to the period)")
+    print(f"Dimorphos          ellipsoid {' x '.join(f'{2 * a:g}' for a in system.secondary.semi_axes_m)} m (Daly et al. "
+          f"2023), mass {system.secondary.mass.value:.4e} kg")
+    print(f"orbit              circular at {state.separation[0].to_value(u.km):g} km, period "
+          f"{PERIOD_BEFORE.to_value(u.h):.6f} h; G(mA + mB) = {(system.primary.mass + system.secondary.mass).value * G_SI:.5f} m^3/s^2")
     print(f"model              mutual potential to order {args.order}; contact distance "
           f"{system.contact_distance.to_value(u.m):.1f} m; DOP853 rtol {args.rtol:g}")
     cases = [("nominal", state)]
     if args.impact:
-        elevation = math.radians(args.impact_elevation)
-        direction = -state.velocity.value / np.linalg.norm(state.velocity.value)
-        velocity = (direction * math.cos(elevation) + np.array([0.0, 0.0, math.sin(elevation)])) * args.impactor_speed
-        dv = momentum_impulse(args.impactor_mass * u.kg, velocity * u.km / u.s, args.beta, system.secondary.mass)
-        print(f"impact             dv = {np.linalg.norm(dv.value) * 1e3:.4f} mm/s (beta {args.beta:g}, "
-              f"{args.impactor_mass:g} kg at {args.impactor_speed:g} km/s, elevation {args.impact_elevation:g} deg)")
-        cases.append(("after impact", state.with_velocity_change(dv)))
+        delta_v, text = _impulse(args, state)
+        print(f"impact             {text}")
+        cases.append(("after impact", state.with_velocity_change(delta_v)))
     runs = []
     progress = Progress(len(cases), "propagating")
     try:
@@ -262,6 +322,14 @@ def run(args) -> int:
         progress.close()
     for label, result in runs:
         _report(label, result)
+    if args.impact and runs[1][1].unbound_reason() is not None:
+        print("period change  none: the pair is unbound after the impact")
+    elif args.impact:
+        change = (runs[1][1].mutual_orbit().sidereal_period - runs[0][1].mutual_orbit().sidereal_period).to(u.min)
+        print(f"period change  {change.value:.3f} min")
+        print(f"  mean sidereal period over the {args.orbits} orbits after the impact minus before; measured "
+              f"{PERIOD_CHANGE_THOMAS.value:.1f} +- 1.0 min (3 sigma, Thomas et al. 2023), "
+              f"{PERIOD_CHANGE_INITIAL_NAIDU.value:g} min +- 16 s right after the impact (Naidu et al. 2024)")
     if args.output is not None:
         write_table_output(args.output, _table(runs), f"{rows} rows over {args.orbits} orbits")
     if args.plot is not None:

@@ -60,10 +60,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     run.add_argument("--start", default="2000-01-01T12:00:00", metavar="DATE",
                      help="first output time, ISO date (TDB) or JD number, inside DE421 (default J2000.0)")
     run.add_argument("--span", nargs="+", default=["1", "yr"], metavar="SPAN",
-                     help="how long to integrate from --start, e.g. '1 yr' (default), '20 yr', '200 d'; "
+                     help="how long to integrate from --start, e.g. '1 yr' (default), '20 yr', '200 d' (a number alone is days); "
                           "the run must end inside DE421 (2200-01-31)")
     run.add_argument("--step", nargs="+", default=["1", "d"], metavar="STEP",
-                     help="spacing of the comparison times (default 1 d; at least 1 min)")
+                     help="spacing of the comparison times, e.g. '12 h' (a number alone is days; default 1 d; at least 1 min)")
     run.add_argument("--model", choices=MOON_MODELS, default="de421",
                      help="de421: mantle + fluid core + tides on DE421's orbits (default); rigid / "
                           "core-corrected: rigid Moon with the whole Moon's / the mantle's moments, in REBOUND")

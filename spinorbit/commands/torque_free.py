@@ -7,6 +7,7 @@ import math
 
 from spinorbit.cli import CommandError
 from spinorbit.commands import _inputs as check
+from spinorbit.commands._spin_options import FORMS, READ, add_spin_arguments, spin_state, spin_values
 from spinorbit.commands._common import (Progress, check_output_paths, number, plot_format, quantity, unit,
                                         write_plot_output, write_table_output)
 
@@ -58,10 +59,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--moments", nargs=3, type=number, required=True, metavar=("IX", "IY", "IZ"),
         help="principal moments of inertia about the body x, y, z axes (kg m^2 or ratios; any order)",
     )
-    body.add_argument(
-        "--omega", nargs="+", required=True, metavar="RATE",
-        help="body angular velocity components WX WY WZ along x, y, z, then optionally their unit: "
+    add_spin_arguments(
+        body,
+        omega_help="body angular velocity components WX WY WZ along x, y, z, then optionally their unit: "
         "'14.51 33.529 -98.709' (deg/day, or --omega-unit), '1e-4 0 3e-4 rad/s'",
+        euler313_help="initial attitude: passive 3-1-3 Euler angles PHI THETA PSI of the body relative to "
+        "--spin-frame (default ICRF), then a unit (default deg); default 0 0 0, body = inertial axes",
     )
     body.add_argument(
         "--omega-unit", metavar="UNIT",
@@ -69,8 +72,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "(default), rad/s, deg/h, cycle/d, ...",
     )
     body.add_argument(
-        "--euler313", nargs=3, type=number, default=(0.0, 0.0, 0.0), metavar=("PHI", "THETA", "PSI"),
-        help="initial attitude, passive 3-1-3 Euler angles in degrees (default: 0 0 0, body = inertial axes)",
+        "--spin-frame", choices=("ecliptic", "icrf"),
+        help="frame of the spin's angles: ICRF for --euler313, ecliptic J2000 for --pole and --momentum (as "
+        "published) unless given",
     )
     times = parser.add_argument_group("output times")
     times.add_argument(
@@ -85,16 +89,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     body.add_argument(
         "--pa-threshold", nargs="+", default=["1", "deg"], metavar="ANGLE",
         help="wobble amplitude up to which the state is a principal-axis rotator (PA: one sidereal period; above "
-        "it SAM/LAM with P_psi, P_phi), e.g. '0.1 deg'; default 1 deg (docs/design.md 'PA or NPA')",
+        "it SAM/LAM with P_psi, P_phi), e.g. '0.1 deg' (a number alone is deg); default 1 deg (docs/design.md "
+        "'PA or NPA')",
     )
     spacing = times.add_mutually_exclusive_group()
-    spacing.add_argument("--step", nargs="+", metavar="STEP", help="spacing of output times, e.g. '1 d' (default 1 d)")
+    spacing.add_argument("--step", nargs="+", metavar="STEP", help="spacing of output times, e.g. '1 d' (a number alone is days; default 1 d)")
     spacing.add_argument("--n-times", type=_count, metavar="N", help="number of evenly spaced output times instead")
     files = parser.add_argument_group("output files")
     files.add_argument("--output", metavar="FILE.ecsv", help="write the table (time, attitude, spin, pole, periods; "
                        "docs/conventions.md 'Output tables') as ECSV (FILE.ecsv) or CSV (FILE.csv)")
-    files.add_argument("--plot", metavar="FILE.png", help="plot periods, pole and mode against the date "
-                       "(needs matplotlib; .png, .pdf or .svg)")
+    files.add_argument("--plot", metavar="FILE.png", help="plot against the date: a tumbler's periods, pole and "
+                       "class; a principal-axis rotator's pole drift (arcsec), period residual and wobble (needs "
+                       "matplotlib; .png, .pdf or .svg)")
 
 
 def _offsets(args):
@@ -127,28 +133,45 @@ def _epoch(text, offsets):
     return epoch
 
 
-def _state(args):
-    import astropy.units as u
+def _state(args, epoch):
+    """(RotationState at ``epoch``, the spin form, its checked values) from the spin options given."""
+    from spinorbit import InvalidBodyError, RigidBody
 
-    from spinorbit import InvalidBodyError, RigidBody, RotationState
-
-    has_unit = len(args.omega) > 3
-    if has_unit and args.omega_unit is not None:
-        raise CommandError(f"--omega '{' '.join(args.omega)}' has its unit and --omega-unit gives another; "
-                           "give the unit once.")
-    omega_unit = unit("--omega-unit", "deg/day" if args.omega_unit is None else args.omega_unit, "angular velocity",
-                      "deg/day or rad/s")
-    omega = check.vector("--omega", args.omega, "rad / d", "14.51 33.529 -98.709 deg/day",
-                         default_unit=omega_unit.to_string())
-    omega_unit = omega.unit
-    if not any(omega.value):
-        raise CommandError("--omega expects a non-zero angular velocity; got 0 0 0 (a body at rest has no rotation).")
+    if args.omega is not None:
+        if len(args.omega) > 3 and args.omega_unit is not None:
+            raise CommandError(f"--omega '{' '.join(args.omega)}' has its unit and --omega-unit gives another; "
+                               "give the unit once.")
+        if args.omega_unit is not None:
+            omega_unit = unit("--omega-unit", args.omega_unit, "angular velocity", "deg/day or rad/s")
+            args.omega = [*args.omega, *omega_unit.to_string().split()]
+        other_forms = [key for form, keys in FORMS.items() if form != "euler313" for key in keys]
+        if args.euler313 is None and all(getattr(args, key) is None for key in other_forms):
+            args.euler313 = ["0", "0", "0"]  # the documented default: body axes on the inertial axes
     try:
         body = RigidBody(args.moments)
     except InvalidBodyError as error:
         raise CommandError(f"--moments: {error}") from None
-    phi, theta, psi = (angle * u.deg for angle in args.euler313)
-    return RotationState.from_euler313(body, phi, theta, psi, omega), omega_unit
+    form, values = spin_values(args, {})
+    if form == "euler313":
+        if not values["omega"].value.any():
+            raise CommandError("--omega expects a non-zero angular velocity; got 0 0 0 (a body at rest has no "
+                               "rotation).")
+    frame = args.spin_frame or ("icrf" if form == "euler313" else "ecliptic")
+    return spin_state(body, form, values, epoch, frame), form, values
+
+
+def _given(form, values) -> dict:
+    """The spin as given, for the table's metadata: each key's values in its unit (omega in the unit given)."""
+    meta = {"spin_form": form}
+    for key, value in values.items():
+        if key == "mode":
+            meta["mode_given"] = value
+        elif key == "omega":
+            meta["omega_xyz"], meta["omega_unit"] = value.value.tolist(), value.unit.to_string()
+        else:
+            unit_name = READ[key][1]
+            meta[f"{key}_{unit_name}"] = value.to_value(unit_name).tolist()
+    return meta
 
 
 def _summary(state, threshold) -> list[str]:
@@ -207,7 +230,7 @@ def _pa_threshold(args):
                           "rotator.")
 
 
-def _table(args, state, epoch, offsets, quaternions, omegas, omega_unit, threshold):
+def _table(args, state, epoch, offsets, quaternions, omegas, given, threshold):
     """The output schema's table (docs/conventions.md, "Output tables") of the run, with the inputs in meta."""
     import astropy.units as u
     from astropy.table import Table
@@ -226,9 +249,7 @@ def _table(args, state, epoch, offsets, quaternions, omegas, omega_unit, thresho
     table.meta.update({
         "software": f"spinorbit {__version__} torque-free",
         "moments_xyz": list(args.moments),
-        "euler313_deg": list(args.euler313),
-        "omega_xyz": [float(value) for value in args.omega[:3]],
-        "omega_unit": omega_unit.to_string(),
+        **given,
         "mode": state.mode,
         "sense": state.sense,
         "P_psi_d": float(p_psi.to_value(u.day)),
@@ -267,12 +288,12 @@ def run(args) -> int:
         _require_matplotlib()
     offsets = _offsets(args)
     epoch = _epoch(args.epoch, offsets)
-    state, omega_unit = _state(args)
+    state, form, values = _state(args, epoch)
     threshold = _pa_threshold(args)
     for line in _summary(state, threshold):
         print(line)
     quaternions, omegas = _propagate(state, offsets)
-    table = _table(args, state, epoch, offsets, quaternions, omegas, omega_unit, threshold)
+    table = _table(args, state, epoch, offsets, quaternions, omegas, _given(form, values), threshold)
     span = f"{offsets[-1]:g} d"
     if args.output is not None:
         write_table_output(args.output, table, f"{len(table)} rows over {span}")

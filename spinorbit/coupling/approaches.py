@@ -16,7 +16,7 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from spinorbit.coupling.rebound import SimulationSnapshot, body_index
+from spinorbit.coupling.rebound import SimulationSnapshot, body_index, integrate_interruptibly
 from spinorbit.coupling.sampling import de421_state
 
 __all__ = ["MAX_STEP_DAYS", "MIN_STEP_DAYS", "approaches", "ephemeris_separation", "rebound_separation"]
@@ -33,7 +33,7 @@ def rebound_separation(sim, body, target):
     run = SimulationSnapshot.of(sim).build()
 
     def separation(day):
-        run.integrate(day)
+        integrate_interruptibly(run, day)
         a, b = run.particles[i], run.particles[j]
         return (np.array([a.x - b.x, a.y - b.y, a.z - b.z]), np.array([a.vx - b.vx, a.vy - b.vy, a.vz - b.vz]))
 

@@ -23,7 +23,7 @@ import time as _time
 import numpy as np
 
 from spinorbit.core.model.gravity_field import make_body
-from spinorbit.coupling.rebound import ROTATION_STATE_SIZE, SimulationSnapshot, body_index
+from spinorbit.coupling.rebound import ROTATION_STATE_SIZE, SimulationSnapshot, body_index, integrate_interruptibly
 from spinorbit.coupling.rigid_body import CoupledRigidBody
 from spinorbit.runs.checkpoint import Checkpoint, CheckpointSchedule, fingerprint
 
@@ -223,7 +223,7 @@ def coupled_run(sim, body, moments_per_mass, state, start, times, perturbers, to
         ``steps`` (BS steps taken, REBOUND's ``steps_done``), ``wall_seconds`` (integration only).
     """
     copy = SimulationSnapshot.of(sim).build()
-    copy.integrate(start)
+    integrate_interruptibly(copy, start)
     copy.integrator = "bs"
     copy.integrator.eps_abs = tolerance
     copy.integrator.eps_rel = tolerance

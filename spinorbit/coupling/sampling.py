@@ -419,7 +419,11 @@ def rebound_orbit(sim, body):
     callable
         ``days -> (positions (n, 3), velocities (n, 3))``, au and au/day.
     """
-    from spinorbit.coupling.rebound import SimulationSnapshot, body_index  # only REBOUND samplers need it
+    from spinorbit.coupling.rebound import (  # only REBOUND samplers need it
+        SimulationSnapshot,
+        body_index,
+        integrate_interruptibly,
+    )
 
     centre = body_index(sim, body)
     snapshot = SimulationSnapshot.of(sim)
@@ -431,7 +435,7 @@ def rebound_orbit(sim, body):
         out = np.empty((days.size, 6))
         xyz, vel = np.zeros((run.N, 3)), np.zeros((run.N, 3))
         for j in order:
-            run.integrate(days[j])
+            integrate_interruptibly(run, days[j])
             run.serialize_particle_data(xyz=xyz, vxvyvz=vel)
             out[j, :3], out[j, 3:] = xyz[centre], vel[centre]
         return out[:, :3], out[:, 3:]
@@ -478,7 +482,11 @@ def sample_from_rebound(sim, body, start, end, perturbers=DEFAULT_PERTURBERS,
     """
     if not perturbers:
         raise ValueError("perturbers: expected at least one particle name.")
-    from spinorbit.coupling.rebound import SimulationSnapshot, body_index  # only REBOUND samplers need it
+    from spinorbit.coupling.rebound import (  # only REBOUND samplers need it
+        SimulationSnapshot,
+        body_index,
+        integrate_interruptibly,
+    )
 
     centre = body_index(sim, body)
     indices = [body_index(sim, p) for p in perturbers]
@@ -489,11 +497,11 @@ def sample_from_rebound(sim, body, start, end, perturbers=DEFAULT_PERTURBERS,
 
     def provider(days):
         run = snapshot.build()
-        run.integrate(days[0])
+        integrate_interruptibly(run, days[0])
         out = np.empty((days.size, len(indices), 6))
         xyz, vel = np.zeros((run.N, 3)), np.zeros((run.N, 3))
         for j, t in enumerate(days):
-            run.integrate(t)
+            integrate_interruptibly(run, t)
             run.serialize_particle_data(xyz=xyz, vxvyvz=vel)
             out[j, :, :3] = xyz[indices] - xyz[centre]
             out[j, :, 3:] = vel[indices] - vel[centre]

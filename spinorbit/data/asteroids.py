@@ -54,6 +54,7 @@ from spinorbit.coupling.rebound import (
     DEFAULT_BODIES,
     body_index,
     install_extra_forces,
+    integrate_interruptibly,
     simulation_from_de421,
     small_body_simulation,
 )
@@ -349,7 +350,7 @@ def published_orbit_simulation(state=APOPHIS_HORIZONS, time=None, bodies=DEFAULT
                                 integrator=integrator, extra_forces=extra_forces, non_gravitational=terms)
     if time is not None:
         day, fraction = tdb_day_and_fraction(time)
-        sim.integrate(day + fraction)
+        integrate_interruptibly(sim, day + fraction)
     return sim
 
 

@@ -171,16 +171,17 @@ def dart_system(order=ORDER, separation=SEPARATION, period=PERIOD_BEFORE, didymo
     return system(rho)
 
 
-def dart_state(system=None, separation=SEPARATION):
+def dart_state(system=None, separation=SEPARATION, libration=0 * u.rad):
     """The pre-impact relative equilibrium: Dimorphos synchronous at ``separation`` on a circular orbit.
 
     Dimorphos at +x on the inertial x axis, moving along +y at the model's circular speed, its long axis
     toward Didymos and its spin the orbit's rate; Didymos spinning in 2.26 h about its axis, the orbit's
-    normal (``BinaryState.synchronous``). ``system`` defaults to :func:`dart_system` at ``separation``.
+    normal (``BinaryState.synchronous``). ``system`` defaults to :func:`dart_system` at ``separation``;
+    ``libration`` turns Dimorphos from the line to Didymos (a free libration before the impact).
     """
     system = dart_system(separation=separation) if system is None else system
     spin = 2.0 * math.pi / DIDYMOS_SPIN_PERIOD.to_value(u.s)
-    return BinaryState.synchronous(system, separation, spin * u.rad / u.s)
+    return BinaryState.synchronous(system, separation, spin * u.rad / u.s, libration=libration)
 
 
 def along_track(state, delta_v):

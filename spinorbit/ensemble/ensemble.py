@@ -31,7 +31,7 @@ from astropy.table import Column, MaskedColumn, QTable
 from astropy.utils.masked import Masked
 
 from spinorbit.ensemble.errors import EnsembleError, EnsembleInterrupted
-from spinorbit.ensemble.executors import open_executor
+from spinorbit.ensemble.executors import open_executor, owns_workers
 from spinorbit.ensemble.outcomes import (
     INITIAL_COLUMNS,
     OUTCOME_UNITS,
@@ -451,7 +451,37 @@ class Ensemble:
             done += len(self.chunk_members(chunk))
             report(done, self.n_members)
 
-        lost = {}
+        lost, description = {}, str(executor)
+        try:
+            description = self._run_on(executor, pending, keep_tables, stats, finish, lost)
+        except KeyboardInterrupt:  # Ctrl-C or SIGTERM: what finished is kept (checkpointed as it arrived)
+            stats.update(wall_seconds=_time.perf_counter() - clock, executor=description, interrupted=True,
+                         members_complete=self.members_complete)
+            self.last_run = stats
+            raise
+        stats.update(wall_seconds=_time.perf_counter() - clock, executor=description)
+        self.last_run = stats
+        if lost:
+            members = sum(len(self.chunk_members(c)) for c in lost)
+            first = next(iter(lost.values()))
+            where = f"in '{checkpoint}'" if checkpoint is not None else "in memory only (no checkpoint given)"
+            raise EnsembleInterrupted(
+                f"{len(lost)} of {self.n_chunks} chunks ({members} members) did not come back from {description} "
+                f"({type(first).__name__}: {first}); the {self.n_members - members} members completed are kept "
+                f"{where}. Call run() again (with the same checkpoint) to run only the missing members.")
+        return self.table()
+
+    @property
+    def members_complete(self):
+        """Members whose chunk is complete (run now or restored): those a resume does not run again."""
+        return sum(len(self.chunk_members(c)) for c in self._complete)
+
+    def _run_on(self, executor, pending, keep_tables, stats, finish, lost):
+        """Run the ``pending`` chunks on ``executor``, ``finish`` each as it arrives; lost ones into ``lost``.
+
+        Returns the executor's description. A chunk still out when this stops (Ctrl-C) is cancelled,
+        and the executor's own workers stopped (:func:`~spinorbit.ensemble.executors.open_executor`).
+        """
         with open_executor(executor) as (pool, description):
             # On an executor, the members are built where they run (once each), unless the first member is
             # torque-free: then the members are built here to keep the torque-free ones here (not shipped).
@@ -478,25 +508,21 @@ class Ensemble:
                     partial[chunk] = (rows, failures)
                     futures[pool.submit(run_chunk, self.make_scene, ship, self.at_days, keep_tables, None, self.route,
                                         self.batch_integrators, leader)] = chunk
-            for future in concurrent.futures.as_completed(futures):
-                chunk = futures[future]
-                try:
-                    rows, failures, tables = future.result()
-                except Exception as error:  # noqa: BLE001 — the executor lost it: kept for the message
-                    lost[chunk] = error
-                    continue
-                finish(chunk, {**partial[chunk][0], **rows}, {**partial[chunk][1], **failures}, tables)
-        stats.update(wall_seconds=_time.perf_counter() - clock, executor=description)
-        self.last_run = stats
-        if lost:
-            members = sum(len(self.chunk_members(c)) for c in lost)
-            first = next(iter(lost.values()))
-            where = f"in '{checkpoint}'" if checkpoint is not None else "in memory only (no checkpoint given)"
-            raise EnsembleInterrupted(
-                f"{len(lost)} of {self.n_chunks} chunks ({members} members) did not come back from {description} "
-                f"({type(first).__name__}: {first}); the {self.n_members - members} members completed are kept "
-                f"{where}. Call run() again (with the same checkpoint) to run only the missing members.")
-        return self.table()
+            try:
+                for future in concurrent.futures.as_completed(futures):
+                    chunk = futures[future]
+                    try:
+                        rows, failures, tables = future.result()
+                    except Exception as error:  # noqa: BLE001 — the executor lost it: kept for the message
+                        lost[chunk] = error
+                        continue
+                    finish(chunk, {**partial[chunk][0], **rows}, {**partial[chunk][1], **failures}, tables)
+            except BaseException:  # stopped: a caller's executor keeps running only what had started
+                if not owns_workers(executor):  # our own pool is stopped by open_executor (stop_pool)
+                    for future in futures:
+                        future.cancel()
+                raise
+        return description
 
     def rerun(self, indices, executor="serial", checkpoint=None):
         """Run members ``indices`` again, each alone, replace their rows (and failures); return the table.

@@ -4,9 +4,10 @@
 into a :class:`concurrent.futures.Executor` (or None: in this process) for the length of a run:
 
 - ``None``: in this process when one core is available to it, else a ``ProcessPoolExecutor`` with
-  one worker per available core (``os.sched_getaffinity``);
+  one worker per available core (``os.sched_getaffinity``), as for an ``int``;
 - ``"serial"``: in this process;
-- an ``int`` K: a ``ProcessPoolExecutor`` of K workers;
+- an ``int`` K: a ``ProcessPoolExecutor`` of K workers (:func:`~spinorbit.ensemble.workers.process_pool`:
+  they die with this process and are stopped at once when the run is, :mod:`spinorbit.ensemble.workers`);
 - ``"dask"``: an embedded ``dask.distributed.LocalCluster(processes=True)`` (one single-threaded
   worker per core, its dashboard on a free port) and its ``Client``, closed after the run;
 - a ``dask.distributed.Client`` (e.g. one connected to a scheduler address, or to a dask-jobqueue
@@ -24,8 +25,9 @@ import contextlib
 import os
 
 from spinorbit.core.errors import SpinorbitError
+from spinorbit.ensemble.workers import process_pool, stop_pool
 
-__all__ = ["DaskExecutor", "ExecutorError", "available_cores", "dask_client", "open_executor"]
+__all__ = ["DaskExecutor", "ExecutorError", "available_cores", "dask_client", "open_executor", "owns_workers"]
 
 
 class ExecutorError(SpinorbitError, ValueError):
@@ -94,6 +96,11 @@ def dask_client(address=None, workers=None):
     return Client(cluster)
 
 
+def owns_workers(executor):
+    """Whether :func:`open_executor` makes (and so stops) the workers of ``executor``: None, an int, "dask"."""
+    return executor is None or executor == "dask" or (isinstance(executor, int) and not isinstance(executor, bool))
+
+
 @contextlib.contextmanager
 def open_executor(executor):
     """Yield (Executor or None, description) for ``executor`` (module docstring); owned ones are shut down after."""
@@ -105,8 +112,13 @@ def open_executor(executor):
     elif isinstance(executor, (int,)) and not isinstance(executor, bool):
         if executor < 1:
             raise ExecutorError(f"executor expects a positive number of worker processes; got {executor}.")
-        with concurrent.futures.ProcessPoolExecutor(max_workers=executor) as pool:
+        pool = process_pool(executor)
+        try:
             yield pool, f"a process pool of {executor} workers"
+        except BaseException:  # Ctrl-C, SIGTERM, an error: stop now, not after every submitted chunk
+            stop_pool(pool)
+            raise
+        pool.shutdown(wait=True)
     elif executor == "dask":
         client = dask_client()
         try:

@@ -57,11 +57,12 @@ class Ellipsoid:
         a, b, c along the body axes x, y, z (length; plain numbers are read in km).
     subdivisions : int
         Icosphere level of the facet model used for the laws without a closed form (Lambert,
-        Kaasalainen): 20·4^k facets, the error falling as 4^−k (``docs/photometry.md``).
+        Kaasalainen): 20·4^k facets, the error falling as 4^−k (``docs/photometry.md``); 5 (20 480 facets,
+        3e-4 relative, 0.3 mmag) by default.
     """
 
     semi_axes: u.Quantity
-    subdivisions: int = 6
+    subdivisions: int = 5
 
     def __post_init__(self):
         axes = value_in("semi_axes", self.semi_axes, u.km, "[1.0, 0.8, 0.6] * u.km", plain_unit=u.km, shape=(3,))
@@ -178,7 +179,7 @@ def brightness(shape, sun_directions, observer_directions, law="lommel-seeliger"
         Unit vectors from the body's centre to the Sun and to the observer, in the body frame
         (dimensionless; length 1 within :data:`UNIT_TOLERANCE`).
     law : {"lommel-seeliger", "lambert", "kaasalainen"}
-        S = μμ₀/(μ + μ₀), μμ₀, or μμ₀/(μ + μ₀) + c μμ₀ (Kaasalainen, Torppa & Muinonen 2001, eq. 1
+        S = μμ₀/(μ + μ₀), μμ₀, or μμ₀/(μ + μ₀) + c μμ₀ (Kaasalainen, Torppa & Muinonen 2001: their law
         without its phase factor).
     lambert_weight : float
         c of "kaasalainen" (0.1 in their paper); ignored by the other laws.

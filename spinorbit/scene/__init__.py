@@ -36,7 +36,7 @@ from spinorbit.scene.orbit import ApproachError
 from spinorbit.scene.many import ScenePlans, SceneResults
 from spinorbit.scene.plan import Decision, PerturberEstimate, Plan, PlanError
 from spinorbit.scene.scene import Scene, SceneResult
-from spinorbit.scene.thermal import ThermalInputError, ThermalModel
+from spinorbit.scene.thermal import ThermalInputError, ThermalModel, VanishingYorpWarning
 from spinorbit.scene.thermal_planning import SeparatrixCrossingError
 
 __all__ = [
@@ -57,4 +57,5 @@ __all__ = [
     "SeparatrixCrossingError",
     "ThermalInputError",
     "ThermalModel",
+    "VanishingYorpWarning",
 ]

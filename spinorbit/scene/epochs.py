@@ -66,14 +66,14 @@ class _ReboundStates:
         return states
 
     def _integrate(self, days):
-        from spinorbit.coupling.rebound import SimulationSnapshot, body_index
+        from spinorbit.coupling.rebound import SimulationSnapshot, body_index, integrate_interruptibly
 
         index = {name: body_index(self.simulation, name) for name in self.names}
         run = SimulationSnapshot.of(self.simulation).build()
         out = {name: (np.empty((days.size, 3)), np.empty((days.size, 3))) for name in self.names}
         xyz, vel = np.zeros((run.N, 3)), np.zeros((run.N, 3))
         for j in np.argsort(days, kind="stable"):
-            run.integrate(days[j])
+            integrate_interruptibly(run, days[j])
             run.serialize_particle_data(xyz=xyz, vxvyvz=vel)
             for name, i in index.items():
                 out[name][0][j], out[name][1][j] = xyz[i], vel[i]

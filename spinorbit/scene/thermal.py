@@ -22,7 +22,8 @@ from astropy import units as u
 from spinorbit.quantities import finite_result, value_in
 from spinorbit.scene.errors import SceneError
 
-__all__ = ["ThermalModel", "ThermalInputError", "DEFAULT_K3_SQUARED", "MOMENT_RTOL", "validate_thermal"]
+__all__ = ["ThermalModel", "ThermalInputError", "VanishingYorpWarning", "DEFAULT_K3_SQUARED", "MOMENT_RTOL",
+           "validate_thermal", "warn_if_yorp_vanishes"]
 
 #: Burns & Safronov's (1973) shape factor K₃² ≈ 0.01 for a moderately elongated body, the value
 #: Harris (1994) uses for the damping time scales of tumbling asteroids.
@@ -43,6 +44,14 @@ def _real(name, value, example):
     return value_in(name, value, u.dimensionless_unscaled, example, shape=())
 
 
+class VanishingYorpWarning(UserWarning):
+    """The shape is mirror-symmetric in its three principal planes, so its YORP is zero by symmetry.
+
+    The mean recoil torque then has no part that changes the spin rate, the obliquity or the tumbling
+    state (S, Z, H); a part that precesses the spin axis about the orbit normal is left.
+    """
+
+
 def _positive(name, value, unit, example):
     if not isinstance(value, u.Quantity) or not value.isscalar or not value.unit.is_equivalent(unit):
         raise ThermalInputError(f"{name} expects a scalar Quantity in {unit} such as {example}; got {value!r}.")
@@ -57,8 +66,11 @@ class ThermalModel:
     """Sunlight's recoil on a shape (Rubincam 2000, zero conductivity) and the body's nutation damping.
 
     Build with :meth:`from_shape`. Attributes: ``shape``, ``properties`` (its constant-density
-    :class:`~spinorbit.shape.ShapeMassProperties`), ``block`` (the representation, au/day/kg m²),
-    ``degree``, ``efficiency``, ``density``, ``mu_q`` (Pa, or None: no damping), ``k3_squared``.
+    :class:`~spinorbit.shape.ShapeMassProperties`), ``block`` (the recoil in au/day/kg m²: its facets,
+    and the harmonics of degree ``degree``), ``torque`` (what the full route evaluates: "facets" or
+    "harmonics"), ``efficiency``, ``density``, ``mu_q`` (Pa, or None: no damping), ``k3_squared``,
+    ``mirror_planes`` (the principal axes whose normal plane mirrors the shape,
+    :func:`spinorbit.shape.symmetry.mirror_planes`).
     The state's body axes are the shape's principal axes (as :func:`~spinorbit.shape.rigid_body_from_shape`
     makes them), where the block's torque is expressed.
     """
@@ -71,9 +83,12 @@ class ThermalModel:
     density: u.Quantity
     mu_q: u.Quantity | None = None
     k3_squared: float = DEFAULT_K3_SQUARED
+    torque: str = "harmonics"
+    mirror_planes: tuple = ()
 
     @classmethod
-    def from_shape(cls, shape, density, degree=None, efficiency=1.0, mu_q=None, k3_squared=DEFAULT_K3_SQUARED):
+    def from_shape(cls, shape, density, degree=None, efficiency=1.0, mu_q=None, k3_squared=DEFAULT_K3_SQUARED,
+                   torque="harmonics"):
         """The recoil of ``shape`` at constant ``density``, with nutation damping if ``mu_q`` is given.
 
         Parameters
@@ -83,7 +98,8 @@ class ThermalModel:
             Bulk density (kg/m³), which makes the shape's moments and the damping's ρ.
         degree : int, optional
             Degree L of the representation in the Sun's direction
-            (:data:`spinorbit.shape.thermal.DEFAULT_THERMAL_DEGREE`; errors per degree in docs/thermal.md).
+            (:data:`spinorbit.shape.thermal.DEFAULT_THERMAL_DEGREE`; errors per degree in docs/thermal.md),
+            what the full route evaluates with ``torque="harmonics"``.
         efficiency : float
             η of :func:`spinorbit.core.model.thermal.recoil_pressure`: 1 when all the light is
             re-emitted or scattered as by a Lambertian surface, 1 − A for a Bond albedo A whose
@@ -93,6 +109,12 @@ class ThermalModel:
             ~10⁹–10¹¹ Pa for rubble piles to monoliths); None: no damping.
         k3_squared : float
             Burns & Safronov's shape factor K₃² (dimensionless, :data:`DEFAULT_K3_SQUARED`).
+        torque : {"harmonics", "facets"}
+            What the full route sums at each step: the degree-L harmonics (smooth in the Sun's direction,
+            a few hundred ns at L = 8, but their truncation moves the mean YORP torque by up to tens of
+            per cent of itself) or the facets themselves (exact; about 1.5 ns a facet, but each facet's
+            terminator is a kink the integrator's error control meets at tight tolerances: docs/thermal.md
+            measures both). The mean route averages the facets exactly either way.
 
         Raises
         ------
@@ -100,7 +122,8 @@ class ThermalModel:
             Not a Shape, a density or μQ that is not a positive Quantity, η outside (0, 1], K₃² ≤ 0.
         """
         from spinorbit.shape import Shape, shape_mass_properties, thermal_block
-        from spinorbit.shape.thermal import DEFAULT_THERMAL_DEGREE
+        from spinorbit.shape.symmetry import mirror_planes
+        from spinorbit.shape.thermal import DEFAULT_THERMAL_DEGREE, TORQUES
 
         if not isinstance(shape, Shape):
             raise ThermalInputError(f"shape expects a spinorbit.shape.Shape (read_obj, read_icq, "
@@ -116,15 +139,22 @@ class ThermalModel:
         if not k3_squared > 0.0:
             raise ThermalInputError(f"k3_squared expects Burns & Safronov's positive shape factor K₃² (about "
                                     f"{DEFAULT_K3_SQUARED}); got {k3_squared!r}.")
+        if torque not in TORQUES:
+            raise ThermalInputError(f"torque expects one of {TORQUES} (the facet sum itself, or its degree-L "
+                                    f"harmonics); got {torque!r}.")
+        if degree is not None and torque == "facets":
+            raise ThermalInputError(f"degree {degree!r} is the harmonics' degree, but torque='facets' sums the facets "
+                                    "themselves: give torque='harmonics' with it, or leave degree out.")
         degree = DEFAULT_THERMAL_DEGREE if degree is None else degree
         properties = shape_mass_properties(shape, density=density)
         try:
-            block = thermal_block(shape, properties, degree=degree, efficiency=float(efficiency))
+            block = thermal_block(shape, properties, degree=degree, efficiency=float(efficiency), torque=torque)
         except ValueError as error:
             raise ThermalInputError(f"degree: {error}") from None
         block.flags.writeable = False
         return cls(shape, properties, block, int(degree), float(efficiency), density.to(u.kg / u.m**3),
-                   None if mu_q is None else mu_q.to(u.Pa), float(k3_squared))
+                   None if mu_q is None else mu_q.to(u.Pa), float(k3_squared), torque,
+                   mirror_planes(shape, properties))
 
     # ------------------------------------------------------------------------------------------
 
@@ -219,10 +249,33 @@ class ThermalModel:
         to_si = 1.0 / 86400.0**2  # kg m / day² per N, kg m² / day² per N m
         return np.array([fx, fy, fz]) * to_si * u.N, np.array([tx, ty, tz]) * to_si * u.N * u.m
 
+    @property
+    def yorp_vanishes(self):
+        """True when the shape mirrors itself in all three principal planes: no mean change of S, Z, H (YORP)."""
+        return len(self.mirror_planes) == 3
+
+    @property
+    def torque_text(self):
+        """What the full route evaluates, in words (plans and reprs)."""
+        return "the facet sum" if self.torque == "facets" else f"harmonics of degree {self.degree}"
+
     def __repr__(self):
         damping = f", μQ = {self.mu_q:.3g}" if self.mu_q is not None else ""
-        return (f"ThermalModel({len(self.shape)} facets, degree {self.degree}, η = {self.efficiency:g}, "
+        return (f"ThermalModel({len(self.shape)} facets, {self.torque_text}, η = {self.efficiency:g}, "
                 f"ρ = {self.density:.4g}{damping})")
+
+
+def warn_if_yorp_vanishes(thermal):
+    """Warn (:class:`VanishingYorpWarning`) when a run's shape has no mean YORP torque by symmetry."""
+    import warnings
+
+    if thermal.yorp_vanishes:
+        warnings.warn(
+            f"the shape ({len(thermal.shape)} facets) mirrors itself in its three principal planes, like a triaxial "
+            "ellipsoid or a box, so its YORP is zero by symmetry (Rubincam 2000; docs/thermal.md): the mean recoil "
+            "changes neither the spin rate, nor the obliquity, nor the tumbling state; only a precession of the "
+            "spin axis about the orbit normal and the periodic terms are left. Use an irregular shape (read_obj, "
+            "gaussian_random_sphere) for a YORP evolution.", VanishingYorpWarning, stacklevel=4)
 
 
 def validate_thermal(state, thermal, thermal_route, orbit, perturbers, epoch, times):

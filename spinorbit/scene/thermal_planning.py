@@ -43,7 +43,7 @@ from spinorbit.scene.plan import ARCSEC_PER_RAD, Decision, Plan, PlanError
 from spinorbit.scene.tolerances import CHECK_RTOL_FACTOR, first_tolerance
 
 __all__ = ["THERMAL_ROUTES", "MIN_MEAN_ORBITS", "MEAN_STEP_SHARE", "MAX_FULL_RHS", "MEAN_CHANGE_ERROR",
-           "ORBIT_POINTS", "FULL_RHS_SECONDS", "MEAN_RHS_SECONDS", "SeparatrixCrossingError", "ThermalSetup", "plan_thermal", "thermal_setup",
+           "ORBIT_POINTS", "FULL_RHS_SECONDS", "MEAN_RHS_SECONDS", "FULL_FACET_SECONDS", "MEAN_FACET_SECONDS", "SeparatrixCrossingError", "ThermalSetup", "plan_thermal", "thermal_setup",
            "orbit_short_period", "mean_difference"]
 
 THERMAL_ROUTES = ("auto", "full", "mean")
@@ -60,6 +60,11 @@ MEAN_STEP_SHARE = 0.01
 #: planner compares the routes in these seconds, so only their ratio (≈ 1.1) decides.
 FULL_RHS_SECONDS = 5.2e-7
 MEAN_RHS_SECONDS = 5.5e-7
+#: What the facets add: per facet and full right-hand side with ``torque="facets"`` (the direct sum), and
+#: per facet and torus point of the mean route's exact orbit average (benchmarks/thermal_scene.py measures
+#: both with the constants above; the planner compares the routes in these seconds).
+FULL_FACET_SECONDS = 1.4e-9
+MEAN_FACET_SECONDS = 1.6e-9
 #: Right-hand sides beyond which the full route is refused: 2e9 is ~17 min at FULL_RHS_SECONDS.
 MAX_FULL_RHS = 2e9
 #: Relative error of the mean theory's secular changes of (S, Z, H) against the full integration:
@@ -119,6 +124,17 @@ class ThermalSetup:
 def thermal_setup(scene):
     """:class:`ThermalSetup` of a thermal scene."""
     return ThermalSetup(scene)
+
+
+def _exact_rates(setup):
+    """The recoil's mean d(S, Z, H, h)/dt at the start: the exact orbit average on the mean route's torus grid."""
+    from spinorbit.core.averaging.thermal_mean import EXACT_POINTS_S, EXACT_POINTS_Z, exact_mean_thermal_rates
+    from spinorbit.core.elements.canonical import inertia_constants
+
+    out = np.empty(4)
+    exact_mean_thermal_rates(setup.el0, setup.model, setup.frame, inertia_constants(*setup.moments), EXACT_POINTS_S,
+                             EXACT_POINTS_Z, out)
+    return out
 
 
 def _torus_rates(setup, t, model, n_orbit=1, period=1.0):
@@ -224,13 +240,7 @@ def plan_thermal(scene, skip=True):
     SeparatrixCrossingError
         The mean route is needed but reaches the separatrix inside the span at the initial rate.
     """
-    from spinorbit.core.averaging.thermal_mean import (
-        MIN_SEPARATRIX_DISTANCE,
-        THERMAL_POINTS_ORBIT,
-        THERMAL_POINTS_S,
-        THERMAL_POINTS_Z,
-        recoil_only_model,
-    )
+    from spinorbit.core.averaging.thermal_mean import EXACT_POINTS_S, EXACT_POINTS_Z, MIN_SEPARATRIX_DISTANCE
     from spinorbit.time import time_from_tdb_days
 
     tolerance = scene.tolerance_rad
@@ -241,7 +251,8 @@ def plan_thermal(scene, skip=True):
     decisions = [Decision("outputs", f"{scene.output_days.size} output time(s)", "as asked")]
     recoil_at_q = thermal.torque_bound(setup.perihelion * u.au)
     decisions.append(Decision(
-        "sunlight", f"Rubincam recoil of {len(thermal.shape)} facets, degree {thermal.degree}, η = {thermal.efficiency:g}"
+        "sunlight", f"Rubincam recoil of {len(thermal.shape)} facets (full route: {thermal.torque_text}), "
+        f"η = {thermal.efficiency:g}"
         + (f"; nutation damping μQ = {thermal.mu_q:.3g}, K₃² = {thermal.k3_squared:g}" if thermal.mu_q is not None else ""),
         f"thermal= was given; |T| ≤ {recoil_at_q.to_value(u.N * u.m):.3g} N m at perihelion "
         f"({setup.perihelion:.4g} au); the Sun's gravity torque comes with its position (one torque sum)"))
@@ -255,8 +266,7 @@ def plan_thermal(scene, skip=True):
     if setup.el0 is None:
         refusal.append(f"the state has no canonical elements ({setup.why_no_elements})")
     else:
-        recoil = recoil_only_model(setup.model)
-        rates = _torus_rates(setup, setup.t0, recoil, THERMAL_POINTS_ORBIT, setup.period_orbit)
+        rates = _exact_rates(setup)
         from spinorbit.core.averaging.dissipation import damping_rate_of_s
         from spinorbit.core.elements.canonical import inertia_constants
 
@@ -267,7 +277,7 @@ def plan_thermal(scene, skip=True):
         intervals = np.diff(np.concatenate([[setup.t0], scene.output_days]))
         mean_steps = int(np.sum(np.ceil(intervals / step - 1e-9)))  # each output is landed on
         check_steps = int(np.sum(np.ceil(intervals / (0.5 * step) - 1e-9)))  # the check at half the step
-        grid = THERMAL_POINTS_S * THERMAL_POINTS_Z * THERMAL_POINTS_ORBIT
+        grid = EXACT_POINTS_S * EXACT_POINTS_Z
         mean_rhs = float(mean_steps + check_steps) * STAGES * grid
         short_orbit = orbit_short_period(setup)
         short_torus, nu = _torus_bound(setup, thermal)
@@ -277,7 +287,7 @@ def plan_thermal(scene, skip=True):
         separatrix, to_separatrix = _separatrix_time(setup, rates)
         mean_info = dict(step=step, steps=mean_steps, rhs=mean_rhs, short_period=short_orbit + short_torus,
                          averaging=averaging, estimate=estimate, separatrix=separatrix, to_separatrix=to_separatrix,
-                         evolution=evolution, n_grid=(THERMAL_POINTS_S, THERMAL_POINTS_Z, THERMAL_POINTS_ORBIT))
+                         evolution=evolution, n_grid=(EXACT_POINTS_S, EXACT_POINTS_Z))
         facts += (f"; YORP{' + damping' if setup.damping else ''} evolution time Z/|rate| ≈ {_years(evolution)}; "
                   f"mean estimate {estimate * ARCSEC_PER_RAD:.3g} arcsec (orbit short-period {short_orbit * ARCSEC_PER_RAD:.3g}, "
                   f"torus bound {short_torus * ARCSEC_PER_RAD:.3g} at ν = {nu:.3g} rad/d, averaging "
@@ -285,7 +295,9 @@ def plan_thermal(scene, skip=True):
                   f"1 − m = {separatrix:.3g}"
                   + (f", separatrix in ≈ {_years(to_separatrix)} at the initial rate" if math.isfinite(to_separatrix)
                      else ", not approaching the separatrix"))
-        full_s, mean_s = full_rhs * FULL_RHS_SECONDS, mean_rhs * MEAN_RHS_SECONDS
+        facets = len(thermal.shape)
+        full_s = full_rhs * (FULL_RHS_SECONDS + (facets * FULL_FACET_SECONDS if thermal.torque == "facets" else 0.0))
+        mean_s = mean_rhs * (MEAN_RHS_SECONDS + facets * MEAN_FACET_SECONDS)
         costs = (f"cost: full ≈ {full_rhs:.3g} right-hand sides ≈ {full_s:.3g} CPU s, mean ≈ {mean_rhs:.3g} ≈ "
                  f"{mean_s:.3g} CPU s ({mean_steps} steps of {_years(step)})")
         facts += "; " + costs
@@ -338,13 +350,13 @@ def plan_thermal(scene, skip=True):
                     integrator="quaternion", rtol=rtol, end_only=scene.end_only, tolerance_rad=tolerance, kappa=1.0,
                     dropped_bound_rad=0.0, full=not skip, decisions=decisions,
                     thermal=dict(setup=setup, mean=mean_info))
-    n_s, n_z, n_orbit = mean_info["n_grid"]
+    n_s, n_z = mean_info["n_grid"]
     decisions.append(Decision(
         "integrator", f"mean DOP853, fixed step {_years(mean_info['step'])} ({mean_info['steps']} steps; checked "
-        f"against half the step), grid {n_s} × {n_z} × {n_orbit}, gravity's mean precession"
-        + (", nutation damping" if setup.damping else ""),
-        f"step = {MEAN_STEP_SHARE:g} × the evolution time (at least one orbit); the grid converges geometrically "
-        "(tests/test_thermal_mean.py)"))
+        f"against half the step), the facet sum's orbit average in closed form on a {n_s} × {n_z} torus grid, "
+        "gravity's mean precession" + (", nutation damping" if setup.damping else ""),
+        f"step = {MEAN_STEP_SHARE:g} × the evolution time (at least one orbit); the torus grid leaves a few 1e-4 "
+        "of the mean rates (docs/thermal.md, tests/test_yorp_mean.py)"))
     return Plan(route="thermal-mean", orbit_source="kepler", kept=("sun",), dropped=(), estimates={},
                 integrator="mean-dop853", rtol=None, end_only=scene.end_only, tolerance_rad=tolerance, kappa=1.0,
                 dropped_bound_rad=0.0, full=not skip, decisions=decisions, thermal=dict(setup=setup, mean=mean_info))

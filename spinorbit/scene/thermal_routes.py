@@ -67,7 +67,9 @@ def _normals(scene, n):
 def run_thermal_full(scene, plan, report):
     """The full integration under the Sun's gravity and the recoil, checked a posteriori; ``report(fraction)``."""
     from spinorbit.core.integrators.quaternion import integrate_quaternion
+    from spinorbit.scene.thermal import warn_if_yorp_vanishes
 
+    warn_if_yorp_vanishes(scene.thermal)
     setup = plan.thermal["setup"]
     t_out = scene.output_days
 
@@ -100,9 +102,11 @@ def run_thermal_full(scene, plan, report):
 def run_thermal_mean(scene, plan, report):
     """The mean YORP run (and its check at half the step): mean elements, pole, obliquity, periods."""
     from spinorbit.core.averaging.thermal_mean import SeparatrixReachedError, propagate_mean_thermal
+    from spinorbit.scene.thermal import warn_if_yorp_vanishes
     from spinorbit.scene.thermal_planning import SeparatrixCrossingError, mean_difference
     from spinorbit.time import time_from_tdb_days
 
+    warn_if_yorp_vanishes(scene.thermal)
     setup, info = plan.thermal["setup"], plan.thermal["mean"]
     t_out = scene.output_days
 

@@ -18,7 +18,8 @@ from spinorbit.core.model.thermal import pack_thermal, recoil_pressure
 from spinorbit.shape.mass import ShapeMassProperties
 from spinorbit.shape.mesh import Shape
 
-__all__ = ["thermal_block", "principal_facets", "principal_vertices", "DEFAULT_THERMAL_DEGREE", "DEFAULT_SHADOW_SAMPLES"]
+__all__ = ["thermal_block", "principal_facets", "principal_vertices", "DEFAULT_THERMAL_DEGREE", "DEFAULT_SHADOW_SAMPLES",
+           "TORQUES"]
 
 #: Degree of the default representation: its spin-averaged torque's error against the facet sum and
 #: its cost per evaluation, degree by degree, are in docs/thermal.md (benchmarks/thermal_validation.py).
@@ -26,6 +27,9 @@ DEFAULT_THERMAL_DEGREE = 8
 #: Sample points per facet edge of a shadowed fit (q² rays per facet and direction): the centroid
 #: alone (q = 1) decides a facet's shadow all or nothing; q = 2 halves that step at four times the rays.
 DEFAULT_SHADOW_SAMPLES = 2
+#: How a block's torque is evaluated: the degree-L harmonics, or the facet sum itself (exact, one pass over
+#: the facets per evaluation).
+TORQUES = ("harmonics", "facets")
 SECONDS_PER_DAY = 86400.0
 METRES_PER_KM = 1000.0
 
@@ -43,7 +47,7 @@ def principal_facets(shape: Shape, properties: ShapeMassProperties):
 
 
 def thermal_block(shape: Shape, properties: ShapeMassProperties, degree=DEFAULT_THERMAL_DEGREE, efficiency=1.0, *,
-                  self_shadowing=False, shadow_samples=DEFAULT_SHADOW_SAMPLES, shadow_grid=None):
+                  self_shadowing=False, shadow_samples=DEFAULT_SHADOW_SAMPLES, shadow_grid=None, torque="harmonics"):
     """The thermal block of a shape for ``make_model(..., thermal=block)`` in au, day and kg m².
 
     Parameters
@@ -66,6 +70,10 @@ def thermal_block(shape: Shape, properties: ShapeMassProperties, degree=DEFAULT_
     shadow_grid : int, optional
         Latitudes of the fit's Sun-direction grid (default
         :func:`spinorbit.core.model.thermal.default_shadow_grid`).
+    torque : {"harmonics", "facets"}
+        What an evaluation sums: the degree-L representation, or the facets themselves (exact, not with
+        self-shadowing; docs/thermal.md times both). The block carries the facets either way, for the
+        exact mean YORP average.
 
     Returns
     -------
@@ -76,9 +84,11 @@ def thermal_block(shape: Shape, properties: ShapeMassProperties, degree=DEFAULT_
         raise ValueError(f"efficiency: expected 0 < η ≤ 1 (the Lambertian share of the sunlight); got {efficiency!r}.")
     if not isinstance(self_shadowing, (bool, np.bool_)):
         raise TypeError(f"self_shadowing: expected True or False; got {self_shadowing!r}.")
+    if torque not in TORQUES:
+        raise ValueError(f"torque: expected one of {TORQUES}; got {torque!r}.")
     vertices = principal_vertices(shape, properties)
     normals, areas, centroids = face_geometry(vertices, shape.faces)
     shadowing = shadow_geometry(vertices, shape.faces, shadow_samples) if self_shadowing else None
     pressure_model = recoil_pressure(efficiency) * SECONDS_PER_DAY**2  # kg m⁻¹ s⁻² → kg m⁻¹ day⁻²
     return pack_thermal(normals, areas, centroids, int(degree), pressure_model, 1.0, shadowing=shadowing,
-                        shadow_grid=shadow_grid)
+                        shadow_grid=shadow_grid, direct=torque == "facets")

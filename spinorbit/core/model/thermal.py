@@ -32,10 +32,20 @@ orbit-averaged torques, which YORP's evolution needs, are carried almost entirel
     block[base + TH_PRESSURE]     P(d₀) in the caller's force / length² unit
     block[base + TH_DISTANCE]     d₀, the distance of P(d₀), in the model's length unit
     block[base + TH_ALL_DEGREES]  1 when odd degrees ≥ 3 carry terms (a shadowed fit), 0 when they are zero
+    block[base + TH_FACETS]       m, the number of facets in the facet table at the block's end
+    block[base + TH_DIRECT]       1: the torque and force are the facet sum itself, 0: the harmonics
     block[base + TH_RECURRENCE …]      the Legendre recurrence coefficients (2l − 1)/(l − m), then (l + m − 1)/(l − m),
                                   (L + 1)² values each
     then, per harmonic, N_lm g_lm for the torque (3 values) and for the force (3 values), with
     N_lm the normalisation of Y_lm = N_lm P_lm(sin φ) (cos, sin) mλ
+    then the facet table (:func:`facet_table_offset`): FACET_WIDTH rows n_x, n_y, n_z, A, and A (r × n)
+    x, y, z, each of TH_FACETS values (the facet count rounded up to a multiple of eight with zero facets,
+    so that the sums run eight facets to a register, :mod:`spinorbit.core.math.lanes`)
+
+The facet table is the surface the coefficients were made from. It is what the exact averages of
+:mod:`spinorbit.core.averaging.recoil_orbit_mean` sum, and, with ``TH_DIRECT``, what every evaluation
+sums instead of the harmonics: exact for a convex shape at every Sun direction, at the cost of one pass
+over the facets (docs/thermal.md times both).
 
 Harmonics are indexed l² (order 0), l² + 2m − 1 (cos mλ) and l² + 2m (sin mλ), m = 1..l.
 
@@ -54,18 +64,24 @@ import numpy as np
 from numpy.polynomial import legendre
 
 from spinorbit.core.jit import jit
+from spinorbit.core.math.lanes import WIDTH, broadcast, lane_of, load_lanes, select
 from spinorbit.core.model.polyhedron import regular_solid_harmonics
 from spinorbit.core.model.shadowing import shadowed_recoil_sums
 
 __all__ = [
     "TH_DEGREE", "TH_SUN_ROW", "TH_PRESSURE", "TH_DISTANCE", "TH_ALL_DEGREES", "TH_RECURRENCE", "MAX_THERMAL_DEGREE",
     "clamped_cosine_coefficient", "harmonic_count", "real_harmonics", "pack_thermal", "thermal_block_size",
-    "facet_force_torque", "thermal_force_torque_xyz", "recoil_pressure", "sun_direction_grid",
-    "default_shadow_grid",
+    "facet_force_torque", "thermal_force_torque_xyz", "facet_sum_xyz", "recoil_pressure", "sun_direction_grid",
+    "default_shadow_grid", "TH_FACETS", "TH_DIRECT", "FACET_WIDTH", "facet_table_offset",
+    "padded_facet_count", "lane_sums6", "FACET_NX", "FACET_NY", "FACET_NZ", "FACET_AREA", "FACET_ARM_X", "FACET_ARM_Y",
+    "FACET_ARM_Z",
 ]
 
-TH_DEGREE, TH_SUN_ROW, TH_PRESSURE, TH_DISTANCE, TH_ALL_DEGREES = 0, 1, 2, 3, 4
-TH_RECURRENCE = 5
+TH_DEGREE, TH_SUN_ROW, TH_PRESSURE, TH_DISTANCE, TH_ALL_DEGREES, TH_FACETS, TH_DIRECT = range(7)
+TH_RECURRENCE = 7
+#: Values per facet in the block's facet table: n (3), A, A (r × n) (3), one row of each.
+FACET_WIDTH = 7
+FACET_NX, FACET_NY, FACET_NZ, FACET_AREA, FACET_ARM_X, FACET_ARM_Y, FACET_ARM_Z = range(FACET_WIDTH)
 #: Highest degree of the representation: P_LL grows like (2L − 1)!!, far from overflow at 40.
 MAX_THERMAL_DEGREE = 40
 #: Speed of light (m/s, exact, SI) and the nominal total solar irradiance at 1 au (W/m², IAU 2015
@@ -97,9 +113,22 @@ def harmonic_count(degree_max):
     return (degree_max + 1) ** 2
 
 
-def thermal_block_size(degree_max):
-    """Floats in a thermal block of degree L: header, norms and six coefficients per harmonic."""
-    return TH_RECURRENCE + 8 * harmonic_count(degree_max)
+def padded_facet_count(facets):
+    """Facets rounded up to whole registers of :data:`spinorbit.core.math.lanes.WIDTH` (the table's row length)."""
+    return -(-int(facets) // WIDTH) * WIDTH
+
+
+def thermal_block_size(degree_max, facets=0):
+    """Floats in a thermal block of degree L with ``facets`` facets: header, recurrences, six coefficients
+    per harmonic, the facet table."""
+    return TH_RECURRENCE + 8 * harmonic_count(degree_max) + FACET_WIDTH * padded_facet_count(facets)
+
+
+@jit(inline="always")
+def facet_table_offset(block, base):
+    """Index of the facet table's first value in ``block`` (its layout in the module docstring)."""
+    degree_max = int(block[base + TH_DEGREE])
+    return base + TH_RECURRENCE + 8 * (degree_max + 1) * (degree_max + 1)
 
 
 def default_shadow_grid(degree_max):
@@ -163,7 +192,7 @@ def real_harmonics(directions, degree_max):
 
 
 def pack_thermal(normals, areas, centroids, degree_max, pressure, distance, sun_row=-1, *, shadowing=None,
-                 shadow_grid=None):
+                 shadow_grid=None, direct=False):
     """The thermal block of a shape: the compact representation of F(ŝ) and T(ŝ).
 
     Parameters
@@ -187,6 +216,9 @@ def pack_thermal(normals, areas, centroids, degree_max, pressure, distance, sun_
     shadow_grid : int, optional
         Latitudes of the fit's direction grid (:func:`sun_direction_grid`); default
         :func:`default_shadow_grid`.
+    direct : bool
+        Evaluate the facet sum itself instead of the harmonics (``TH_DIRECT``). Not with shadows:
+        the shadows exist only as the fit.
 
     Returns
     -------
@@ -198,7 +230,11 @@ def pack_thermal(normals, areas, centroids, degree_max, pressure, distance, sun_
     if not (pressure > 0 and distance > 0 and math.isfinite(pressure) and math.isfinite(distance)):
         raise ValueError(f"pressure and distance: expected positive finite numbers; got {pressure!r}, {distance!r}.")
     count = harmonic_count(degree_max)
-    if shadowing is not None and not shadowing.convex:
+    shadowed = shadowing is not None and not shadowing.convex
+    if direct and shadowed:
+        raise ValueError("direct: the facet sum without shadows cannot stand for a shadowed surface (its shadows "
+                         "exist only as the fit); give direct=False, or self_shadowing=False for the facet sum.")
+    if shadowed:
         if shadowing.faces.shape[0] != np.asarray(areas).shape[0]:
             raise ValueError(f"shadowing: expected the geometry of the same {np.asarray(areas).shape[0]} facets; got "
                              f"{shadowing.faces.shape[0]}. Build it from the vertices the facets came from.")
@@ -222,8 +258,12 @@ def pack_thermal(normals, areas, centroids, degree_max, pressure, distance, sun_
             k = n * n + 2 * m - 1 if m > 0 else n * n
             rec_a[k] = (2.0 * n - 1.0) / (n - m)
             rec_b[k] = (n + m - 1.0) / (n - m)
-    header = np.array([float(degree_max), float(sun_row), float(pressure), float(distance), all_degrees])
-    return np.concatenate([header, rec_a, rec_b, coefficients.ravel()])
+    padded = padded_facet_count(np.asarray(areas).shape[0])
+    header = np.array([float(degree_max), float(sun_row), float(pressure), float(distance), all_degrees,
+                       float(padded), 1.0 if direct else 0.0])
+    facets = np.zeros((FACET_WIDTH, padded))  # zero facets pad the rows: no area, no arm, never lit
+    facets[:, :areas.shape[0]] = np.column_stack([normals, areas, areas[:, None] * np.cross(centroids, normals)]).T
+    return np.concatenate([header, rec_a, rec_b, coefficients.ravel(), facets.ravel()])
 
 
 def facet_force_torque(normals, areas, centroids, sun_direction):
@@ -257,6 +297,11 @@ def thermal_force_torque_xyz(sx, sy, sz, distance, block, base):
     coef = rec_b + count
     inv = 1.0 / math.sqrt(sx * sx + sy * sy + sz * sz)
     x, y, z = sx * inv, sy * inv, sz * inv
+    ratio = block[base + TH_DISTANCE] / distance
+    scale = -block[base + TH_PRESSURE] * ratio * ratio
+    if block[base + TH_DIRECT] != 0.0:
+        fx, fy, fz, tx, ty, tz = facet_sum_xyz(x, y, z, block, base)
+        return scale * fx, scale * fy, scale * fz, scale * tx, scale * ty, scale * tz
     fx = fy = fz = tx = ty = tz = 0.0
     mm_re, mm_im = 1.0, 0.0  # P_mm (cos φ)^m (cos, sin) mλ = (2m − 1)!! Re, Im (x + iy)^m
     for m in range(degree_max + 1):
@@ -281,6 +326,47 @@ def thermal_force_torque_xyz(sx, sy, sz, distance, block, base):
                 fx += block[row + 3] * value
                 fy += block[row + 4] * value
                 fz += block[row + 5] * value
-    ratio = block[base + TH_DISTANCE] / distance
-    scale = -block[base + TH_PRESSURE] * ratio * ratio
     return scale * fx, scale * fy, scale * fz, scale * tx, scale * ty, scale * tz
+
+
+@jit
+def facet_sum_xyz(x, y, z, block, base):
+    """Σ A max(0, n·ŝ) n and Σ A max(0, n·ŝ)(r × n) over the block's facet table, ŝ = (x, y, z) a unit vector.
+
+    The direct sum of the module docstring without −P(d): the exact recoil of a convex surface. Eight
+    facets per register; each lane's arithmetic is the scalar IEEE operation, the eight partial sums
+    are added at the end.
+    """
+    table = facet_table_offset(block, base)
+    count = int(block[base + TH_FACETS])
+    sx, sy, sz, zero = broadcast(x), broadcast(y), broadcast(z), broadcast(0.0)
+    fx = fy = fz = tx = ty = tz = zero
+    for k in range(0, count, WIDTH):
+        nx = load_lanes(block, table + FACET_NX * count + k)
+        ny = load_lanes(block, table + FACET_NY * count + k)
+        nz = load_lanes(block, table + FACET_NZ * count + k)
+        cosine = nx * sx + ny * sy + nz * sz
+        cosine = select(cosine > zero, cosine, zero)
+        lit = cosine * load_lanes(block, table + FACET_AREA * count + k)
+        fx = fx + lit * nx
+        fy = fy + lit * ny
+        fz = fz + lit * nz
+        tx = tx + cosine * load_lanes(block, table + FACET_ARM_X * count + k)
+        ty = ty + cosine * load_lanes(block, table + FACET_ARM_Y * count + k)
+        tz = tz + cosine * load_lanes(block, table + FACET_ARM_Z * count + k)
+    return lane_sums6(fx, fy, fz, tx, ty, tz)
+
+
+@jit(inline="always")
+def lane_sums6(a, b, c, d, e, f):
+    """The sums over the lanes of six Lanes values, lane 0 first."""
+    sa = sb = sc = sd = se = sf = 0.0
+    for i in range(WIDTH):
+        va, vb, vc, vd, ve, vf = lane_of((a, b, c, d, e, f), i)
+        sa += va
+        sb += vb
+        sc += vc
+        sd += vd
+        se += ve
+        sf += vf
+    return sa, sb, sc, sd, se, sf

@@ -6,7 +6,7 @@ surface it contributes when both are positive, and the disk-integrated brightnes
 
     L(ŝ, ô) = Σ_k A_k S(μ₀, μ)  over the facets with μ₀ > 0 and μ > 0,
 
-with the laws of Kaasalainen, Torppa & Muinonen (2001, Icarus 153, 37, eq. 1 without its phase
+with the laws of Kaasalainen, Torppa & Muinonen (2001, Icarus 153, 37: their law without its phase
 factor f(α), which :mod:`spinorbit.photometry` applies to the whole sum)::
 
     Lommel–Seeliger  S = μ μ₀ / (μ + μ₀)
@@ -35,7 +35,7 @@ __all__ = ["LAWS", "EPOCH_GROUP", "DEFAULT_LAMBERT_WEIGHT", "law_weights", "face
 #: The laws by name, and the weights (w_LS, w_L) of S = μ μ₀ (w_LS/(μ + μ₀) + w_L); Kaasalainen's
 #: Lambert weight is the argument c of :func:`law_weights`.
 LAWS = ("lommel-seeliger", "lambert", "kaasalainen")
-#: Kaasalainen et al. (2001)'s Lambert weight c (their section 2: "c ≈ 0.1").
+#: The Lambert weight c of Kaasalainen et al. (2001), who take c = 0.1.
 DEFAULT_LAMBERT_WEIGHT = 0.1
 #: Epochs per pass over the facets: two registers of eight doubles.
 EPOCH_GROUP = 16

@@ -49,6 +49,8 @@ BENCHMARKS = (
     Benchmark("bench_elliptic.py"),
     Benchmark("accuracy_elliptic.py"),
     Benchmark("accuracy_photometry.py", quick=("--no-write",)),
+    Benchmark("bench_photometry.py", quick=("--repeat", "1", "--size", "1000", "--no-write")),
+    Benchmark("wobble_detectability.py", quick=("--quick",)),
     Benchmark("accuracy_symmetric_permanent.py", quick=("--no-write",)),
     Benchmark("accuracy_torque_free.py"),
     Benchmark("bench_torque_free.py"),

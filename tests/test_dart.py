@@ -148,7 +148,7 @@ def test_cheng_velocity_change_gives_thomas_period_change(nominal):
 
 @pytest.mark.xfail(strict=True, reason=(
     "missed: Δv = −2.63 mm/s gives −32.19 min at the published central values, 31 s short of Naidu et al. "
-    "(2024)'s −32.7 min ± 16 s. The change scales nearly as 1/separation (−0.028 min per metre): the bar is met "
+    "(2024)'s −32.7 min ± 16 s. The change scales nearly as 1/separation (its size grows by 0.028 min per metre less): the bar is met "
     "for a pre-impact separation of 1.188 km, 0.5σ below the published 1.206 ± 0.035 km (docs/binary.md)"))
 def test_naidu_velocity_change_gives_naidu_initial_period_change(nominal):
     # Bar of issue 37: Δv = −2.63 mm/s (Naidu et al. 2024) must give their immediate change −32.7 min

@@ -8,6 +8,7 @@ a terminal does).
 """
 
 import ast
+import contextlib
 import os
 import signal
 import subprocess
@@ -92,12 +93,12 @@ STOP_SECONDS = 1.5
 FIRST_CHUNK_SECONDS = 120.0
 
 
-def _start_ensemble(tmp_path):
+def _start_ensemble(tmp_path, output=subprocess.PIPE):
     env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
     # 1000 members (chunks of 64): minutes of work, so the run is surely under way when signalled
     return subprocess.Popen([sys.executable, "-m", "spinorbit", "apophis", "--members", "1000", "--workers", "2",
                              "--seed", "7", "--checkpoint-dir", str(tmp_path / "chunks")],
-                            cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            cwd=ROOT, env=env, stdout=output, stderr=output, text=True,
                             start_new_session=True)
 
 
@@ -137,8 +138,36 @@ def test_an_ensemble_command_stops_within_a_second_and_keeps_its_finished_chunks
     assert process.returncode == status, err
     assert took < STOP_SECONDS, f"{took:.2f} s from the signal to the exit"
     assert "Traceback" not in err and err.count("\n") <= 2, err  # the progress line and one message
-    kept = sorted(p.name for p in chunks.iterdir())
-    assert kept and all(name.startswith("chunk-") for name in kept)  # no temporary file left half-written
+    names = sorted(p.name for p in chunks.iterdir())
+    kept = [name for name in names if name.startswith("chunk-")]
+    assert kept and not any(name.startswith(".") for name in names), names  # no temporary file left half-written
     assert f"{64 * len(kept)} of 1000 members are kept" in err.replace("\r", "\n").splitlines()[-1]
     time.sleep(0.5)  # the workers were terminated and reaped before the exit; allow the kernel a moment
     assert [w.pid for w in workers if w.is_running() and w.status() != psutil.STATUS_ZOMBIE] == []
+
+
+def test_the_workers_die_with_a_killed_parent(tmp_path):
+    # SIGKILL leaves the parent no chance to stop its pool: the kernel's parent-death signal does it
+    # (before, the workers were re-parented to PID 1 and still computing 10 minutes later).
+    psutil = pytest.importorskip("psutil")
+    # output to a file: orphaned workers would hold a pipe open, and reading it to its end would hang
+    with open(tmp_path / "output", "w") as output:
+        process = _start_ensemble(tmp_path, output)
+    workers = []
+    try:
+        deadline = time.monotonic() + FIRST_CHUNK_SECONDS
+        while len(workers) < 2 and time.monotonic() < deadline and process.poll() is None:
+            time.sleep(0.1)
+            workers = psutil.Process(process.pid).children(recursive=True)
+        assert len(workers) == 2, (tmp_path / "output").read_text()
+        time.sleep(0.5)  # past the workers' initializer (where the parent-death signal is asked for)
+        process.kill()
+        process.wait()
+        _, alive = psutil.wait_procs(workers, timeout=5.0)  # a few seconds, as the issue asks
+        assert alive == [], f"workers still alive 5 s after their parent's SIGKILL: {alive}"
+    finally:
+        process.kill()
+        process.wait()
+        for worker in workers:  # never leave a worker behind, even when the test fails
+            with contextlib.suppress(psutil.NoSuchProcess):
+                worker.kill()

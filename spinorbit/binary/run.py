@@ -44,6 +44,7 @@ from spinorbit.core.binary.libration import (
     secondary_rotation_table,
 )
 from spinorbit.core.binary.propagate import propagate_binary
+from spinorbit.core.free_motion.wobble import wobble_amplitude_many
 from spinorbit.quantities import value_in
 
 #: Fewest cycles a reported libration line completes in the run: below 10, one resolution 2π/T is more
@@ -161,6 +162,18 @@ class BinaryRun:
     def libration(self):
         """φ(t), B's long axis from the line to A in B's equator, modulo π (Quantity rad)."""
         return self.secondary_rotation()[:, COL_LIBRATION] * u.rad
+
+    def secondary_wobble(self):
+        """The wobble amplitude of B's rotation at each output time (Quantity deg): the largest angle its
+        circulation axis (C in SAM, A in LAM) makes with its angular momentum over the torque-free motion
+        through that instant (:mod:`spinorbit.core.free_motion.wobble`; ``docs/conventions.md``, "Wobble and
+        rotation class"). 0 for a principal-axis rotation; the package calls a body tumbling above 1°."""
+        model = self.model
+        moments = np.array([model[core.M_INERTIA_B], model[core.M_INERTIA_B + 4], model[core.M_INERTIA_B + 8]])
+        momenta = np.ascontiguousarray(self.states[:, core.OMEGA_B:core.OMEGA_B + 3] * moments)
+        out = np.empty(len(momenta))
+        wobble_amplitude_many(momenta, moments[0], moments[1], moments[2], out)
+        return (out * u.rad).to(u.deg)
 
     def secondary_modes(self):
         """Mode names (SAM, LAM, principal-axis, separatrix) of B's rotation at each output time."""

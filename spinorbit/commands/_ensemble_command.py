@@ -19,8 +19,9 @@ def add_ensemble_arguments(parser) -> None:
     where = group.add_mutually_exclusive_group()
     where.add_argument("--workers", metavar="K", help="K local worker processes (default: one per core)")
     where.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://10.0.0.1:8786")
-    group.add_argument("--seed", default=None, help="root seed of the members' draws (default: fresh entropy, "
-                       "recorded in the output)")
+    group.add_argument("--seed", default=None, help="root seed of the members' draws (default: the one stored in "
+                       "--checkpoint-dir, else fresh entropy; printed at the start and stored there, so the same "
+                       "command resumes)")
     group.add_argument("--checkpoint-dir", metavar="DIR", help="keep completed chunks in DIR; run again with the same "
                        "DIR and options to run only the missing members")
 
@@ -66,7 +67,8 @@ def run_apophis_ensemble(args, span_days) -> int:
 
     check_ensemble_arguments(args)
     tolerance = float(args.tolerance_quantity.to_value("arcsec"))
-    parameters = apophis_parameters(args.members, args.seed, span_days=span_days, orbit=args.orbit,
+    seed = _seed(args)
+    parameters = apophis_parameters(args.members, seed, span_days=span_days, orbit=args.orbit,
                                     perturbers=tuple(args.perturbers), tolerance_arcsec=tolerance)
     ensemble = Ensemble(apophis_member, parameters)
     executor = _executor(args)
@@ -87,6 +89,27 @@ def run_apophis_ensemble(args, span_days) -> int:
     if args.plot is not None:
         write_plot_output(args.plot, lambda temporary: histograms(table, temporary, plot_format(args.plot)))
     return 0 if not ensemble.failures else 1
+
+
+def _seed(args) -> int:
+    """The members' root seed: --seed, else the one stored in --checkpoint-dir (a resume), else fresh
+    entropy; printed before the run, so that a killed run can always be repeated or resumed."""
+    import numpy as np
+
+    from spinorbit.ensemble.store import stored_seed
+
+    if args.seed is not None:
+        print(f"seed               {args.seed} (--seed)")
+        return args.seed
+    stored = None if args.checkpoint_dir is None else stored_seed(args.checkpoint_dir)
+    if stored is not None:
+        print(f"seed               {stored} (stored in '{args.checkpoint_dir}': this run resumes the ensemble there)")
+        return stored
+    seed = int(np.random.SeedSequence().entropy)
+    where = (f"stored in '{args.checkpoint_dir}', so the same command resumes" if args.checkpoint_dir is not None
+             else "add --checkpoint-dir DIR to keep finished chunks")
+    print(f"seed               {seed} (fresh; --seed {seed} draws the same members; {where})", flush=True)
+    return seed
 
 
 def _kept(ensemble, args) -> str:

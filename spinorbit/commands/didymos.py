@@ -102,7 +102,8 @@ def _report(label, run):
         f"{label}",
         *orbit_lines,
         f"  Dimorphos rotation       non-principal-axis (SAM/LAM) at {100 * tumbling:.0f} % of the output times, "
-        f"principal-axis at the rest, max E/E0 - 1 = {energy_excess:.3g}"
+        f"principal-axis at the rest, max E/E0 - 1 = {energy_excess:.3g}, max wobble "
+        f"{run.secondary_wobble().max().to_value(u.deg):.3g} deg (tumbling above 1 deg)"
         + (f", P_psi = {p_psi.to_value(u.h):.3f} h, P_phi = {p_phi.to_value(u.h):.3f} h" if tumbling else ""),
         f"  drift                    |dE/E| = {e_rel.max():.2e} (|dE/U| = {e_potential.max():.2e}), "
         f"|dH/H| = {run.angular_momentum_drift().max():.2e}",

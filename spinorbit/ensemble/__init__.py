@@ -1,4 +1,5 @@
-"""Ensembles of Scenes: Monte Carlo over unknown phases and parameters, on any executor (``docs/ensembles.md``).
+"""Ensembles of Scenes, or of members that run themselves: Monte Carlo over unknown phases and parameters,
+on any executor (``docs/ensembles.md``).
 
 - :mod:`~spinorbit.ensemble.ensemble` — :class:`Ensemble`: members from ``make_scene(**row)``, fixed
   chunks, one outcome table, checkpoints, failures and reruns;
@@ -7,7 +8,10 @@
 - :mod:`~spinorbit.ensemble.store` — completed chunks in checksummed, atomic checkpoint files;
 - :mod:`~spinorbit.ensemble.outcomes` — a member's outcome row from its SceneResult;
 - :mod:`~spinorbit.ensemble.free` — torque-free members in one vectorised call of the exact free flow;
-- :mod:`~spinorbit.ensemble.apophis` — the Apophis 2029 encounter over phase and moment-ratio uncertainty.
+- :mod:`~spinorbit.ensemble.apophis` — the Apophis 2029 encounter over phase and moment-ratio uncertainty;
+- :mod:`~spinorbit.ensemble.self_run` — members that run themselves (not Scenes);
+- :mod:`~spinorbit.ensemble.dart` — DART's period change over the published uncertainties (members that
+  run themselves: full-two-body runs, not Scenes).
 """
 
 from spinorbit.ensemble.ensemble import Ensemble

@@ -1,8 +1,9 @@
 """An ensemble of Scenes: one member per parameter row, run in fixed chunks on any executor, one outcome table.
 
 A member is a :class:`~spinorbit.scene.Scene` built by ``make_scene(**parameters)`` from one row of
-the parameter table (``docs/ensembles.md``). The members are cut into chunks of consecutive indices
-whose size depends on the ensemble alone (its member count, or ``chunk_size``), never on the
+the parameter table (``docs/ensembles.md``), or a member that runs itself
+(:mod:`~spinorbit.ensemble.self_run`): same chunks, executors, checkpoints and reruns. The members are
+cut into chunks of consecutive indices whose size depends on the ensemble alone (its member count, or ``chunk_size``), never on the
 executor or the number of workers; a chunk runs in one process, its members sharing the perturber
 samples of one orbit (:meth:`Scene.sharing_samples`), so the table is the same bits whichever
 executor ran it. A worker builds its members' Scenes itself: only ``make_scene`` (picklable: a
@@ -21,7 +22,7 @@ type and message), its row masked, and :meth:`Ensemble.rerun` runs it again alon
 from __future__ import annotations
 
 import concurrent.futures
-import hashlib
+import contextlib
 import math
 import time as _time
 
@@ -41,8 +42,10 @@ from spinorbit.ensemble.outcomes import (
     outcome_row,
 )
 from spinorbit.ensemble.free import torque_free_rows
+from spinorbit.ensemble.identity import ensemble_fingerprint, ensemble_identity, value_text
 from spinorbit.ensemble.process_memo import clear_process_samplings, leader_plan, process_memo, sharing_key
 from spinorbit.ensemble.samplers import SEED_COLUMNS, sample_parameters
+from spinorbit.ensemble.self_run import checked_units, own_columns, own_row, runs_itself
 from spinorbit.ensemble.store import ChunkStore
 
 __all__ = ["ROUTES", "Ensemble", "run_chunk", "torque_free"]
@@ -85,21 +88,17 @@ def _parameter_table(parameters):
     return table
 
 
-def _fingerprint_text(value):
-    if isinstance(value, u.Quantity):
-        return f"Q{np.asarray(value.value, dtype=float).tobytes().hex()}{value.unit}"
-    if isinstance(value, float):
-        return value.hex()
-    return f"{type(value).__name__}{value!r}"
-
-
 def build_member(make_scene, parameters):
-    """The single-body Scene of one member (EnsembleError when make_scene returns something else)."""
+    """The member of one row: a single-body Scene or a member that runs itself (:func:`runs_itself`);
+    EnsembleError when make_scene returns something else."""
     from spinorbit.scene import Scene
 
     scene = make_scene(**parameters)
+    if runs_itself(scene):
+        return scene
     if not isinstance(scene, Scene) or scene.members is not None:
-        raise EnsembleError(f"make_scene expects to return a single-body spinorbit.scene.Scene; it returned "
+        raise EnsembleError(f"make_scene expects to return a single-body spinorbit.scene.Scene or a member with an "
+                            f"outcome_row(at_days) method; it returned "
                             f"{type(scene).__name__}{' of several bodies' if isinstance(scene, Scene) else ''}.")
     return scene
 
@@ -111,7 +110,9 @@ def failure_record(index, parameters, error):
 
 
 def torque_free(scene):
-    """The member needs no integration: no perturbers and no orbit."""
+    """The member needs no integration: a Scene with no perturbers and no orbit."""
+    if runs_itself(scene):
+        return False
     return not scene.named and not scene.fixed and not scene.moving and scene.orbit is None
 
 
@@ -149,7 +150,8 @@ def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None,
     bits in any process or batch). With ``route="auto"`` (and no tables kept) the members that can
     share a plan run as groups by the batch route (:func:`spinorbit.ensemble.batch.run_group`, its
     batch integrators ``integrators``, default :data:`~spinorbit.ensemble.batch.BATCH_INTEGRATORS`);
-    every row records its route in ``ensemble_route`` ("batch", "scene" or "torque-free"). A group
+    every row records its route in ``ensemble_route`` ("batch", "scene", "torque-free", or "self-run" for a
+    member that runs itself). A group
     takes the plan of ``leader`` (the ensemble's (index, parameters) whose plan leads, planned once
     per process) when the leader would be in it, else its first member's; the members the leader's
     plan does not fit (its drops) are led by the first of them.
@@ -178,12 +180,12 @@ def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None,
     if route == "auto" and not keep_tables:
         groups, single = {}, []
         for member in built:
-            key = group_key(member[1], at_days)
+            key = None if runs_itself(member[1]) else group_key(member[1], at_days)
             (single.append(member) if key is None else
              groups.setdefault((sharing_key(member[1]), key), []).append(member))
         led = None
         if leader is not None and groups:
-            text = "|".join(f"{name}={_fingerprint_text(value)}" for name, value in leader[1].items())
+            text = "|".join(f"{name}={value_text(value)}" for name, value in leader[1].items())
             led = leader_plan(make_scene, leader, at_days, samples_of, integrators, build_member, text)
         for keys, group in groups.items():
             # the ensemble leader's plan where it fits the group (and could be made), else the first member's
@@ -207,6 +209,9 @@ def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None,
         single.sort(key=lambda member: member[0])
     for index, scene, parameters in single:
         try:
+            if runs_itself(scene):
+                rows[index] = {**own_row(scene, at_days), "ensemble_route": "self-run"}
+                continue
             with scene.sharing_samples(samples_of(scene)):
                 result = scene.run()
             rows[index] = {**outcome_row(scene, result, at_days), "ensemble_route": "scene"}
@@ -224,7 +229,8 @@ class Ensemble:
     Parameters
     ----------
     make_scene : callable
-        ``make_scene(**parameters) -> Scene`` (one body). A module-level function, so that worker
+        ``make_scene(**parameters) -> Scene`` (one body), or a member that runs itself (an object with
+        ``outcome_row(at_days) -> dict``, module docstring). A module-level function, so that worker
         processes can import it; an expensive orbit it needs should be cached in its module
         (e.g. ``functools.cache``), so each process builds it once and members share its samples.
         Each member is built once, where its chunk runs. On an executor, this process builds the
@@ -253,6 +259,9 @@ class Ensemble:
         :func:`~spinorbit.core.integrators.batch_quaternion.integrate_quaternion_batch`'s signature
         (module-level, so that workers can import it); default
         :data:`~spinorbit.ensemble.batch.BATCH_INTEGRATORS`.
+    outcome_units : dict, optional
+        ``{column: astropy unit}`` of the numeric outcome columns of members that run themselves (their
+        rows hold plain numbers in these units); columns not named are plain numbers.
 
     Attributes
     ----------
@@ -265,7 +274,8 @@ class Ensemble:
         ``wall_seconds`` and ``executor`` of the last :meth:`run` or :meth:`rerun`.
     """
 
-    def __init__(self, make_scene, parameters, chunk_size=None, at=None, route="auto", batch_integrators=None):
+    def __init__(self, make_scene, parameters, chunk_size=None, at=None, route="auto", batch_integrators=None,
+                 outcome_units=None):
         if not callable(make_scene):
             raise EnsembleError(f"make_scene expects a callable returning a Scene; got {make_scene!r}.")
         if route not in ROUTES:
@@ -276,6 +286,7 @@ class Ensemble:
             raise EnsembleError(f"batch_integrators expects a dict {{plan integrator name: batch function}} (e.g. "
                                 f"{{'quaternion': integrate_quaternion_batch}}); got {batch_integrators!r}.")
         self.route, self.batch_integrators = route, batch_integrators
+        self.outcome_units = checked_units(outcome_units)
         self.make_scene = make_scene
         self.parameters = _parameter_table(parameters)
         n = len(self.parameters)
@@ -292,11 +303,11 @@ class Ensemble:
 
     @classmethod
     def sampled(cls, make_scene, n, seed=None, chunk_size=None, at=None, route="auto", batch_integrators=None,
-                **distributions):
+                outcome_units=None, **distributions):
         """An ensemble of ``n`` members whose parameters are drawn, each from its own seed
         (:func:`~spinorbit.ensemble.samplers.sample_parameters`; the seeds are columns of the result)."""
         return cls(make_scene, sample_parameters(n, seed, **distributions), chunk_size=chunk_size, at=at, route=route,
-                   batch_integrators=batch_integrators)
+                   batch_integrators=batch_integrators, outcome_units=outcome_units)
 
     # ------------------------------------------------------------------------------------------
     @property
@@ -334,21 +345,22 @@ class Ensemble:
 
     @property
     def fingerprint(self):
-        """SHA-256 of what fixes the results: make_scene's name, every parameter's bits, chunk size, times."""
-        digest = hashlib.sha256()
-        digest.update(f"{getattr(self.make_scene, '__module__', '')}.{getattr(self.make_scene, '__qualname__', '')}"
-                      f"|{self.chunk_size}|{self.n_members}|".encode())
-        if self.route != "auto" or self.batch_integrators is not None:  # the route decides the bits too
-            names = sorted((k, f"{getattr(f, '__module__', '')}.{getattr(f, '__qualname__', '')}")
-                           for k, f in (self.batch_integrators or {}).items())
-            digest.update(f"route={self.route}|{names}|".encode())
-        if self.at_days is not None:
-            digest.update(self.at_days.tobytes())
+        """SHA-256 of what fixes the results: make_scene's name, every parameter's bits, chunk size, times
+        (:func:`~spinorbit.ensemble.identity.ensemble_fingerprint`)."""
+        return ensemble_fingerprint(self, self._plain_columns())
+
+    @property
+    def identity(self):
+        """The fingerprint's content field by field (:func:`~spinorbit.ensemble.identity.ensemble_identity`),
+        kept in a checkpoint directory so that a refusal can say which field differs."""
+        return ensemble_identity(self, self._plain_columns())
+
+    def _chunk_store(self, checkpoint):
+        """The checkpoint directory taken for this ensemble (locked, its manifest checked), or no store."""
+        if checkpoint is None:
+            return contextlib.nullcontext(None)
         columns = self._plain_columns()
-        for index in range(self.n_members):
-            digest.update("|".join(f"{name}={_fingerprint_text(values[index])}"
-                                   for name, values in columns.items()).encode())
-        return digest.hexdigest()
+        return ChunkStore(checkpoint, ensemble_fingerprint(self, columns), ensemble_identity(self, columns))
 
     @property
     def failures(self):
@@ -429,9 +441,18 @@ class Ensemble:
         EnsembleInterrupted
             Chunks were lost to the executor (a killed worker, a broken pool); those completed are in
             the checkpoint and in memory: run again (with the same checkpoint) to run only the rest.
+        spinorbit.runs.checkpoint.CheckpointError
+            ``checkpoint`` holds another ensemble (the message names the fields that differ), is in
+            use by another running ensemble, or a file in it is corrupted.
+        KeyboardInterrupt
+            Ctrl-C (or the CLI's SIGTERM): the chunks not started are cancelled, the workers of an
+            executor made here stopped; ``last_run["members_complete"]`` members are kept.
         """
+        with self._chunk_store(checkpoint) as store:
+            return self._run(store, executor, checkpoint, progress, keep_tables)
+
+    def _run(self, store, executor, checkpoint, progress, keep_tables):
         clock = _time.perf_counter()
-        store = None if checkpoint is None else ChunkStore(checkpoint, self.fingerprint)
         restored = 0 if store is None else self._restore(store)
         pending = [c for c in range(self.n_chunks) if c not in self._complete]
         done = self.n_members - sum(len(self.chunk_members(c)) for c in pending)
@@ -530,7 +551,10 @@ class Ensemble:
         Their chunks must be complete (run or restored from ``checkpoint``); with ``checkpoint`` the
         chunk files are rewritten with the new rows.
         """
-        store = None if checkpoint is None else ChunkStore(checkpoint, self.fingerprint)
+        with self._chunk_store(checkpoint) as store:
+            return self._rerun(store, indices, executor)
+
+    def _rerun(self, store, indices, executor):
         if store is not None:
             self._restore(store)
         indices = sorted({int(i) for i in indices})
@@ -574,11 +598,12 @@ class Ensemble:
         names = list(TIMED_COLUMNS) if self.at_days is None else [f"{n}_t{k}" for k in timed for n in TIMED_COLUMNS]
         names += [*INITIAL_COLUMNS, *RUN_COLUMNS]
         present = {name for row in self._rows.values() for name in row}
-        return [name for name in names if name in present]
+        return [name for name in names if name in present] + own_columns(self._rows, names)
 
     def member_routes(self):
         """{route: members} of the members with a row: "batch" (planned as a group and integrated together,
-        :mod:`spinorbit.ensemble.batch`), "scene" (their own Scene run) or "torque-free" (vectorised)."""
+        :mod:`spinorbit.ensemble.batch`), "scene" (their own Scene run), "torque-free" (vectorised) or
+        "self-run" (a member that runs itself)."""
         counts = {}
         for row in self._rows.values():
             route = row.get("ensemble_route", "scene")
@@ -607,6 +632,8 @@ class Ensemble:
                 data = np.array([v if p else 0.0 for v, p in zip(values, present)], dtype=float)
                 if base in OUTCOME_UNITS:
                     data = data * OUTCOME_UNITS[base]
+                elif name in self.outcome_units:
+                    data = data * self.outcome_units[name]
                 table[name] = data if present.all() else Masked(data, mask=~present)
         errors = [f"{self._failures[i]['type']}: {self._failures[i]['message']}" if i in self._failures else ""
                   for i in range(n)]

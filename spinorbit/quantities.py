@@ -31,7 +31,7 @@ from astropy import units as u
 from spinorbit.core.errors import NonFiniteError, all_finite, require_finite_result
 
 __all__ = ["QuantityInputError", "bare_number_message", "finite_result", "finite_values", "parse_quantity", "parse_unit",
-           "value_in"]
+           "require_quantity", "value_in"]
 
 # The physical types value_in compares with, looked up once: comparing with a string parses the name
 # on every call (~4 µs each, several per member of an ensemble); comparing PhysicalTypes is the same test.
@@ -66,12 +66,12 @@ def _arrived(value) -> str:
 
 def _bare(value) -> str:
     """A bare number or array as the user wrote it, short: "float 0.000218", "list [0.1, 0, 0.3]"."""
-    if isinstance(value, np.ndarray):
-        shown = np.array2string(value, threshold=6, separator=", ")
-    else:
-        shown = repr(value)
-        shown = shown if len(shown) <= 60 else shown[:57] + "..."
-    return f"{type(value).__name__} {shown}"
+    if isinstance(value, np.ndarray) and value.dtype.kind in "biuf":
+        head = ", ".join(f"{x:.6g}" for x in value.ravel()[:3].tolist()) + (", ..." if value.size > 3 else "")
+        shape = "" if value.ndim == 1 else f" of shape {value.shape}"
+        return f"ndarray{shape} [{head}]"
+    shown = " ".join(repr(value).split())  # one line, whatever arrived
+    return f"{type(value).__name__} {shown if len(shown) <= 60 else shown[:57] + '...'}"
 
 
 def bare_number_message(name: str, unit, example: str, value) -> str:
@@ -87,6 +87,16 @@ def bare_number_message(name: str, unit, example: str, value) -> str:
             "never guessed, multiply by the unit meant.")
 
 
+def require_quantity(name: str, value, unit, example: str) -> None:
+    """Raise ``QuantityInputError`` with :func:`bare_number_message` unless ``value`` is a Quantity.
+
+    For checks of their own that read a Quantity's physical type before converting it (a G·M, an
+    acceleration): the bare number is refused in the same words as by :func:`value_in`.
+    """
+    if not isinstance(value, u.Quantity):
+        raise QuantityInputError(bare_number_message(name, unit, example, value))
+
+
 def _frequency_advice(name: str, value, unit: u.UnitBase) -> str:
     time_unit = (u.rad / unit).to_string()  # the time unit of the expected rate: d for rad / d
     return (
@@ -97,7 +107,7 @@ def _frequency_advice(name: str, value, unit: u.UnitBase) -> str:
     )
 
 
-def value_in(name: str, value, unit, example: str, *, plain_unit=None, finite: bool = True,
+def value_in(name: str, value, unit, example: str, *, finite: bool = True,
              shape: tuple | None = None) -> np.ndarray | float:
     """``value`` as plain floats in ``unit``, after checking its physical type.
 
@@ -106,15 +116,12 @@ def value_in(name: str, value, unit, example: str, *, plain_unit=None, finite: b
     name : str
         The argument or option, as the user wrote it (``"angular_velocity"``, ``"--span"``).
     value : Quantity or array_like
-        A Quantity of ``unit``'s physical type. Plain numbers only where ``unit`` is dimensionless
-        (or, until every caller is converted, read in ``plain_unit``).
+        A Quantity of ``unit``'s physical type. Plain numbers only where ``unit`` is dimensionless; for
+        a dimensional ``unit`` they are refused with :func:`bare_number_message` (units are never guessed).
     unit : str or astropy unit
         The unit the caller works in (``rad / day``, ``day``, ``kg m2``).
     example : str
         A correct value to show in the message (``"0.1 * u.rad / u.s"``).
-    plain_unit : astropy unit, optional
-        The unit of plain numbers; None (the rule): plain numbers are refused for a dimensional
-        ``unit`` with :func:`bare_number_message`, and read as they are for a dimensionless one.
     finite : bool
         Refuse NaN and ±inf (default).
     shape : tuple, optional
@@ -151,14 +158,13 @@ def value_in(name: str, value, unit, example: str, *, plain_unit=None, finite: b
                 f"{name}: expected a Quantity in {_expected(unit)} such as {example}; got "
                 f"{_arrived(value)}."
             )
-    elif plain_unit is None and unit.physical_type != _DIMENSIONLESS:
-        raise QuantityInputError(bare_number_message(name, unit, example, value))
+    elif unit.physical_type != _DIMENSIONLESS:
+        require_quantity(name, value, unit, example)
     else:
-        plain_unit = u.dimensionless_unscaled if plain_unit is None else plain_unit
         try:
-            values = np.asarray(value, dtype=float) * u.Unit(plain_unit).to(unit)
+            values = np.asarray(value, dtype=float) * u.dimensionless_unscaled.to(unit)
         except (TypeError, ValueError):
-            raise QuantityInputError(f"{name}: expected numbers (in {plain_unit}) or a Quantity such as {example}; "
+            raise QuantityInputError(f"{name}: expected a number or a dimensionless Quantity such as {example}; "
                                      f"got {_arrived(value)}.") from None
     values = np.asarray(values, dtype=float)
     if shape is not None and values.shape != tuple(shape):

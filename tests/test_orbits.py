@@ -18,6 +18,7 @@ from astropy import units as u
 from astropy.coordinates import BarycentricMeanEcliptic, CartesianRepresentation, ICRS, SkyCoord
 from astropy.time import Time
 
+from spinorbit.quantities import QuantityInputError
 from spinorbit.data.asteroids import (
     APOPHIS_2029,
     APOPHIS_HORIZONS,
@@ -124,11 +125,11 @@ GOOD = dict(a=2.5 * u.au, e=0.3, inc=5 * u.deg, raan=80 * u.deg, argp=30 * u.deg
     ({"e": float("nan")}, OrbitElementsError, "0 <= e < 1"),
     ({"a": -1 * u.au}, OrbitElementsError, "positive semi-major axis"),
     ({"a": 0 * u.au}, OrbitElementsError, "positive semi-major axis"),
-    ({"a": 2.5}, OrbitElementsError, "length Quantity"),
+    ({"a": 2.5}, QuantityInputError, "a expects a length Quantity .*bare float 2.5"),
     ({"inc": 190 * u.deg}, OrbitElementsError, "inclination"),
     ({"inc": -1 * u.deg}, OrbitElementsError, "inclination"),
     ({"raan": 400 * u.deg}, OrbitElementsError, "modulo 360"),
-    ({"mean_anomaly": 10.0}, OrbitElementsError, "angle Quantity"),
+    ({"mean_anomaly": 10.0}, QuantityInputError, "mean_anomaly expects an angle Quantity .*bare float 10.0"),
     ({"frame": "galactic"}, OrbitElementsError, "frame expects one of"),
     ({"epoch": Time("2250-01-01", scale="tdb")}, EphemerisRangeError, "DE421's span"),
     ({"epoch": "2010-01-01"}, SceneError, "scalar astropy Time"),

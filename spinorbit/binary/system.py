@@ -226,6 +226,15 @@ class BinaryState:
     secondary_quaternion: tuple
     secondary_spin: u.Quantity
 
+    def __post_init__(self):
+        # the units now, not at the first propagation: a bare number is refused where it was given
+        for name, value, unit, example in (("separation", self.separation, u.m, "[1200, 0, 0] * u.m"),
+                                           ("velocity", self.velocity, u.m / u.s, "[0, 0.1757, 0] * u.m / u.s"),
+                                           ("primary_spin", self.primary_spin, u.rad / u.s, "[0, 0, 7.7e-4] * u.rad / u.s"),
+                                           ("secondary_spin", self.secondary_spin, u.rad / u.s,
+                                            "[0, 0, 1.46e-4] * u.rad / u.s")):
+            value_in(name, value, unit, example, shape=(3,), finite=False)
+
     @classmethod
     def synchronous(cls, system, separation, primary_spin, speed=None, libration=0 * u.rad):
         """B on an orbit in the inertial x-y plane at +x, its long axis (x) along the line to A, spinning at the
@@ -302,7 +311,7 @@ def momentum_impulse(impactor_mass, impactor_velocity, beta, target_mass):
     m = value_in("impactor_mass", impactor_mass, u.kg, "579.4 * u.kg", shape=())
     v = value_in("impactor_velocity", impactor_velocity, u.m / u.s, "[0, -6144.9, 0] * u.m / u.s", shape=(3,))
     big_m = value_in("target_mass", target_mass, u.kg, "4.3e9 * u.kg", shape=())
-    b = value_in("beta", beta, u.dimensionless_unscaled, "3.61", plain_unit=u.dimensionless_unscaled, shape=())
+    b = value_in("beta", beta, u.dimensionless_unscaled, "3.61", shape=())
     if not m > 0 or not big_m > 0:
         raise ValueError(f"impactor_mass, target_mass: expected positive masses, got {m} kg and {big_m} kg.")
     return b * m * v / big_m * u.m / u.s

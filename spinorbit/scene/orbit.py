@@ -21,6 +21,7 @@ from astropy.table import QTable
 from astropy.time import Time
 
 from spinorbit.core.errors import SpinorbitError
+from spinorbit.quantities import require_quantity
 from spinorbit.scene.errors import SceneError
 from spinorbit.time import tdb_days, time_from_tdb_days
 
@@ -116,6 +117,7 @@ class Orbit:
         scenes whose geometry should be simple (tests, benchmarks, tutorials)."""
         from spinorbit.ephemeris import de421_constants
 
+        require_quantity("radius", radius, u.au, "2.5 * u.au")
         if not isinstance(radius, u.Quantity) or radius.unit.physical_type != "length" or not radius.value > 0:
             raise SceneError(f"Orbit.circular expects a positive length Quantity such as 2.5 * u.au; got {radius!r}.")
         r = float(radius.to_value(u.au))
@@ -303,6 +305,7 @@ class Orbit:
         vectors = []
         for label, value, kind, unit in (("position", position, "length", u.km),
                                          ("velocity", velocity, "speed", u.km / u.day)):
+            require_quantity(label, value, unit, "[1, 0, 0] * u.au" if kind == "length" else "[0, 30, 0] * u.km / u.s")
             if (not isinstance(value, u.Quantity) or value.unit.physical_type != kind or value.shape != (3,)
                     or not np.all(np.isfinite(value.value))):
                 raise SceneError(f"{label} expects a finite {kind} Quantity of shape (3,) such as "

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from astropy import units as u
 
-from spinorbit.quantities import finite_result, value_in
+from spinorbit.quantities import finite_result, require_quantity, value_in
 from spinorbit.scene.errors import SceneError
 
 __all__ = ["ThermalModel", "ThermalInputError", "VanishingYorpWarning", "DEFAULT_K3_SQUARED", "MOMENT_RTOL",
@@ -53,6 +53,7 @@ class VanishingYorpWarning(UserWarning):
 
 
 def _positive(name, value, unit, example):
+    require_quantity(name, value, unit, example)
     if not isinstance(value, u.Quantity) or not value.isscalar or not value.unit.is_equivalent(unit):
         raise ThermalInputError(f"{name} expects a scalar Quantity in {unit} such as {example}; got {value!r}.")
     magnitude = float(value.to_value(unit))

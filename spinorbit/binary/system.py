@@ -187,6 +187,7 @@ class BinarySystem:
         return core.make_binary_model(G_SI, self.primary.integrals, self.secondary.integrals, self.order,
                                       self.contact_distance.to_value(u.m))
 
+    @finite_result("BinarySystem.circular_speed")
     def circular_speed(self, separation):
         """Relative speed of the circular orbit at ``separation`` with B's long axis towards A (Quantity m/s).
 
@@ -194,6 +195,7 @@ class BinarySystem:
         circular for the model that is integrated (not only for point masses).
         """
         r = value_in("separation", separation, u.m, "1200 * u.m", shape=())
+        check_separation(r, self.contact_distance.to_value(u.m), "the separation asked for")
         y = np.zeros(core.BINARY_STATE_SIZE)
         y[core.POSITION] = r
         y[core.QUAT_A] = y[core.QUAT_B] = 1.0
@@ -295,6 +297,7 @@ class BinaryState:
         return quat_to_matrix(np.asarray(self.secondary_quaternion, dtype=float))[:, 0]
 
 
+@finite_result("momentum_impulse", "β m v / M overflows double precision")
 def momentum_impulse(impactor_mass, impactor_velocity, beta, target_mass):
     """Δv of a target hit by an impactor, with momentum enhancement β: Δv = β m v / M.
 

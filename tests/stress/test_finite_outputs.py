@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 from astropy import units as u
 
-from spinorbit.binary import Figure
+from spinorbit.binary import BinarySystem, Figure, momentum_impulse
+from spinorbit.core.binary.errors import ContactError
 from spinorbit.core.errors import NonFiniteError
 from spinorbit.core.free_motion.flow import torque_free_states_many
 from spinorbit.core.model.polyhedron import InvalidMeshError
@@ -26,6 +27,7 @@ from spinorbit.shape import (
 )
 from spinorbit.yarkovsky import yarkovsky_drift
 
+DENSITY = 2 * u.g / u.cm ** 3
 YARKOVSKY = dict(radius=150 * u.m, density=2000 * u.kg / u.m ** 3, heat_capacity=680 * u.J / (u.kg * u.K),
                  rotation_period=6 * u.h, obliquity=0 * u.deg, semi_major_axis=1.5 * u.au,
                  thermal_inertia=300 * u.J / (u.m ** 2 * u.K * u.s ** 0.5))
@@ -118,3 +120,16 @@ def test_a_nan_vertex_in_a_shape_file_is_named_by_its_line(tmp_path):
     (tmp_path / "bad.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv inf 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n")
     with pytest.raises(ShapeFileError, match=r"bad.obj, line 4: expected 'v x y z' with three finite numbers"):
         read_obj(tmp_path / "bad.obj", u.km)
+
+
+def test_binary_helpers_refuse_what_they_cannot_compute():
+    with pytest.raises(NonFiniteError, match=r"momentum_impulse\b.*β m v / M overflows"):
+        momentum_impulse(1e300 * u.kg, [0, -1e300, 0] * u.m / u.s, 3.6, 1e-300 * u.kg)
+    system = BinarySystem(Figure.sphere("A", 300 * u.m, DENSITY), Figure.sphere("B", 50 * u.m, DENSITY))
+    # Inside the contact distance (350 m) the series diverges: no circular speed (it was NaN at 1e-300 m).
+    with pytest.raises(ContactError, match="the separation asked for"):
+        system.circular_speed(1e-300 * u.m)
+    speed = system.circular_speed(1200 * u.m)
+    total = (system.primary.mass + system.secondary.mass).to_value(u.kg)
+    # Two spheres: Kepler's √(G M / r) (1e-12: the order-2 field of spheres, rounded).
+    assert speed.to_value(u.m / u.s) == pytest.approx(np.sqrt(6.6743e-11 * total / 1200), rel=1e-12)

@@ -92,6 +92,7 @@ NOT_DIMENSIONAL_IN = {
     "HG1G2": {"H", "G1", "G2"},
     "LinearExponential": {"H", "amplitude"},
     "apophis_rotation_state": {"phase"},  # a fraction of P_psi in [0, 1)
+    "reshaped": {"axis_ratios"},  # Dimorphos's a/b and a/c after the impact
     "Normal": {"sigma"},  # a sampler of numbers or Quantities, for the user's own make_scene
     "free_members_table": {"parameters"},
 }

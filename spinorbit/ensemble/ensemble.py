@@ -489,7 +489,8 @@ class Ensemble:
             raise EnsembleInterrupted(
                 f"{len(lost)} of {self.n_chunks} chunks ({members} members) did not come back from {description} "
                 f"({type(first).__name__}: {first}); the {self.n_members - members} members completed are kept "
-                f"{where}. Call run() again (with the same checkpoint) to run only the missing members.")
+                f"{where}. Call run() again (with the same checkpoint) to run only the missing members.",
+                members_lost=members, cause=first, executor=description)
         return self.table()
 
     @property

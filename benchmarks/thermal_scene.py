@@ -2,10 +2,12 @@
 
 Writes the section ``thermal_scene`` of docs/thermal.md (every number there comes from this script):
 
-1. CPU time per right-hand side of the full route (quaternion DOP853 under the Sun and the degree-8
-   recoil) and of the mean route (eq. 11 at one torus point): interleaved repeats, median and
-   range; the planner prices both routes with them (``FULL_RHS_SECONDS``, ``MEAN_RHS_SECONDS`` in
-   spinorbit/scene/thermal_planning.py, which this script compares with what it measured);
+1. CPU time per right-hand side of the full route (quaternion DOP853 under the Sun and the recoil, on
+   the degree-8 harmonics and on the facets) and of the mean route (eq. 11 and the exact orbit
+   average at one torus point), at two mesh sizes: interleaved repeats, median and range; the planner
+   prices both routes with them (``FULL_RHS_SECONDS``, ``FULL_FACET_SECONDS``, ``MEAN_RHS_SECONDS``,
+   ``MEAN_FACET_SECONDS`` in spinorbit/scene/thermal_planning.py, which this script compares with
+   what it measured);
 2. the Scene's mean route against its full route over a span both afford (two sizes), at whole and
    half orbits, against the mean route's own error estimate;
 3. the planner's choice, reason and estimated costs for spans from 1 yr to 10⁶ yr.
@@ -48,11 +50,19 @@ ELEMENTS = (1 * u.au, 0.1, 5 * u.deg, 20 * u.deg, 30 * u.deg, 0 * u.deg)
 SPIN = 2 * math.pi / 0.25
 
 
-def tumbler(radius_km, mu_q=None):
-    shape = gaussian_random_sphere(radius_km * u.km, 0.15, seed=5, subdivisions=3)
+class _Tumbler:
+    def __init__(self, state, shape):
+        self.state, self.body_shape = state, shape
+
+
+def tumbler(radius_km, mu_q=None, subdivisions=None):
+    """(state, thermal model) of the tumbler; with ``subdivisions``, (a holder of state and shape, None)."""
+    shape = gaussian_random_sphere(radius_km * u.km, 0.15, seed=5, subdivisions=subdivisions or 3)
     body = rigid_body_from_shape(shape, density=DENSITY)
     q = np.array([0.9, 0.2, -0.3, 0.25])
     state = RotationState(body, q / np.linalg.norm(q), np.array([0.3, 0.1, 1.0]) * SPIN * u.rad / u.day)
+    if subdivisions is not None:
+        return _Tumbler(state, shape), None
     return state, ThermalModel.from_shape(shape, DENSITY, mu_q=mu_q)
 
 
@@ -62,29 +72,42 @@ def elements(table):
 
 
 def rhs_costs(repeats):
-    state, thermal = tumbler(0.2)
-    orbit = Orbit.kepler(*ELEMENTS, EPOCH)
-    setup = thermal_setup(Scene(state, EPOCH, EPOCH + 1 * u.yr, orbit=orbit, thermal=thermal))
-    counts = {}
+    """CPU seconds per right-hand side: the full route on the harmonics and on the facets, and the mean route
+    per torus point, on the tumbler at two mesh sizes (so a facet's share and the fixed part separate)."""
+    from spinorbit.core.averaging.thermal_mean import EXACT_POINTS_S, EXACT_POINTS_Z
 
-    def full():
-        _, stats = integrate_quaternion(setup.y0, setup.t0, [setup.t0 + 100.0], setup.model, rtol=1e-10,
-                                        return_stats=True)
-        counts["full"] = stats["rhs_calls"]
+    out = {}
+    for subdivisions in (2, 3):
+        state, _ = tumbler(0.2, subdivisions=subdivisions)
+        orbit = Orbit.kepler(*ELEMENTS, EPOCH)
+        counts, jobs = {}, []
+        for torque in ("harmonics", "facets"):
+            thermal = ThermalModel.from_shape(state.body_shape, DENSITY, torque=torque)
+            setup = thermal_setup(Scene(state.state, EPOCH, EPOCH + 1 * u.yr, orbit=orbit, thermal=thermal))
 
-    def mean():
-        _, steps = propagate_mean_thermal(setup.el0, setup.t0, [setup.t0 + 4 * 365.25], setup.model, setup.frame,
-                                          365.25)
-        counts["mean"] = steps * thermal_planning.STAGES * 16 * 8 * 16
+            def full(setup=setup, torque=torque):
+                _, stats = integrate_quaternion(setup.y0, setup.t0, [setup.t0 + 100.0], setup.model, rtol=1e-10,
+                                                return_stats=True)
+                counts[torque] = stats["rhs_calls"]
 
-    timings, _ = interleaved_timings([full, mean], repeats, clock=time.process_time, warm_up=True)
-    return {name: (t, counts[name]) for name, t in zip(("full", "mean"), timings)}
+            jobs.append(full)
+
+        def mean(setup=setup):
+            _, steps = propagate_mean_thermal(setup.el0, setup.t0, [setup.t0 + 4 * 365.25], setup.model, setup.frame,
+                                              365.25)
+            counts["mean"] = steps * thermal_planning.STAGES * EXACT_POINTS_S * EXACT_POINTS_Z
+
+        timings, _ = interleaved_timings(jobs + [mean], repeats, clock=time.process_time, warm_up=True)
+        out[len(state.body_shape)] = {name: (t, counts[name]) for name, t in zip(("harmonics", "facets", "mean"), timings)}
+    return out
 
 
 def agreement():
     rows = []
     for radius in (0.06, 0.2):
-        state, thermal = tumbler(radius)
+        holder, _ = tumbler(radius, subdivisions=3)
+        # The full route on the facet sum: the mean route averages it exactly (the harmonics' differ by ~15 %).
+        state, thermal = holder.state, ThermalModel.from_shape(holder.body_shape, DENSITY, torque="facets")
         orbit = Orbit.kepler(*ELEMENTS, EPOCH)
         setup = thermal_setup(Scene(state, EPOCH, EPOCH + 1 * u.yr, orbit=orbit, thermal=thermal))
         days = setup.period_orbit * np.array([1.0, 1.5, 2.0, 2.5, 4.0, 8.0])
@@ -127,16 +150,27 @@ def markdown(costs, agree, picks, seconds):
     load = os.getloadavg()[0]
     lines = [f"Written by `PYTHONPATH=$PWD python benchmarks/thermal_scene.py` in {seconds:.0f} s. {machine_line()} "
              f"1-minute load average at the end: {load:.2f}.", ""]
+    per = {n: {k: (t.median / c, t.min / c, t.max / c, len(t.samples)) for k, (t, c) in row.items()}
+           for n, row in costs.items()}
+    small, large = sorted(per)
+    facet_full = (per[large]["facets"][0] - per[large]["harmonics"][0]) / large
+    facet_mean = (per[large]["mean"][0] - per[small]["mean"][0]) / (large - small)
+    fixed_mean = per[large]["mean"][0] - large * facet_mean
     lines += ["**Cost per right-hand side** (CPU time of this process, interleaved repeats, median and range), "
-              "200 m Gaussian random sphere (1280 facets), degree-8 recoil and the Sun:", "",
-              "| route | what one right-hand side is | ns (median, min–max) | planner's constant (ns) |",
-              "|---|---|---|---|"]
-    for name, what, constant in (("full", "quaternion equations, Sun + recoil", thermal_planning.FULL_RHS_SECONDS),
-                                 ("mean", "eq. (11) at one torus point, recoil only", thermal_planning.MEAN_RHS_SECONDS)):
-        timing, count = costs[name]
-        lines.append(f"| {name} | {what} | {timing.median / count * 1e9:.0f} ({timing.min / count * 1e9:.0f}–"
-                     f"{timing.max / count * 1e9:.0f}, {len(timing.samples)} runs) | {constant * 1e9:.0f} |")
-    lines += ["", "**Mean route against full route** through the Scene (the tumbler at 1 au, e = 0.1, 6 h, "
+              f"200 m Gaussian random sphere at two mesh sizes ({small} and {large} facets): the full route (quaternion "
+              "equations, the Sun and the recoil) on the degree-8 harmonics and on the facet sum, and the mean route "
+              "per torus point (eq. 11 and the exact orbit average of the facet sum).", "",
+              "| facets | full, harmonics (ns) | full, facets (ns) | mean, per torus point (ns) |", "|---|---|---|---|"]
+    for n in (small, large):
+        lines.append(f"| {n} | " + " | ".join(f"{per[n][k][0] * 1e9:.0f} ({per[n][k][1] * 1e9:.0f}–{per[n][k][2] * 1e9:.0f}, "
+                                              f"{per[n][k][3]} runs)" for k in ("harmonics", "facets", "mean")) + " |")
+    lines += ["", f"From these: a facet adds {facet_full * 1e9:.2f} ns to a full right-hand side on the facets and "
+              f"{facet_mean * 1e9:.2f} ns to a mean torus point, whose fixed part is {fixed_mean * 1e9:.0f} ns. The planner's "
+              f"constants (spinorbit/scene/thermal_planning.py): FULL_RHS_SECONDS {thermal_planning.FULL_RHS_SECONDS * 1e9:.0f} ns, "
+              f"FULL_FACET_SECONDS {thermal_planning.FULL_FACET_SECONDS * 1e9:.2f} ns, MEAN_RHS_SECONDS "
+              f"{thermal_planning.MEAN_RHS_SECONDS * 1e9:.0f} ns, MEAN_FACET_SECONDS "
+              f"{thermal_planning.MEAN_FACET_SECONDS * 1e9:.2f} ns; only the routes' ratio decides."]
+    lines += ["", "**Mean route against full route** through the Scene (the full route on the facet sum, `torque=\"facets\"`; the tumbler at 1 au, e = 0.1, 6 h, "
               "tolerance 0.01 rad), outputs at 1, 2, 4 and 8 orbits (whole) and at 1.5 and 2.5 orbits (half): the largest difference of the L direction, Z and S (rad, as `mean_difference`) against the "
               "mean route's error estimate.", "",
               "| radius | ΔZ/Z over 8 orbits (full) | whole orbits | half orbits | mean estimate | full (CPU s) | "

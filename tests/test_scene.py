@@ -16,6 +16,7 @@ from astropy import constants as const
 from astropy import units as u
 from astropy.time import Time
 
+from spinorbit.quantities import QuantityInputError
 from spinorbit import RigidBody, RotationState
 from spinorbit.data.asteroids import (
     APOPHIS_2029,
@@ -724,7 +725,7 @@ def test_moving_perturber_run_equals_a_direct_one_way_propagation_with_its_keple
 
 
 def test_moving_perturber_bad_input():
-    with pytest.raises(SceneError, match="gm expects"):
+    with pytest.raises(QuantityInputError, match="gm expects .* Quantity .*got the bare float 1e-07"):
         EphemerisPerturber("p", 1e-7, lambda d: d)
     with pytest.raises(SceneError, match="callable"):
         EphemerisPerturber("p", 1e-7 * u.au**3 / u.day**2, "not callable")

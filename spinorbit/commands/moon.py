@@ -154,7 +154,7 @@ def run(args) -> int:
         compare_model_with_de421,
         comparison_table,
     )
-    from spinorbit.runs.checkpoint import CheckpointError
+    from spinorbit.runs.checkpoint import CheckpointError, CheckpointWriteError
 
     check_outputs(args)
     span = quantity("--span", args.span, "d", "time", "1 yr")
@@ -186,7 +186,7 @@ def run(args) -> int:
                                               progress=advance, schedule=schedule, resume=args.resume,
                                               settings=settings, start_day=start)
     except CheckpointError as error:  # name the option whose file it is
-        option = "--checkpoint" if str(error).startswith("cannot write") else "--resume"
+        option = "--checkpoint" if isinstance(error, CheckpointWriteError) else "--resume"
         raise CommandError(f"{option}: {error}") from None
     except KeyboardInterrupt:
         if schedule is not None and os.path.exists(schedule.path):

@@ -45,7 +45,7 @@ from spinorbit.ensemble.free import torque_free_rows
 from spinorbit.ensemble.identity import ensemble_fingerprint, ensemble_identity, value_text
 from spinorbit.ensemble.process_memo import clear_process_samplings, leader_plan, process_memo, sharing_key
 from spinorbit.ensemble.samplers import SEED_COLUMNS, sample_parameters
-from spinorbit.ensemble.self_run import own_row, runs_itself
+from spinorbit.ensemble.self_run import checked_units, own_columns, own_row, runs_itself
 from spinorbit.ensemble.store import ChunkStore
 
 __all__ = ["ROUTES", "Ensemble", "run_chunk", "torque_free"]
@@ -286,11 +286,7 @@ class Ensemble:
             raise EnsembleError(f"batch_integrators expects a dict {{plan integrator name: batch function}} (e.g. "
                                 f"{{'quaternion': integrate_quaternion_batch}}); got {batch_integrators!r}.")
         self.route, self.batch_integrators = route, batch_integrators
-        if outcome_units is not None and not (isinstance(outcome_units, dict) and all(
-                isinstance(k, str) and isinstance(v, u.UnitBase) for k, v in outcome_units.items())):
-            raise EnsembleError(f"outcome_units expects a dict {{column name: astropy unit}} (e.g. {{'period_change': "
-                                f"u.min}}); got {outcome_units!r}.")
-        self.outcome_units = dict(outcome_units or {})
+        self.outcome_units = checked_units(outcome_units)
         self.make_scene = make_scene
         self.parameters = _parameter_table(parameters)
         n = len(self.parameters)
@@ -493,7 +489,8 @@ class Ensemble:
             raise EnsembleInterrupted(
                 f"{len(lost)} of {self.n_chunks} chunks ({members} members) did not come back from {description} "
                 f"({type(first).__name__}: {first}); the {self.n_members - members} members completed are kept "
-                f"{where}. Call run() again (with the same checkpoint) to run only the missing members.")
+                f"{where}. Call run() again (with the same checkpoint) to run only the missing members.",
+                members_lost=members, cause=first, executor=description)
         return self.table()
 
     @property
@@ -602,12 +599,7 @@ class Ensemble:
         names = list(TIMED_COLUMNS) if self.at_days is None else [f"{n}_t{k}" for k in timed for n in TIMED_COLUMNS]
         names += [*INITIAL_COLUMNS, *RUN_COLUMNS]
         present = {name for row in self._rows.values() for name in row}
-        # then the columns of members that run themselves, in the order the first row holding each gives
-        own = []
-        for index in sorted(self._rows):
-            own += [name for name in self._rows[index] if name not in names and name not in own
-                    and name != "ensemble_route"]
-        return [name for name in names if name in present] + own
+        return [name for name in names if name in present] + own_columns(self._rows, names)
 
     def member_routes(self):
         """{route: members} of the members with a row: "batch" (planned as a group and integrated together,

@@ -38,7 +38,8 @@ import numpy as np
 from spinorbit.runs.atomic import write_bytes_atomically
 from spinorbit.core.errors import SpinorbitError
 
-__all__ = ["CHECKPOINT_FORMAT_VERSION", "Checkpoint", "CheckpointError", "CheckpointSchedule", "RunStopped",
+__all__ = ["CHECKPOINT_FORMAT_VERSION", "Checkpoint", "CheckpointError", "CheckpointWriteError", "CheckpointSchedule",
+           "RunStopped",
            "fingerprint", "validate_header"]
 
 #: Version of the layout written by :meth:`Checkpoint.write`; :meth:`Checkpoint.read` accepts only it.
@@ -62,6 +63,10 @@ MAX_DIMENSIONS = 8
 
 class CheckpointError(SpinorbitError, ValueError):
     """A checkpoint file is missing, unreadable, truncated, corrupted, or belongs to another run."""
+
+
+class CheckpointWriteError(CheckpointError):
+    """A checkpoint cannot be written (the file a run writes, not the one it resumes from)."""
 
 
 def fingerprint(*arrays) -> str:
@@ -199,7 +204,7 @@ class Checkpoint:
 
         Raises
         ------
-        CheckpointError
+        CheckpointWriteError
             The file cannot be written (read-only directory, full disk, a directory in the way);
             the checkpoint previously at ``path``, if any, is unchanged.
         """
@@ -207,7 +212,7 @@ class Checkpoint:
         try:
             write_bytes_atomically(path, data)
         except OSError as error:
-            raise CheckpointError(
+            raise CheckpointWriteError(
                 f"cannot write checkpoint '{os.fspath(path)}' ({error.strerror or error}); the previous checkpoint "
                 "there, if any, is unchanged. Free disk space or choose a writable path."
             ) from None

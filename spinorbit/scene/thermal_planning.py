@@ -54,17 +54,16 @@ MIN_MEAN_ORBITS = 2.0
 #: the span) against 400.
 MEAN_STEP_SHARE = 0.01
 #: CPU time of one right-hand side of the full route (quaternion equations, the Sun and the degree-8
-#: recoil) and of the mean route (eq. 11 at one torus point): benchmarks/thermal_scene.py measures both
-#: (docs/thermal.md, "The Scene's thermal routes": medians 520 and 554 ns on 2 shared cores, the mean
-#: one since its rates take the free motion once per call and the attitude once per torus point); the
-#: planner compares the routes in these seconds, so only their ratio (≈ 1.1) decides.
-FULL_RHS_SECONDS = 5.2e-7
-MEAN_RHS_SECONDS = 5.5e-7
-#: What the facets add: per facet and full right-hand side with ``torque="facets"`` (the direct sum), and
-#: per facet and torus point of the mean route's exact orbit average (benchmarks/thermal_scene.py measures
-#: both with the constants above; the planner compares the routes in these seconds).
-FULL_FACET_SECONDS = 1.4e-9
-MEAN_FACET_SECONDS = 1.6e-9
+#: recoil) and of the mean route at one torus point (eq. 11 and the exact orbit average, its fixed part),
+#: and what each facet adds: to a full right-hand side with ``torque="facets"`` (the direct sum), and to
+#: a mean torus point (the orbit average's pass over the facets). benchmarks/thermal_scene.py measures
+#: all four (docs/thermal.md, "The Scene's thermal routes": medians 498 ns, 1190 ns, 0.46 ns and 0.96 ns
+#: per facet on 2 shared cores, from meshes of 320 and 1280 facets); the planner compares the routes in
+#: these seconds, so only their ratios decide.
+FULL_RHS_SECONDS = 5.0e-7
+MEAN_RHS_SECONDS = 1.2e-6
+FULL_FACET_SECONDS = 4.6e-10
+MEAN_FACET_SECONDS = 9.6e-10
 #: Right-hand sides beyond which the full route is refused: 2e9 is ~17 min at FULL_RHS_SECONDS.
 MAX_FULL_RHS = 2e9
 #: Relative error of the mean theory's secular changes of (S, Z, H) against the full integration:

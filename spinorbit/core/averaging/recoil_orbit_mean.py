@@ -16,8 +16,9 @@ since n·ŝ(ν) = |P n| cos(ν − ν₀). So the orbit-averaged torque on the f
 
     ⟨T⟩_orbit = −P(d₀) (d₀/a)² / (π √(1 − e²)) Σ_k √(1 − (n_k·w)²) A_k (r_k × n_k)
 
-(eccentricity and perihelion enter only through a²√(1 − e²), as for the zero-conductivity model in
-Rubincam 2000, Icarus 148, 2, §3, and the annual mean insolation of Ward 1974, J. Geophys. Res. 79, 3375).
+(eccentricity and perihelion enter only through a²√(1 − e²), as Scheeres 2007, Icarus 188, 430, found
+for the zero-conductivity YORP; facet by facet it is the annual mean insolation of Ward 1974,
+J. Geophys. Res. 79, 3375).
 The first-order average over the orbit and the rotation together does not depend on their order, so
 the remaining average over the rotation (the torus of the free motion, or the phase of a principal-axis
 rotation) takes this smooth function of the attitude: √(1 − x²) has a branch point only where a facet's

@@ -71,6 +71,7 @@ BENCHMARKS = (
     Benchmark("bench_stm.py", quick=("--repeat", "1", "--no-write")),
     Benchmark("fit_toutatis.py", quick=("--no-write",)),
     Benchmark("didymos_report.py", quick=("--no-write",)),
+    Benchmark("dart_report.py", quick=("--no-write", "--members", "4")),
     Benchmark("bench_binary.py", quick=("--repeat", "1", "--no-write")),
     Benchmark("bench_averaged.py"),
     Benchmark("stability.py"),

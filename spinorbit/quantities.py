@@ -20,13 +20,18 @@ per second (2π rad/s). Turns per time are written with astropy's ``u.cycle`` (`
 
 from __future__ import annotations
 
+import dataclasses
+import functools
+import inspect
 import math
 
 import numpy as np
 from astropy import units as u
 
-__all__ = ["QuantityInputError", "bare_number_message", "finite_values", "parse_quantity", "parse_unit", "require_quantity",
-           "value_in"]
+from spinorbit.core.errors import NonFiniteError, all_finite, require_finite_result
+
+__all__ = ["QuantityInputError", "bare_number_message", "finite_result", "finite_values", "parse_quantity", "parse_unit",
+           "require_quantity", "value_in"]
 
 # The physical types value_in compares with, looked up once: comparing with a string parses the name
 # on every call (~4 µs each, several per member of an ensemble); comparing PhysicalTypes is the same test.
@@ -171,12 +176,13 @@ def value_in(name: str, value, unit, example: str, *, finite: bool = True,
 
 
 def finite_values(name: str, values, example: str = "") -> None:
-    """Raise ``ValueError`` naming ``name`` and the first non-finite entry if any entry is NaN or ±inf."""
+    """Raise :class:`~spinorbit.core.errors.NonFiniteError` (a ``ValueError``) naming ``name`` and the first
+    non-finite entry if any entry is NaN or ±inf."""
     values = np.asarray(values, dtype=float)
     bad = ~np.isfinite(values)
     if np.any(bad):
         first = float(values[bad].flat[0])
-        raise ValueError(f"{name}: expected finite numbers{f' such as {example}' if example else ''}; got "
+        raise NonFiniteError(f"{name}: expected finite numbers{f' such as {example}' if example else ''}; got "
                          f"{first!r}{f' among {values.size} values' if values.size > 1 else ''}.")
 
 
@@ -225,3 +231,64 @@ def parse_quantity(option: str, words, unit, example: str, default_unit=None) ->
         raise QuantityInputError(f"{option} expects {hint}; got '{text}' (physical type {_kind(quantity_unit)})."
                                  ) from error
     return magnitude * quantity_unit
+
+
+def _numbers_in(result, depth=0):
+    """(label, plain numbers) of every number a result carries: Quantities, arrays, floats, and the
+    fields of tuples and dataclasses (two levels down, enough for the package's result records)."""
+    if isinstance(result, u.Quantity):
+        yield "", result.value
+    elif isinstance(result, (np.ndarray, float, np.floating, complex)):
+        yield "", result
+    elif depth < 2 and isinstance(result, (tuple, list)):
+        for k, item in enumerate(result):
+            for label, values in _numbers_in(item, depth + 1):
+                yield f"[{k}]{label}", values
+    elif depth < 2 and dataclasses.is_dataclass(result) and not isinstance(result, type):
+        for item in dataclasses.fields(result):
+            for label, values in _numbers_in(getattr(result, item.name), depth + 1):
+                yield f".{item.name}{label}", values
+
+
+def _shown_arguments(function, args, kwargs):
+    try:
+        bound = inspect.signature(function).bind(*args, **kwargs)
+    except TypeError:
+        return ""
+    parts = []
+    for name, value in bound.arguments.items():
+        if name in ("self", "cls"):
+            continue
+        text = f"{value:.4g}" if isinstance(value, u.Quantity) and value.isscalar else repr(value)
+        parts.append(f"{name}={text if len(text) <= 40 else text[:37] + '...'}")
+    return ", ".join(parts)
+
+
+def finite_result(what, advice=""):
+    """Decorate a public function of the units layer: its result is checked finite on the way out.
+
+    Its inputs are checked on the way in (:func:`value_in`), so NaN or inf in the result, or an
+    ``OverflowError`` or ``ZeroDivisionError`` on the way, means finite inputs beyond what double
+    precision carries: :class:`~spinorbit.core.errors.NonFiniteError` names the function, the
+    arguments and the part of the result, instead of a NaN handed on or a bare arithmetic error.
+    Floating-point warnings inside are silenced, since the result is checked.
+    """
+    def decorate(function):
+        @functools.wraps(function)
+        def checked(*args, **kwargs):
+            try:
+                with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
+                    result = function(*args, **kwargs)
+            except (OverflowError, ZeroDivisionError) as error:
+                failure = "overflowed" if isinstance(error, OverflowError) else "divided by zero (a term underflowed to 0)"
+                raise NonFiniteError(
+                    f"{what}: the arithmetic {failure} for {_shown_arguments(function, args, kwargs)}: "
+                    f"{advice or 'the inputs lie beyond what double precision carries through this computation'}. "
+                    "Give values in the physical range (check their units and magnitudes).") from None
+            for label, values in _numbers_in(result):
+                if all_finite(values) is False:  # the message (and its argument list) only when needed
+                    require_finite_result(
+                        f"{what}{label} for {_shown_arguments(function, args, kwargs)}", values, advice)
+            return result
+        return checked
+    return decorate

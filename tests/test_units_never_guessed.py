@@ -210,6 +210,8 @@ def _calls():
         "Scene": (call(Scene, state=_state(), times=EPOCH + [1.0, 2.0] * u.day),
                   {"tolerance": 1e-6, "pa_threshold": 1.0}),
         "Orbit.circular": (call(Orbit.circular, radius=2.5 * u.au), {"radius": 2.5}),
+        "Orbit.approaches": (call(Orbit.de421("moon").approaches, body="earth", start=EPOCH, end=EPOCH + 30 * u.day),
+                             {"max_distance": 0.05}),
         "Orbit.kepler": (call(Orbit.kepler, **elements), bare_elements),
         "Orbit.from_elements": (call(Orbit.from_elements, **elements), bare_elements),
         "Orbit.from_state": (call(Orbit.from_state, position=[1.0, 0, 0] * u.au, velocity=[0, 30.0, 0] * u.km / u.s,

@@ -22,11 +22,11 @@ from astropy.table import QTable
 from astropy.time import Time
 
 from spinorbit.core.errors import SpinorbitError
-from spinorbit.quantities import require_quantity
+from spinorbit.quantities import require_quantity, value_in
 from spinorbit.scene.errors import SceneError
 from spinorbit.time import tdb_days, time_from_tdb_days
 
-__all__ = ["NON_GRAVITATIONAL_TERMS", "ApproachError", "Orbit"]
+__all__ = ["APPROACH_MAX_DISTANCE", "NON_GRAVITATIONAL_TERMS", "ApproachError", "Orbit"]
 
 #: The non-gravitational terms a built orbit takes (JPL's small-body model, g(r) = (1 au/r)²).
 NON_GRAVITATIONAL_TERMS = ("A1", "A2", "A3")
@@ -36,6 +36,13 @@ UNITS_G_TOLERANCE = 1e-6
 
 class ApproachError(SpinorbitError, ValueError):
     """No close approach inside the span asked for, or a span an orbit cannot be asked about."""
+
+
+#: The default cut-off of :meth:`Orbit.approaches`: JPL's Close-Approach Data lists one object's approaches
+#: to 0.2 au (its documented per-object query, https://ssd-api.jpl.nasa.gov/doc/cad.html; the 0.05 au default
+#: there is the all-NEO survey's, which would drop Toutatis's 2008 approach at 0.0502 au). A minimum farther
+#: out is the body passing on the far side of its orbit, not an encounter.
+APPROACH_MAX_DISTANCE = 0.2 * u.au
 
 
 def _scalar_time(name, value):
@@ -410,8 +417,9 @@ class Orbit:
         states = [separation(float(day)) for day in days]
         return (np.array([r for r, _ in states]) * u.au, np.array([v for _, v in states]) * u.au / u.day)
 
-    def approaches(self, body, start, end):
-        """Every local minimum of the distance to ``body`` between ``start`` and ``end``.
+    def approaches(self, body, start, end, max_distance=APPROACH_MAX_DISTANCE):
+        """The close approaches to ``body`` between ``start`` and ``end``: each local minimum of the distance
+        within ``max_distance``.
 
         Parameters
         ----------
@@ -419,33 +427,43 @@ class Orbit:
             A particle of the REBOUND simulation (for a REBOUND orbit) or a DE421 body.
         start, end : astropy.time.Time
             Scalar, start before end, inside DE421's span.
+        max_distance : Quantity (length) or None
+            The cut-off, :data:`APPROACH_MAX_DISTANCE` (0.2 au, JPL's Close-Approach Data for one object)
+            by default; None lists every local minimum, the far side of the orbit included.
 
         Returns
         -------
         astropy.table.QTable
-            ``time`` (Time, TDB), ``distance`` (km, centre to centre), ``speed`` (km/s, relative);
-            one row per approach, in time order (empty if the distance only falls or only rises).
+            ``time`` (Time, TDB), ``distance`` (au) and ``distance_km`` (km), centre to centre, ``speed``
+            (km/s, relative); one row per approach, in time order (empty if none is within the cut-off).
         """
         from spinorbit.coupling.approaches import approaches
         from spinorbit.ephemeris import de421_constants
 
+        limit_au = math.inf if max_distance is None else value_in("max_distance", max_distance, u.au, "0.05 * u.au",
+                                                                  shape=())
+        if not limit_au > 0:
+            raise ApproachError(f"max_distance expects a positive length such as 0.05 * u.au, or None for every "
+                                f"minimum; got {max_distance!s}.")
         start_day, end_day = _scalar_time("start", start), _scalar_time("end", end)
         if not end_day > start_day:
             raise ApproachError(f"end expects a time after start; got start {start.tdb.iso}, end {end.tdb.iso}.")
         _check_inside_de421("the span", start_day, end_day)
-        found = approaches(self._separation(body), start_day, end_day)
+        found = [m for m in approaches(self._separation(body), start_day, end_day) if m[1] <= limit_au]
         au_km = de421_constants().au_km
         table = QTable()
         table["time"] = time_from_tdb_days(np.array([m[0] for m in found]))
-        table["distance"] = np.array([m[1] for m in found]) * au_km * u.km
+        table["distance"] = np.array([m[1] for m in found]) * u.au
+        table["distance_km"] = np.array([m[1] for m in found]) * au_km * u.km  # DE421's au, as the orbit's states
         table["speed"] = (np.array([m[2] for m in found]) * au_km / 86400.0) * u.km / u.s
         return table
 
     def closest_approach(self, body, start, end):
         """The closest approach to ``body`` between ``start`` and ``end``: (Time, distance Quantity).
 
-        The smallest of :meth:`approaches`: a local minimum of the distance inside the span, found
-        to 1e-9 d (0.1 ms; :mod:`spinorbit.coupling.approaches`).
+        The smallest local minimum of the distance inside the span, however far (:meth:`approaches` with
+        ``max_distance=None``), found to 1e-9 d (0.1 ms; :mod:`spinorbit.coupling.approaches`); the
+        distance in au.
 
         Raises
         ------
@@ -454,7 +472,7 @@ class Orbit:
         spinorbit.ephemeris.EphemerisRangeError
             A span outside DE421.
         """
-        table = self.approaches(body, start, end)
+        table = self.approaches(body, start, end, max_distance=None)
         if len(table) == 0:
             raise ApproachError(f"no close approach of {self.name} to {body} between {start.tdb.iso} and "
                                 f"{end.tdb.iso} TDB: the distance only falls or only rises there. Widen the span.")

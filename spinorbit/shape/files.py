@@ -21,6 +21,7 @@ Every reading error names the file and line, says what was expected and what arr
 
 from __future__ import annotations
 
+import math
 import os
 
 import numpy as np
@@ -111,10 +112,14 @@ def _obj_vertex(path, number, words):
     try:
         if len(words) < 4:
             raise ValueError
-        return [float(w) for w in words[1:4]]
+        values = [float(w) for w in words[1:4]]
     except ValueError:
         raise ShapeFileError(f"{path}, line {number}: expected 'v x y z' with three numbers; got "
                              f"{' '.join(words)!r}.") from None
+    if not all(math.isfinite(v) for v in values):
+        raise ShapeFileError(f"{path}, line {number}: expected 'v x y z' with three finite numbers; got "
+                             f"{' '.join(words)!r} (NaN or inf is no position).")
+    return values
 
 
 def _obj_face(path, number, words, vertex_count):
@@ -199,6 +204,9 @@ def read_icq(path, unit=None, name=None) -> Shape:
             grid[k] = [float(w) for w in words]
         except ValueError:
             raise ShapeFileError(f"{path}, vertex line {k + 1}: expected three numbers 'x y z'; got {row!r}.") from None
+        if not np.all(np.isfinite(grid[k])):
+            raise ShapeFileError(f"{path}, vertex line {k + 1}: expected three finite numbers 'x y z'; got {row!r} "
+                                 "(NaN or inf is no position).")
     vertices, faces = icq_mesh(grid.reshape(ICQ_CUBE_FACES, q + 1, q + 1, 3) * unit, source=str(path))
     return _shape(path, vertices, faces, name)
 

@@ -48,9 +48,24 @@ class QuantityInputError(u.UnitTypeError):
     """
 
 
+_BASE_DIMENSIONS = {"m": "length", "s": "time", "kg": "mass", "rad": "angle", "K": "temperature", "A": "current",
+                    "mol": "amount", "cd": "luminous intensity"}
+
+
 def _kind(unit) -> str:
-    """The short name of a unit's physical type ("angular velocity", not astropy's three aliases)."""
-    return str(u.Unit(unit).physical_type).split("/")[-1]
+    """The short name of a unit's physical type ("angular velocity", not astropy's three aliases).
+
+    A type astropy has no name for (G·M's length³/time²) is spelt from its dimensions, never "unknown".
+    """
+    unit = u.Unit(unit)
+    kind = str(unit.physical_type).split("/")[-1]
+    if kind != "unknown":
+        return kind
+    si = unit.decompose(bases=[u.m, u.s, u.kg, u.rad, u.K, u.A, u.mol, u.cd])
+    up = [f"{_BASE_DIMENSIONS[b.name]}" + (f"^{p:g}" if p != 1 else "") for b, p in zip(si.bases, si.powers) if p > 0]
+    down = [f"{_BASE_DIMENSIONS[b.name]}" + (f"^{-p:g}" if p != -1 else "") for b, p in zip(si.bases, si.powers)
+            if p < 0]
+    return " ".join(up or ["1"]) + (" / " + " ".join(down) if down else "")
 
 
 def _expected(unit) -> str:

@@ -141,3 +141,31 @@ def repeat_main(section: str, description: str, measure, markdown, repeat: int =
     print(text)
     if not args.no_write:
         print(f"wrote {write_section(section, text)}")
+
+
+#: Prefix of the line a benchmark prints for each goal it holds a ratio to (``benchmarks/run_all.py``
+#: collects these lines from every script's output and prints them together, each with its bar).
+RATIO_PREFIX = "ratio: "
+
+
+def ratio_goal(name: str, ratio: float, bar: float, at_most: bool = False, stretch: float | None = None) -> str:
+    """A performance goal as a ratio to a peer or a floor measured in the same run: prints its line for
+    run_all (``RATIO_PREFIX``) and returns the verdict for the Markdown, e.g. ``"1.32× (bar ≥ 1×): met"``.
+
+    Why ratios: absolute rates on the shared 2-core machines move by 1.5× from run to run, a ratio of
+    two engines timed interleaved in one process much less. ``at_most``: the bar is an upper bound (a
+    time over a floor's); ``stretch``: a second, optional bar on the same side.
+    """
+    sign = "≤" if at_most else "≥"
+    met = ratio <= bar if at_most else ratio >= bar
+    if met:
+        verdict = "met"
+    else:
+        short = ratio / bar if at_most else bar / ratio
+        verdict = f"missed by a factor {short:.2f}"
+    text = f"{ratio:.3g}× (bar {sign} {bar:g}×): {verdict}"
+    if stretch is not None:
+        stretch_met = ratio <= stretch if at_most else ratio >= stretch
+        text += f"; stretch {sign} {stretch:g}×: {'met' if stretch_met else 'not met'}"
+    print(f"{RATIO_PREFIX}{name} = {text}", flush=True)
+    return text

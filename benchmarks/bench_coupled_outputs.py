@@ -27,12 +27,15 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 import spinorbit.coupling.long_run as long_run  # noqa: E402
-from benchmarks._report import Timing, machine_line, write_section  # noqa: E402
+from benchmarks._report import Timing, machine_line, ratio_goal, write_section  # noqa: E402
 from spinorbit.coupling.moon import MOON_MODELS, RIGID_MODELS, compare_model_with_de421  # noqa: E402
 
 YEAR_DAYS = 365.25
-#: Goal of issue 18 for the daily-output coupled Moon (s of wall time per simulated year).
-GOAL_SECONDS_PER_YEAR = 0.05
+#: Goal of issue 18 for the daily-output coupled Moon, as a ratio (issue 39: absolute times on the shared
+#: machines move by 1.5× from run to run): the whole call with daily outputs over the same model's whole
+#: call with the end state only, same rounds. Issue 18's 0.05 s per simulated year over the end-only
+#: call's 0.025 s/yr in the run that met it: 2×.
+GOAL_DAILY_OVER_END_ONLY = 2.0
 ROUNDS = 5
 
 
@@ -101,7 +104,7 @@ def markdown(samples, span, rounds, load):
              "largest attitude difference, over the daily outputs, between the interpolated run and the "
              f"cut-step run of the same round. 1-minute load average {load[0]:.1f} before, {load[1]:.1f} after.", "",
              "| model | outputs | BS steps | integration (s/yr) | whole call (s/yr) | whole call, CPU (s/yr) "
-             f"| max difference from DE421 | interpolation error | goal ≤ {GOAL_SECONDS_PER_YEAR} s/yr (whole, daily) |",
+             "| max difference from DE421 | interpolation error | goal: whole call (daily) ÷ whole call (end only) |",
              "|---|---|---:|---:|---:|---:|---:|---:|---|"]
     for (model, outputs, cut_steps), rows in samples.items():
         rows = np.array(rows, dtype=float)
@@ -116,8 +119,11 @@ def markdown(samples, span, rounds, load):
             steps = f"{int(rows[0, 2])}"
         error = "—" if np.all(np.isnan(rows[:, 4])) else f"{np.nanmax(rows[:, 4]):.1e}″"
         verdict = ""
-        if outputs == "daily" and not cut_steps:
-            verdict = "met" if whole.median <= GOAL_SECONDS_PER_YEAR else f"missed ({whole.median / GOAL_SECONDS_PER_YEAR:.1f}×)"
+        end_only = samples.get((model, "end only", False))
+        if outputs == "daily" and not cut_steps and end_only:
+            ratio = whole.median / float(np.median(np.array(end_only, dtype=float)[:, 1]))
+            verdict = ratio_goal(f"Moon {model}: daily outputs / end only (whole call, wall)", ratio,
+                                 GOAL_DAILY_OVER_END_ONLY, at_most=True)
         lines.append(f"| {model} | {route} | {steps} | {integration.text(1.0, '.3f')} | "
                      f"{whole.text(1.0, '.3f')} | {cpu.text(1.0, '.3f')} | {rows[0, 3]:.5f}″ | {error} | {verdict} |")
     return "\n".join(lines)

@@ -196,11 +196,15 @@ def measure_free():
     from spinorbit.ensemble import Ensemble, free_members_table
     from spinorbit.ensemble.free import torque_free_rows
 
+    from astropy import units as u
+
     moments, quaternions, omegas = _free_arrays(FREE_MEMBERS)
-    free_members_table(moments[:4], quaternions[:4], omegas[:4], 3.0, attitudes=True)  # compile / cache load
+    omegas, elapsed = omegas * u.rad / u.day, 3.0 * u.day
+    free_members_table(moments[:4], quaternions[:4], omegas[:4], elapsed, attitudes=True)  # compile / cache load
     timings, _ = interleaved_timings(
-        [lambda: free_members_table(moments, quaternions, omegas, 3.0),
-         lambda: free_members_table(moments, quaternions, omegas, 3.0, attitudes=True)], 3, clock=time.process_time)
+        [lambda: free_members_table(moments, quaternions, omegas, elapsed),
+         lambda: free_members_table(moments, quaternions, omegas, elapsed, attitudes=True)], 3,
+        clock=time.process_time)
     scenes = [free_scene(i) for i in range(FREE_SCENES)]
     rows_cpu, _ = interleaved_timings([lambda: torque_free_rows(scenes)], 3, clock=time.process_time)
     whole, _ = interleaved_timings([lambda: Ensemble(free_scene, [dict(i=i) for i in range(FREE_SCENES)]).run(

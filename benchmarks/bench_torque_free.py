@@ -37,7 +37,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from _heyoka_reference import propagate as reference_propagate, rotation_angle  # noqa: E402
-from _report import interleaved_timings, machine_line, write_section  # noqa: E402
+from _report import interleaved_timings, machine_line, ratio_goal, write_section  # noqa: E402
 from peers import fastest_heyoka_integrator, heyoka_equations  # noqa: E402
 
 from spinorbit.core import make_model  # noqa: E402
@@ -46,8 +46,11 @@ from spinorbit.core.dynamics import python_reference  # noqa: E402
 from spinorbit.core.free_motion.flow import torque_free_states, torque_free_states_many  # noqa: E402
 from spinorbit.core.free_motion.flow_constants import FL_PERIOD_HI, FL_RATE_HI, flow_constants  # noqa: E402
 
-GOAL_STATES_PER_SECOND = 5.0e6  # issue 18: many times per state, one core
-GOAL_ONE_TIME_STATES_PER_SECOND = 2.0e6  # issue 18: one time per state
+# The goals as ratios to heyoka's states/s measured in the same run (issue 39: absolute rates on the shared
+# machines move by 1.5× from run to run). Issue 18's absolute goals, 5e6 states/s (many times per state) and
+# 2e6 (one time per state), over heyoka's 4.48e5 in the run that first met them: 11× and 4.5×, rounded down.
+GOAL_RATIO_TO_HEYOKA = 10.0
+GOAL_ONE_TIME_RATIO_TO_HEYOKA = 4.0
 MOMENTS = (2.0 / 3.0, 1.0, 2.0)
 MOMENTUM = np.array([math.sin(1.1), 0.0, math.cos(1.1)])
 IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
@@ -331,13 +334,13 @@ def one_time_floor(quaternions, momenta, t, repeats=7):
     return {name: tuple(None if f is None else next(per_state) for f in pair) for name, pair in jobs.items()}
 
 
-def floor_text(floor, one_time_rate):
+def floor_text(floor, one_time_rate, heyoka_rate):
     names = list(floor)
     kernel = floor[names[0]][1]
     whole_scalar = floor[names[1]][0]
     set_up_scalar, set_up_lanes = floor[names[2]]
     evaluation = whole_scalar - set_up_scalar
-    budget = 1e9 / GOAL_ONE_TIME_STATES_PER_SECOND
+    budget = 1e9 / (GOAL_ONE_TIME_RATIO_TO_HEYOKA * heyoka_rate)  # ns per state at the bar, in this run
     call = 1e9 / one_time_rate
 
     def cell(value):
@@ -350,7 +353,7 @@ def floor_text(floor, one_time_rate):
              "| part | one state at a time | eight in lanes |", "|---|---:|---:|"]
     lines += [f"| {name} | {cell(scalar)} | {cell(lanes)} |" for name, (scalar, lanes) in floor.items()]
     lines += [f"| one evaluation (the second row less the third's first column) | {evaluation:.0f} | – |", "",
-              f"The goal's budget is {budget:.0f} ns per state; the whole call measures {call:.0f} ns, {kernel:.0f} ns "
+              f"The goal's budget in this run is {budget:.0f} ns per state; the whole call measures {call:.0f} ns, {kernel:.0f} ns "
               f"of it in the kernel (the first row), the rest the Python wrapper's checks and the allocation of "
               f"the outputs. In lanes the set-up costs "
               f"{set_up_lanes:.0f} ns against {set_up_scalar:.0f} ns state by state: the motion constants, the "
@@ -466,24 +469,27 @@ def main():
     for (name, count, timing, err), rate in zip(rows, rates):
         err_text = "—" if math.isnan(err) else f"{err:.1e}"
         lines.append(f"| {name} | {rate_text(count, timing)} | {rate / exact_rate:.3g}× | {err_text} |")
-    verdict = "met" if exact_rate >= GOAL_STATES_PER_SECOND else "missed"
     one_time_rate = rates[2]
-    one_time_verdict = "met" if one_time_rate >= GOAL_ONE_TIME_STATES_PER_SECOND else "missed"
+    heyoka_rate = rates[4]  # heyoka double, many times per state: the peer of both goals
+    verdict = ratio_goal("torque-free exact (many times per state) / heyoka", exact_rate / heyoka_rate,
+                         GOAL_RATIO_TO_HEYOKA)
+    one_time_verdict = ratio_goal("torque-free exact (one time per state) / heyoka", one_time_rate / heyoka_rate,
+                                  GOAL_ONE_TIME_RATIO_TO_HEYOKA)
     lines += [
         "",
-        f"Goal: ≥ {GOAL_STATES_PER_SECOND:.0e} states/s on one core for the exact solution (many times "
-        f"per state): **{verdict}** ({exact_rate:.3g} states/s). With one time per state the per-state "
+        f"Goals, as ratios to heyoka's states/s in this run (absolute rates on the shared machine move by "
+        f"1.5× from run to run): the exact solution, many times per state, {exact_rate:.3g} states/s against "
+        f"heyoka's {heyoka_rate:.3g}: **{verdict}**. With one time per state the per-state "
         f"setup dominates (one compensated AGM for K and Π, forward map to the elements, node frame, "
-        f"coefficients of pn's nome series; "
-        f"≈ {1e6 / one_time_rate:.1f} µs per state; goal ≥ {GOAL_ONE_TIME_STATES_PER_SECOND:.0e}): "
-        f"**{one_time_verdict}** for that workload ({one_time_rate:.3g} states/s). The integrators cannot reach the exact "
+        f"coefficients of pn's nome series; ≈ {1e6 / one_time_rate:.1f} µs per state), {one_time_rate:.3g} "
+        f"states/s: **{one_time_verdict}**. The integrators cannot reach the exact "
         "solution's error in double precision at any tolerance they accept; they are shown at their "
         "tightest tolerance, so their speed is an upper bound for equal accuracy. Their cost scales with "
         "the span, not with the number of output times; the exact solution's cost is per output time "
         "and does not depend on the span.",
     ]
     lines += floor_text(one_time_floor(quaternions_many, momenta_many, float(one_time[0]),
-                                       repeats=min(EXACT_REPEATS, 7)), one_time_rate)
+                                       repeats=min(EXACT_REPEATS, 7)), one_time_rate, heyoka_rate)
     markdown = "\n".join(lines)
     print(markdown)
     if write:

@@ -16,6 +16,11 @@ Two scripts compare this checkout with another revision and need it named: ``bef
 (``--base OLD_CHECKOUT``) runs in full mode only when ``--base`` is given here; ``bench_startup.py``
 measures this checkout alone unless ``--before REV`` is given. Their quick runs use this checkout as
 its own base.
+
+**Ratios with their bars.** Every performance goal of docs/performance.md is a ratio to a peer or a
+floor measured in the same run (absolute rates on the shared machines move by 1.5× from run to run);
+each script prints one ``ratio: …`` line per goal (``_report.ratio_goal``), and the summary lists them
+all, each with the bar it is held to and whether it is met.
 """
 
 from __future__ import annotations
@@ -30,6 +35,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 HERE = Path(__file__).resolve().parent
+RATIO_PREFIX = "ratio: "  # _report.RATIO_PREFIX (not imported: run_all must run without the package's imports)
 
 
 @dataclass(frozen=True)
@@ -71,6 +77,7 @@ BENCHMARKS = (
     Benchmark("bench_stm.py", quick=("--repeat", "1", "--no-write")),
     Benchmark("fit_toutatis.py", quick=("--no-write",)),
     Benchmark("didymos_report.py", quick=("--no-write",)),
+    Benchmark("dart_report.py", quick=("--no-write", "--members", "4")),
     Benchmark("bench_binary.py", quick=("--repeat", "1", "--no-write")),
     Benchmark("bench_averaged.py"),
     Benchmark("stability.py"),
@@ -93,8 +100,14 @@ def arguments(benchmark: Benchmark, quick: bool, base: str | None, before: str |
     return list(benchmark.full)
 
 
-def run(names=None, quick: bool = False, base: str | None = None, before: str | None = None, stream=sys.stdout):
-    """Run the chosen scripts; returns [(script, status or None if skipped, wall seconds)]."""
+def run(names=None, quick: bool = False, base: str | None = None, before: str | None = None, stream=None,
+        ratios=None):
+    """Run the chosen scripts; returns [(script, status or None if skipped, wall seconds)].
+
+    Each script's output is passed on to ``stream`` (default sys.stdout) line by line; its goal lines
+    (``_report.RATIO_PREFIX``) are appended to ``ratios`` as (script, line) when a list is given.
+    """
+    stream = sys.stdout if stream is None else stream
     chosen = [b for b in BENCHMARKS if names is None or b.script in names]
     unknown = set(names or ()) - {b.script for b in BENCHMARKS}
     if unknown:
@@ -111,17 +124,27 @@ def run(names=None, quick: bool = False, base: str | None = None, before: str | 
             continue
         print(f"== {benchmark.script} {' '.join(argv)}", file=stream, flush=True)
         begin = time.perf_counter()
-        status = subprocess.run([sys.executable, str(HERE / benchmark.script), *argv], cwd=ROOT,
-                                env=environment).returncode
+        with subprocess.Popen([sys.executable, str(HERE / benchmark.script), *argv], cwd=ROOT, env=environment,
+                              stdout=subprocess.PIPE, text=True, bufsize=1) as process:
+            for line in process.stdout:
+                stream.write(line)
+                stream.flush()
+                if ratios is not None and line.startswith(RATIO_PREFIX):
+                    ratios.append((benchmark.script, line[len(RATIO_PREFIX):].strip()))
+        status = process.returncode
         results.append((benchmark.script, status, time.perf_counter() - begin))
     return results
 
 
-def summary(results) -> str:
+def summary(results, ratios=()) -> str:
+    """The scripts' status table, then every goal's ratio with its bar (as the scripts printed them)."""
     lines = ["| script | status | wall (s) |", "|---|---|---:|"]
     for script, status, wall in results:
         text = "skipped" if status is None else ("ok" if status == 0 else f"failed ({status})")
         lines.append(f"| {script} | {text} | {wall:.1f} |")
+    if ratios:
+        lines += ["", "| script | goal = ratio (bar): verdict |", "|---|---|"]
+        lines += [f"| {script} | {line} |" for script, line in ratios]
     return "\n".join(lines)
 
 
@@ -138,8 +161,9 @@ def main(argv=None) -> int:
             argv_ = arguments(benchmark, args.quick, args.base, args.before)
             print(benchmark.script, "(skipped)" if argv_ is None else " ".join(argv_))
         return 0
-    results = run(args.only, args.quick, args.base, args.before)
-    print(summary(results))
+    ratios = []
+    results = run(args.only, args.quick, args.base, args.before, ratios=ratios)
+    print(summary(results, ratios))
     return 1 if any(status not in (0, None) for _, status, _ in results) else 0
 
 

@@ -44,6 +44,9 @@ __all__ = ["main", "console_main", "build_parser", "CommandError", "Terminated",
 
 #: Exit status for a run stopped by bad input (argparse's own convention).
 EXIT_USAGE = 2
+#: Exit status of a run that could not finish for want of the machines running it (its Dask scheduler
+#: or every worker lost): not bad input; what finished is kept, and the same command resumes.
+EXIT_INCOMPLETE = 3
 #: Exit status after Ctrl-C (128 + SIGINT), as shells report it.
 EXIT_INTERRUPTED = 130
 #: Exit status after SIGTERM (128 + SIGTERM), as shells report it.
@@ -185,8 +188,9 @@ def main(argv=None) -> int:
     Returns
     -------
     int
-        0 on success, 2 for bad input or an output that cannot be written, 130 after Ctrl-C (SIGINT),
-        143 after SIGTERM, 141 if stdout was closed early.
+        0 on success, 1 when an ensemble member failed, 2 for bad input or an output that cannot be
+        written, 3 when an ensemble's scheduler or workers were lost, 130 after Ctrl-C (SIGINT), 143
+        after SIGTERM, 141 if stdout was closed early.
     """
     args = build_parser().parse_args(argv)
     from spinorbit.commands._compile_notice import compile_notice

@@ -38,6 +38,7 @@ from astropy import units as u
 from spinorbit.core.errors import SpinorbitError
 from spinorbit.core.math.rotations import rot1, rot3
 from spinorbit.frames import icrf_to_ecliptic_matrix
+from spinorbit.quantities import require_quantity
 
 __all__ = ["ELEMENT_FRAMES", "JPL_OBLIQUITY_J2000", "OrbitElementsError", "check_elements", "elements_to_state",
            "frame_to_icrf_matrix", "solve_kepler"]
@@ -67,6 +68,7 @@ def frame_to_icrf_matrix(frame):
 
 
 def _angle(name, value, low_deg, high_deg, what):
+    require_quantity(name, value, u.deg, "10 * u.deg")
     if not isinstance(value, u.Quantity) or value.unit.physical_type != "angle" or not value.isscalar:
         raise OrbitElementsError(f"{name} expects a scalar angle Quantity such as 10 * u.deg; got {value!r}.")
     degrees = float(value.to_value(u.deg))
@@ -96,6 +98,7 @@ def check_elements(a, e, inc, raan, argp, mean_anomaly):
     tuple of float
         (a_km, e, inc, raan, argp, mean_anomaly), angles in rad.
     """
+    require_quantity("a", a, u.au, "2.53 * u.au")
     if not isinstance(a, u.Quantity) or a.unit.physical_type != "length" or not a.isscalar:
         raise OrbitElementsError(f"a expects a scalar length Quantity such as 2.53 * u.au; got {a!r}.")
     a_km = float(a.to_value(u.km))

@@ -20,12 +20,18 @@ per second (2π rad/s). Turns per time are written with astropy's ``u.cycle`` (`
 
 from __future__ import annotations
 
+import dataclasses
+import functools
+import inspect
 import math
 
 import numpy as np
 from astropy import units as u
 
-__all__ = ["QuantityInputError", "bare_number_message", "finite_values", "parse_quantity", "parse_unit", "value_in"]
+from spinorbit.core.errors import NonFiniteError, all_finite, require_finite_result
+
+__all__ = ["QuantityInputError", "bare_number_message", "finite_result", "finite_values", "parse_quantity", "parse_unit",
+           "require_quantity", "value_in"]
 
 # The physical types value_in compares with, looked up once: comparing with a string parses the name
 # on every call (~4 µs each, several per member of an ensemble); comparing PhysicalTypes is the same test.
@@ -42,9 +48,24 @@ class QuantityInputError(u.UnitTypeError):
     """
 
 
+_BASE_DIMENSIONS = {"m": "length", "s": "time", "kg": "mass", "rad": "angle", "K": "temperature", "A": "current",
+                    "mol": "amount", "cd": "luminous intensity"}
+
+
 def _kind(unit) -> str:
-    """The short name of a unit's physical type ("angular velocity", not astropy's three aliases)."""
-    return str(u.Unit(unit).physical_type).split("/")[-1]
+    """The short name of a unit's physical type ("angular velocity", not astropy's three aliases).
+
+    A type astropy has no name for (G·M's length³/time²) is spelt from its dimensions, never "unknown".
+    """
+    unit = u.Unit(unit)
+    kind = str(unit.physical_type).split("/")[-1]
+    if kind != "unknown":
+        return kind
+    si = unit.decompose(bases=[u.m, u.s, u.kg, u.rad, u.K, u.A, u.mol, u.cd])
+    up = [f"{_BASE_DIMENSIONS[b.name]}" + (f"^{p:g}" if p != 1 else "") for b, p in zip(si.bases, si.powers) if p > 0]
+    down = [f"{_BASE_DIMENSIONS[b.name]}" + (f"^{-p:g}" if p != -1 else "") for b, p in zip(si.bases, si.powers)
+            if p < 0]
+    return " ".join(up or ["1"]) + (" / " + " ".join(down) if down else "")
 
 
 def _expected(unit) -> str:
@@ -60,12 +81,12 @@ def _arrived(value) -> str:
 
 def _bare(value) -> str:
     """A bare number or array as the user wrote it, short: "float 0.000218", "list [0.1, 0, 0.3]"."""
-    if isinstance(value, np.ndarray):
-        shown = np.array2string(value, threshold=6, separator=", ")
-    else:
-        shown = repr(value)
-        shown = shown if len(shown) <= 60 else shown[:57] + "..."
-    return f"{type(value).__name__} {shown}"
+    if isinstance(value, np.ndarray) and value.dtype.kind in "biuf":
+        head = ", ".join(f"{x:.6g}" for x in value.ravel()[:3].tolist()) + (", ..." if value.size > 3 else "")
+        shape = "" if value.ndim == 1 else f" of shape {value.shape}"
+        return f"ndarray{shape} [{head}]"
+    shown = " ".join(repr(value).split())  # one line, whatever arrived
+    return f"{type(value).__name__} {shown if len(shown) <= 60 else shown[:57] + '...'}"
 
 
 def bare_number_message(name: str, unit, example: str, value) -> str:
@@ -81,6 +102,16 @@ def bare_number_message(name: str, unit, example: str, value) -> str:
             "never guessed, multiply by the unit meant.")
 
 
+def require_quantity(name: str, value, unit, example: str) -> None:
+    """Raise ``QuantityInputError`` with :func:`bare_number_message` unless ``value`` is a Quantity.
+
+    For checks of their own that read a Quantity's physical type before converting it (a G·M, an
+    acceleration): the bare number is refused in the same words as by :func:`value_in`.
+    """
+    if not isinstance(value, u.Quantity):
+        raise QuantityInputError(bare_number_message(name, unit, example, value))
+
+
 def _frequency_advice(name: str, value, unit: u.UnitBase) -> str:
     time_unit = (u.rad / unit).to_string()  # the time unit of the expected rate: d for rad / d
     return (
@@ -91,7 +122,7 @@ def _frequency_advice(name: str, value, unit: u.UnitBase) -> str:
     )
 
 
-def value_in(name: str, value, unit, example: str, *, plain_unit=None, finite: bool = True,
+def value_in(name: str, value, unit, example: str, *, finite: bool = True,
              shape: tuple | None = None) -> np.ndarray | float:
     """``value`` as plain floats in ``unit``, after checking its physical type.
 
@@ -100,15 +131,12 @@ def value_in(name: str, value, unit, example: str, *, plain_unit=None, finite: b
     name : str
         The argument or option, as the user wrote it (``"angular_velocity"``, ``"--span"``).
     value : Quantity or array_like
-        A Quantity of ``unit``'s physical type. Plain numbers only where ``unit`` is dimensionless
-        (or, until every caller is converted, read in ``plain_unit``).
+        A Quantity of ``unit``'s physical type. Plain numbers only where ``unit`` is dimensionless; for
+        a dimensional ``unit`` they are refused with :func:`bare_number_message` (units are never guessed).
     unit : str or astropy unit
         The unit the caller works in (``rad / day``, ``day``, ``kg m2``).
     example : str
         A correct value to show in the message (``"0.1 * u.rad / u.s"``).
-    plain_unit : astropy unit, optional
-        The unit of plain numbers; None (the rule): plain numbers are refused for a dimensional
-        ``unit`` with :func:`bare_number_message`, and read as they are for a dimensionless one.
     finite : bool
         Refuse NaN and ±inf (default).
     shape : tuple, optional
@@ -145,14 +173,13 @@ def value_in(name: str, value, unit, example: str, *, plain_unit=None, finite: b
                 f"{name}: expected a Quantity in {_expected(unit)} such as {example}; got "
                 f"{_arrived(value)}."
             )
-    elif plain_unit is None and unit.physical_type != _DIMENSIONLESS:
-        raise QuantityInputError(bare_number_message(name, unit, example, value))
+    elif unit.physical_type != _DIMENSIONLESS:
+        require_quantity(name, value, unit, example)
     else:
-        plain_unit = u.dimensionless_unscaled if plain_unit is None else plain_unit
         try:
-            values = np.asarray(value, dtype=float) * u.Unit(plain_unit).to(unit)
+            values = np.asarray(value, dtype=float) * u.dimensionless_unscaled.to(unit)
         except (TypeError, ValueError):
-            raise QuantityInputError(f"{name}: expected numbers (in {plain_unit}) or a Quantity such as {example}; "
+            raise QuantityInputError(f"{name}: expected a number or a dimensionless Quantity such as {example}; "
                                      f"got {_arrived(value)}.") from None
     values = np.asarray(values, dtype=float)
     if shape is not None and values.shape != tuple(shape):
@@ -164,12 +191,13 @@ def value_in(name: str, value, unit, example: str, *, plain_unit=None, finite: b
 
 
 def finite_values(name: str, values, example: str = "") -> None:
-    """Raise ``ValueError`` naming ``name`` and the first non-finite entry if any entry is NaN or ±inf."""
+    """Raise :class:`~spinorbit.core.errors.NonFiniteError` (a ``ValueError``) naming ``name`` and the first
+    non-finite entry if any entry is NaN or ±inf."""
     values = np.asarray(values, dtype=float)
     bad = ~np.isfinite(values)
     if np.any(bad):
         first = float(values[bad].flat[0])
-        raise ValueError(f"{name}: expected finite numbers{f' such as {example}' if example else ''}; got "
+        raise NonFiniteError(f"{name}: expected finite numbers{f' such as {example}' if example else ''}; got "
                          f"{first!r}{f' among {values.size} values' if values.size > 1 else ''}.")
 
 
@@ -218,3 +246,64 @@ def parse_quantity(option: str, words, unit, example: str, default_unit=None) ->
         raise QuantityInputError(f"{option} expects {hint}; got '{text}' (physical type {_kind(quantity_unit)})."
                                  ) from error
     return magnitude * quantity_unit
+
+
+def _numbers_in(result, depth=0):
+    """(label, plain numbers) of every number a result carries: Quantities, arrays, floats, and the
+    fields of tuples and dataclasses (two levels down, enough for the package's result records)."""
+    if isinstance(result, u.Quantity):
+        yield "", result.value
+    elif isinstance(result, (np.ndarray, float, np.floating, complex)):
+        yield "", result
+    elif depth < 2 and isinstance(result, (tuple, list)):
+        for k, item in enumerate(result):
+            for label, values in _numbers_in(item, depth + 1):
+                yield f"[{k}]{label}", values
+    elif depth < 2 and dataclasses.is_dataclass(result) and not isinstance(result, type):
+        for item in dataclasses.fields(result):
+            for label, values in _numbers_in(getattr(result, item.name), depth + 1):
+                yield f".{item.name}{label}", values
+
+
+def _shown_arguments(function, args, kwargs):
+    try:
+        bound = inspect.signature(function).bind(*args, **kwargs)
+    except TypeError:
+        return ""
+    parts = []
+    for name, value in bound.arguments.items():
+        if name in ("self", "cls"):
+            continue
+        text = f"{value:.4g}" if isinstance(value, u.Quantity) and value.isscalar else repr(value)
+        parts.append(f"{name}={text if len(text) <= 40 else text[:37] + '...'}")
+    return ", ".join(parts)
+
+
+def finite_result(what, advice=""):
+    """Decorate a public function of the units layer: its result is checked finite on the way out.
+
+    Its inputs are checked on the way in (:func:`value_in`), so NaN or inf in the result, or an
+    ``OverflowError`` or ``ZeroDivisionError`` on the way, means finite inputs beyond what double
+    precision carries: :class:`~spinorbit.core.errors.NonFiniteError` names the function, the
+    arguments and the part of the result, instead of a NaN handed on or a bare arithmetic error.
+    Floating-point warnings inside are silenced, since the result is checked.
+    """
+    def decorate(function):
+        @functools.wraps(function)
+        def checked(*args, **kwargs):
+            try:
+                with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
+                    result = function(*args, **kwargs)
+            except (OverflowError, ZeroDivisionError) as error:
+                failure = "overflowed" if isinstance(error, OverflowError) else "divided by zero (a term underflowed to 0)"
+                raise NonFiniteError(
+                    f"{what}: the arithmetic {failure} for {_shown_arguments(function, args, kwargs)}: "
+                    f"{advice or 'the inputs lie beyond what double precision carries through this computation'}. "
+                    "Give values in the physical range (check their units and magnitudes).") from None
+            for label, values in _numbers_in(result):
+                if all_finite(values) is False:  # the message (and its argument list) only when needed
+                    require_finite_result(
+                        f"{what}{label} for {_shown_arguments(function, args, kwargs)}", values, advice)
+            return result
+        return checked
+    return decorate

@@ -385,12 +385,12 @@ def tumbling_attitude(body, p_psi, p_phi, momentum_lon, momentum_lat, phi0, thet
                             "the mode.") from None
     sine = math.sqrt(from_periods.nutation_sine_squared(mu, psi, *moments, big_b))
     theta = math.asin(min(sine, 1.0))
+    limit = value_in("theta_tolerance", theta_tolerance, u.rad, "1 * u.deg", shape=())  # checked even if unused
     if theta0 is not None:
         given = _angle("theta0", theta0, "30 * u.deg")
         if not 0.0 <= given <= math.pi:
             raise SpinFormError(f"theta0 expects an angle in [0°, 180°]; got {theta0!s}.")
         theta = theta if given <= math.pi / 2 else math.pi - theta
-        limit = value_in("theta_tolerance", theta_tolerance, u.rad, "1 * u.deg", shape=())
         if not abs(given - theta) <= limit:
             raise SpinFormError(
                 f"theta0 = {theta0!s} is not the nutation angle of this motion at psi0 = {psi0!s}: the periods and the "

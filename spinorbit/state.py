@@ -1,8 +1,8 @@
 """Rotation states: attitude and spin of a rigid body, with the canonical elements and the exact free motion.
 
 Attitudes are given and returned in the user's body axes (see :class:`spinorbit.RigidBody`); the
-core works in principal axes A ≤ B ≤ C. Spins are Quantities (rad/s, deg/day, …); a plain float is
-read as rad/day, the core's unit. A state made from a published form (:meth:`RotationState.from_pole`,
+core works in principal axes A ≤ B ≤ C. Spins are Quantities (rad/s, deg/day, …); a bare number is
+refused, never read in the core's rad/day (``docs/conventions.md``, "Units"). A state made from a published form (:meth:`RotationState.from_pole`,
 :meth:`RotationState.from_tumbling`) knows its epoch. Conventions: ``docs/conventions.md``.
 """
 
@@ -228,6 +228,15 @@ class RotationState:
         """
         attitude, omega, _ = _spin_forms.pole_attitude(body, pole_lon, pole_lat, period, phase, frame, axes)
         return cls(body, _spin_forms.attitude_quaternion(attitude), omega * RAD_PER_DAY, _spin_forms.check_epoch(epoch))
+
+    @classmethod
+    def from_sbpy(cls, body, phys, epoch, row=0, phase=0 * u.deg, axes=None):
+        """:meth:`from_pole` of the pole and rotation period in a row of an ``sbpy.data.Phys`` (the fields it reads:
+        :mod:`spinorbit.sbpy_tables`); ``epoch``, ``phase`` and ``axes`` as in :meth:`from_pole`."""
+        from spinorbit.sbpy_tables import pole_arguments
+
+        lon, lat, period, frame = pole_arguments(phys, row)
+        return cls.from_pole(body, lon, lat, period, epoch, phase=phase, frame=frame, axes=axes)
 
     @classmethod
     def from_tumbling(cls, body, p_psi, p_phi, momentum_lon, momentum_lat, phi0, theta0, psi0, epoch, mode=None,
@@ -480,25 +489,37 @@ class RotationState:
             return np.eye(3)
         return _as_rotation_matrix(reference)
 
-    def andoyer_variables(self, reference="auto") -> tuple[float, float, float, float, float, float]:
+    def andoyer_variables(self, reference="auto") -> tuple[u.Quantity, ...]:
         """Andoyer variables (L, G, H, l, g, h) in principal axes (A ≤ B ≤ C), paper section 3.
 
-        Momenta in the body's moment unit × rad/day, angles in radians. ``reference`` as in
-        :meth:`canonical_elements`. At J = 0 (spin exactly about C) only l + g is defined; the split
-        follows ``spinorbit.core.elements.andoyer.andoyer_from_attitude``.
+        Quantities: the momenta L, G, H in the body's moment unit × rad/day (rad/day for moments given
+        as ratios), the angles l, g, h in radians. ``reference`` as in :meth:`canonical_elements`. At
+        J = 0 (spin exactly about C) only l + g is defined; the split follows
+        ``spinorbit.core.elements.andoyer.andoyer_from_attitude``.
         """
         self._rotating_momentum()
         frame = self._reference_frame(reference)
         attitude, momentum = self.principal_attitude_and_momentum()
-        return tuple(float(x) for x in _andoyer.andoyer_from_attitude(attitude @ frame.T, momentum))
+        values = _andoyer.andoyer_from_attitude(attitude @ frame.T, momentum)
+        momentum_unit = self._body.moment_unit * RAD_PER_DAY
+        return tuple(float(x) * (momentum_unit if k < 3 else u.rad) for k, x in enumerate(values))
 
     @classmethod
     def from_andoyer(cls, body: RigidBody, big_l, big_g, big_h, l, g, h, reference=None) -> "RotationState":
         """The state of Andoyer variables in principal axes (inverse of :meth:`andoyer_variables`).
 
-        ``reference`` is the passive rotation inertial → frame of h and I (identity by default).
+        ``big_l``, ``big_g``, ``big_h`` are Quantities in the body's moment unit × an angle per time (rad/day
+        for moments given as ratios), ``l``, ``g``, ``h`` angles. ``reference`` is the passive rotation
+        inertial → frame of h and I (identity by default).
         """
-        values = np.array([big_l, big_g, big_h, l, g, h], dtype=float)
+        momentum_unit = body.moment_unit * RAD_PER_DAY
+        example = f"1.0 * u.Unit('{momentum_unit.to_string()}')"
+        momenta = [value_in(name, value, momentum_unit, example, shape=(), finite=False)
+                   for name, value in (("big_l", big_l), ("big_g", big_g), ("big_h", big_h))]
+        angles = [value_in(name, value, u.rad, "0.3 * u.rad", shape=(), finite=False)
+                  for name, value in (("l", l), ("g", g), ("h", h))]
+        values = np.array(momenta + angles, dtype=float)
+        big_l, big_g, big_h = momenta
         if not np.all(np.isfinite(values)) or big_g <= 0 or abs(big_l) > big_g or abs(big_h) > big_g:
             raise InvalidStateError(
                 f"Andoyer variables need finite values with G > 0 and |L|, |H| ≤ G; got L={big_l!r}, G={big_g!r}, "

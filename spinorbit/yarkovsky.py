@@ -21,10 +21,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
 from astropy import units as u
 
 from spinorbit.core.model import yarkovsky as kernel
-from spinorbit.quantities import value_in
+from spinorbit.quantities import finite_result, value_in
 
 __all__ = ["YarkovskyDrift", "yarkovsky_drift", "DRIFT_UNIT"]
 
@@ -54,10 +55,10 @@ def _positive(name, value, unit, example):
 
 
 def _unit_interval(name, value, low_closed, high_closed, meaning):
-    if isinstance(value, u.Quantity):
-        value = value_in(name, value, u.dimensionless_unscaled, "0.1", shape=())
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+    if isinstance(value, (bool, np.bool_)):
         raise ValueError(f"{name}: expected a finite number ({meaning}); got {value!r}.")
+    # Any real number: Python's, numpy's (float32 too) or a dimensionless Quantity; NaN and inf refused.
+    value = value_in(name, value, u.dimensionless_unscaled, "0.1", shape=())
     inside = (value >= 0.0 if low_closed else value > 0.0) and (value <= 1.0 if high_closed else value < 1.0)
     if not inside:
         interval = ("[" if low_closed else "(") + "0, 1" + ("]" if high_closed else ")")
@@ -65,6 +66,8 @@ def _unit_interval(name, value, low_closed, high_closed, meaning):
     return float(value)
 
 
+@finite_result("yarkovsky_drift", "the linear theory's terms (R³, 1/a², exp of the penetration depths) overflow "
+               "double precision for these values")
 def yarkovsky_drift(*, radius, density, heat_capacity, rotation_period, obliquity, semi_major_axis,
                     eccentricity=0.0, thermal_inertia=None, conductivity=None, albedo=0.0, emissivity=0.9,
                     spin_longitude=0.0 * u.deg, samples=256) -> YarkovskyDrift:

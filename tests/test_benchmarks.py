@@ -66,3 +66,20 @@ def test_every_benchmark_runs_in_quick_mode():
     failed = [(script, status) for script, status, _ in results if status != 0]
     assert not failed, run_all.summary(results)
     assert _docs_digest() == before
+
+
+def test_ratio_goals_are_printed_for_run_all_and_judged_on_their_side(capsys):
+    report = importlib.import_module("benchmarks._report")
+    assert _run_all().RATIO_PREFIX == report.RATIO_PREFIX  # run_all keeps its own copy (no package import)
+    assert report.ratio_goal("a / peer", 1.32, 1.0, stretch=1.5) == "1.32× (bar ≥ 1×): met; stretch ≥ 1.5×: not met"
+    assert report.ratio_goal("b / peer", 0.3, 1.0).endswith("missed by a factor 3.33")
+    assert report.ratio_goal("c / floor", 25.0, 30.0, at_most=True) == "25× (bar ≤ 30×): met"
+    assert report.ratio_goal("d / floor", 45.0, 30.0, at_most=True).endswith("missed by a factor 1.50")
+    printed = [line for line in capsys.readouterr().out.splitlines() if line.startswith(report.RATIO_PREFIX)]
+    assert [line.split(" = ")[0] for line in printed] == ["ratio: a / peer", "ratio: b / peer", "ratio: c / floor",
+                                                          "ratio: d / floor"]
+
+
+def test_summary_lists_every_ratio_with_its_bar():
+    text = _run_all().summary([("x.py", 0, 1.0)], [("x.py", "a / peer = 1.32× (bar ≥ 1×): met")])
+    assert "| x.py | a / peer = 1.32× (bar ≥ 1×): met |" in text

@@ -321,6 +321,21 @@ def test_toutatis_scene_end_only_and_plot(capsys, tmp_path):
     assert "LAM" in out
 
 
+def test_toutatis_run_marks_its_close_approach_in_the_summary_ecsv_and_plot(capsys, tmp_path):
+    # 60 d from 1992-11-09 hold the 1992-12-08 approach (0.024 au published; 0.0240 au on this orbit)
+    path = tmp_path / "t.ecsv"
+    status = cli.main(["toutatis", "--span", "60", "d", "--n-times", "3", "--tolerance", "100", "arcsec",
+                       "--output", str(path)])
+    out, err = capsys.readouterr()
+    assert status == 0, err
+    line = re.search(r"closest approach\s+earth 1992-12-08 \d\d:\d\d TDB, (0\.\d+) au \(([\d.e+]+) km\)", out)
+    assert line and float(line[1]) == pytest.approx(0.024, rel=0.02), out
+    assert float(line[2]) == pytest.approx(float(line[1]) * 1.495978707e8, rel=1e-4)
+    meta = Table.read(path).meta
+    (approach,) = meta["close_approaches"]["earth"]
+    assert approach["time"].startswith("1992-12-08") and meta["closest_approaches"]["earth"] == approach
+
+
 def test_toutatis_torque_free_when_the_tolerance_allows(capsys):
     status = cli.main(["toutatis", "--plan", "--span", "0.01", "d", "--tolerance", "100", "arcsec"])
     out, _ = capsys.readouterr()

@@ -24,7 +24,7 @@ def _members(n=N, seed=3):
     moments[:3, 1] = moments[:3, 0]  # A = B: regular precession
     quaternions = rng.normal(size=(n, 4))
     quaternions /= np.linalg.norm(quaternions, axis=1)[:, None]
-    return moments, quaternions, rng.normal(size=(n, 3)) * 2.0
+    return moments, quaternions, rng.normal(size=(n, 3)) * 2.0 * u.rad / u.day
 
 
 def _bits(table, name):
@@ -33,13 +33,13 @@ def _bits(table, name):
 
 
 def _state(moments, quaternion, omega):
-    return RotationState(RigidBody(moments), quaternion, omega * u.rad / u.day)
+    return RotationState(RigidBody(moments), quaternion, omega)
 
 
 @pytest.mark.parametrize("attitudes", [False, True])
 def test_a_member_alone_and_in_any_batch_gives_the_same_bits(attitudes):
     moments, quaternions, omegas = _members()
-    times = [0.5, 3.0]
+    times = [0.5, 3.0] * u.day
     batch = free_members_table(moments, quaternions, omegas, times, attitudes=attitudes)
     assert set(batch["mode_t0"]) == {"SAM", "LAM"}
     halves = [free_members_table(moments[s], quaternions[s], omegas[s], times, attitudes=attitudes)
@@ -79,7 +79,7 @@ def test_the_ensemble_of_scenes_gives_the_vectorised_bits_and_agrees_with_each_s
     # the states as the Scenes hold them (RotationState normalises its quaternion)
     states = [_state(moments[i], quaternions[i], omegas[i]) for i in range(N)]
     vectorised = free_members_table(moments, [s.quaternion for s in states],
-                                    np.array([s.angular_velocity.value for s in states]), 3.0)
+                                    np.array([s.angular_velocity.value for s in states]) * u.rad / u.day, 3.0 * u.day)
     for name in vectorised.colnames:
         assert _bits(table, name) == _bits(vectorised, name), name
     for i in (0, 5, 33):  # the member's own Scene run: its scalar properties and its end pole
@@ -108,17 +108,17 @@ def test_named_times_and_members_of_other_epochs():
 def test_bad_members_are_refused_with_the_reason():
     moments, quaternions, omegas = _members(2)
     with pytest.raises(EnsembleError, match="0 < A ≤ B ≤ C"):
-        free_members_table(moments[:, ::-1], quaternions, omegas, 1.0)
+        free_members_table(moments[:, ::-1], quaternions, omegas, 1.0 * u.day)
     with pytest.raises(EnsembleError, match="row 1 is zero"):
-        free_members_table(moments, quaternions, np.array([[1.0, 0, 0], [0, 0, 0]]), 1.0)
+        free_members_table(moments, quaternions, [[1.0, 0, 0], [0, 0, 0]] * u.rad / u.day, 1.0 * u.day)
     with pytest.raises(EnsembleError, match="unit rows"):
-        free_members_table(moments, 2 * quaternions, omegas, 1.0)
+        free_members_table(moments, 2 * quaternions, omegas, 1.0 * u.day)
     with pytest.raises(EnsembleError, match=r"shape \(2, 3\)"):
-        free_members_table(moments, quaternions, omegas[:1], 1.0)
+        free_members_table(moments, quaternions, omegas[:1], 1.0 * u.day)
     with pytest.raises(EnsembleError, match="finite"):
-        free_members_table(moments, quaternions, omegas, [1.0, np.nan])
+        free_members_table(moments, quaternions, omegas, [1.0, np.nan] * u.day)
     with pytest.raises(EnsembleError, match="beyond the free flow's domain"):
-        free_members_table(moments, quaternions, omegas, 1e16, attitudes=True)
+        free_members_table(moments, quaternions, omegas, 1e16 * u.day, attitudes=True)
 
 
 def _permuted_member(phase):

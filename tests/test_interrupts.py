@@ -82,6 +82,17 @@ def test_every_rebound_integrate_in_the_package_goes_through_the_door():
     assert direct == [], "REBOUND integrate calls outside integrate_interruptibly:\n" + "\n".join(direct)
 
 
+def test_sigterm_during_a_command_raises_terminated_and_only_then():
+    from spinorbit import cli
+
+    before = signal.getsignal(signal.SIGTERM)
+    with pytest.raises(cli.Terminated), cli._sigterm_raises():
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(1.0)
+    assert signal.getsignal(signal.SIGTERM) is before  # given back after the command
+    assert issubclass(cli.Terminated, KeyboardInterrupt) and cli.EXIT_TERMINATED == 143
+
+
 # --------------------------------------------------------------------------------------------------
 # A real ensemble command, stopped by a real signal.
 
@@ -117,7 +128,9 @@ def _wait_for_a_chunk(process, directory):
     (signal.SIGINT, True, 130),    # Ctrl-C at a terminal: the whole process group
     # kill -INT <pid>: the parent alone stops its workers, the path SIGTERM takes too (so slow: ~12 s each)
     pytest.param(signal.SIGINT, False, 130, marks=pytest.mark.slow),
-    (signal.SIGTERM, False, 143),  # kill <pid>
+    # kill <pid>: the same clean-up as Ctrl-C (Terminated is a KeyboardInterrupt), so slow too; the
+    # handler itself is checked in this process below
+    pytest.param(signal.SIGTERM, False, 143, marks=pytest.mark.slow),
 ], ids=["sigint-group", "sigint-process", "sigterm-process"])
 def test_an_ensemble_command_stops_within_a_second_and_keeps_its_finished_chunks(tmp_path, signum, to_group, status):
     psutil = pytest.importorskip("psutil")

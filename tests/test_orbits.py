@@ -18,6 +18,7 @@ from astropy import units as u
 from astropy.coordinates import BarycentricMeanEcliptic, CartesianRepresentation, ICRS, SkyCoord
 from astropy.time import Time
 
+from spinorbit.quantities import QuantityInputError
 from spinorbit.data.asteroids import (
     APOPHIS_2029,
     APOPHIS_HORIZONS,
@@ -124,11 +125,11 @@ GOOD = dict(a=2.5 * u.au, e=0.3, inc=5 * u.deg, raan=80 * u.deg, argp=30 * u.deg
     ({"e": float("nan")}, OrbitElementsError, "0 <= e < 1"),
     ({"a": -1 * u.au}, OrbitElementsError, "positive semi-major axis"),
     ({"a": 0 * u.au}, OrbitElementsError, "positive semi-major axis"),
-    ({"a": 2.5}, OrbitElementsError, "length Quantity"),
+    ({"a": 2.5}, QuantityInputError, "a expects a length Quantity .*bare float 2.5"),
     ({"inc": 190 * u.deg}, OrbitElementsError, "inclination"),
     ({"inc": -1 * u.deg}, OrbitElementsError, "inclination"),
     ({"raan": 400 * u.deg}, OrbitElementsError, "modulo 360"),
-    ({"mean_anomaly": 10.0}, OrbitElementsError, "angle Quantity"),
+    ({"mean_anomaly": 10.0}, QuantityInputError, "mean_anomaly expects an angle Quantity .*bare float 10.0"),
     ({"frame": "galactic"}, OrbitElementsError, "frame expects one of"),
     ({"epoch": Time("2250-01-01", scale="tdb")}, EphemerisRangeError, "DE421's span"),
     ({"epoch": "2010-01-01"}, SceneError, "scalar astropy Time"),
@@ -236,6 +237,25 @@ def test_toutatis_elements_orbit_passes_earth_at_each_published_approach(toutati
     assert ours["distance"].to_value(u.au) == pytest.approx(distance_au, rel=0.05)
     assert abs((ours["time"] - other["time"]).to_value(u.hour)) < 6.0
     assert ours["distance"].to_value(u.au) == pytest.approx(other["distance"].to_value(u.au), rel=0.03)
+
+
+def test_toutatis_close_approaches_are_the_published_four_and_every_minimum_on_request(toutatis_approaches):
+    """With the default cut-off (0.2 au, JPL's Close-Approach Data for one object) 1992–2013 holds the
+    encounters of Toutatis's 4-year near-resonance with Earth, the four published ones among them (1996 at
+    0.035 au and 2000 at 0.074 au as well; measured), and none of the minima on the far side of its orbit at
+    2.9 au, which max_distance=None adds. The 2008 approach (0.0503 au here, 0.0502 published) is why the
+    default is not the all-NEO 0.05 au."""
+    table = toutatis_approaches["2008"]
+    assert [t.iso[:10] for t in table["time"]] == ["1992-12-08", "1996-11-30", "2000-10-31", "2004-09-29",
+                                                   "2008-11-09", "2012-12-12"]
+    assert table["distance"].max() < 0.1 * u.au
+    au_km = de421_constants().au_km
+    assert np.all(table["distance_km"].to_value(u.km) == table["distance"].to_value(u.au) * au_km)
+    every = TOUTATIS_ELEMENT_SETS["2008"].orbit().approaches("earth", Time("2004-06-01", scale="tdb"),
+                                                             Time("2006-06-01", scale="tdb"), max_distance=None)
+    assert len(every) >= 2 and every["distance"].max() > 1 * u.au and every["distance"].min() < 0.02 * u.au
+    with pytest.raises(ApproachError, match="max_distance expects a positive length"):
+        TOUTATIS_ELEMENT_SETS["2008"].orbit().approaches("earth", EPOCH, EPOCH + 1 * u.day, max_distance=0 * u.au)
 
 
 def test_toutatis_elements_orbit_is_near_earth_in_december_1992(toutatis_approaches):

@@ -16,6 +16,7 @@ from astropy import constants as const
 from astropy import units as u
 from astropy.time import Time
 
+from spinorbit.quantities import QuantityInputError
 from spinorbit import RigidBody, RotationState
 from spinorbit.data.asteroids import (
     APOPHIS_2029,
@@ -394,7 +395,6 @@ def test_plan_reads_like_explain():
     ({"times": [1.0, 2.0]}, "astropy Time"),
     ({"times": EPOCH + [1.0, 1.0] * u.day}, "strictly increasing"),
     ({"times": EPOCH + [2.0, 1.0] * u.day}, "strictly increasing"),
-    ({"tolerance": 1e-6}, "angle Quantity"),
     ({"tolerance": 1 * u.m}, "angle Quantity"),
     ({"tolerance": 1 * u.rad}, "between 1e-12 rad and 0.1 rad"),
     ({"quantities": ("attitude", "spin")}, "quantities"),
@@ -412,6 +412,13 @@ def test_bad_inputs_raise_scene_error_in_words(change, message):
     kwargs.update(change)
     with pytest.raises(SceneError, match=message):
         Scene(**kwargs)
+
+
+def test_a_bare_tolerance_is_refused_by_the_units_rule():
+    """A bare number gets the units rule's refusal (QuantityInputError, worded the same everywhere)."""
+    with pytest.raises(QuantityInputError, match="tolerance expects an angle Quantity.*bare float 1e-06"):
+        Scene(sam_state(), EPOCH, EPOCH + 1 * u.day, perturbers=("sun",), orbit=Orbit.circular(2.5 * u.au),
+              tolerance=1e-6)
 
 
 def test_times_before_the_epoch_are_refused_only_where_a_leg_needs_them_after():
@@ -443,14 +450,14 @@ def test_bad_names_raise_the_ephemeris_and_rebound_errors():
         Scene(sam_state(), EPOCH, EPOCH + 1 * u.day, perturbers=("moon",), orbit=Orbit.de421("moon"))
 
 
-@pytest.mark.parametrize("gm, position, message", [
-    (1e-7, [1, 0, 0] * u.au, "gm expects"),
-    (1e-7 * u.au**3 / u.day**2, [1, 0, 0], "position expects"),
-    (1e-7 * u.au**3 / u.day**2, [0, 0, 0] * u.au, "non-zero"),
-    (1e-7 * u.au**3 / u.day**2, [1, 0] * u.au, "shape"),
+@pytest.mark.parametrize("gm, position, error, message", [
+    (1e-7, [1, 0, 0] * u.au, QuantityInputError, r"gm expects a length\^3 / time\^2 Quantity.*bare float"),
+    (1e-7 * u.au**3 / u.day**2, [1, 0, 0], QuantityInputError, "position expects a length Quantity.*bare list"),
+    (1e-7 * u.au**3 / u.day**2, [0, 0, 0] * u.au, SceneError, "non-zero"),
+    (1e-7 * u.au**3 / u.day**2, [1, 0] * u.au, SceneError, "shape"),
 ])
-def test_fixed_perturber_bad_input(gm, position, message):
-    with pytest.raises(SceneError, match=message):
+def test_fixed_perturber_bad_input(gm, position, error, message):
+    with pytest.raises(error, match=message):
         FixedPerturber("p", gm, position)
 
 
@@ -724,7 +731,7 @@ def test_moving_perturber_run_equals_a_direct_one_way_propagation_with_its_keple
 
 
 def test_moving_perturber_bad_input():
-    with pytest.raises(SceneError, match="gm expects"):
+    with pytest.raises(QuantityInputError, match="gm expects .* Quantity .*got the bare float 1e-07"):
         EphemerisPerturber("p", 1e-7, lambda d: d)
     with pytest.raises(SceneError, match="callable"):
         EphemerisPerturber("p", 1e-7 * u.au**3 / u.day**2, "not callable")

@@ -14,6 +14,7 @@ import pytest
 from astropy import units as u
 from astropy.time import Time
 
+from spinorbit.quantities import QuantityInputError
 from spinorbit import RigidBody, RotationState
 from spinorbit.core.averaging.thermal_mean import SeparatrixReachedError, propagate_mean_thermal
 from spinorbit.core.dynamics.equations import MODEL_PERTURBERS, make_model
@@ -209,13 +210,13 @@ def test_bad_thermal_input(small):
     times = EPOCH + [10, 20] * u.day
     with pytest.raises(ThermalInputError, match="Shape"):
         ThermalModel.from_shape("asteroid.obj", DENSITY)
-    with pytest.raises(ThermalInputError, match="density"):
+    with pytest.raises(QuantityInputError, match="density expects a mass density Quantity .*bare float 2000.0"):
         ThermalModel.from_shape(shape, 2000.0)
     with pytest.raises(ThermalInputError, match="positive"):
         ThermalModel.from_shape(shape, -2000 * u.kg / u.m**3)
     with pytest.raises(ThermalInputError, match="efficiency"):
         ThermalModel.from_shape(shape, DENSITY, efficiency=1.5)
-    with pytest.raises(ThermalInputError, match="mu_q"):
+    with pytest.raises(QuantityInputError, match="mu_q expects a stress Quantity .*bare float"):
         ThermalModel.from_shape(shape, DENSITY, mu_q=1e9)
     with pytest.raises(ThermalInputError, match="torque expects"):
         ThermalModel.from_shape(shape, DENSITY, torque="exact")

@@ -180,10 +180,11 @@ def test_andoyer_variables_round_trip_and_meaning():
     state = RotationState(body, q / np.linalg.norm(q), [0.3, 1.2, -0.4] * u.rad / u.day)
     big_l, big_g, big_h, l, g, h = state.andoyer_variables(reference="inertial")
     momentum = body.to_principal @ state.angular_momentum.value
-    assert big_g == pytest.approx(np.linalg.norm(momentum), rel=1e-15)
-    assert big_l == pytest.approx(momentum[2], rel=1e-14)  # L is the C-axis component
+    assert big_g.unit == u.rad / u.day and l.unit == u.rad  # moments as ratios: momenta in rad/day
+    assert big_g.value == pytest.approx(np.linalg.norm(momentum), rel=1e-15)
+    assert big_l.value == pytest.approx(momentum[2], rel=1e-14)  # L is the C-axis component
     back = RotationState.from_andoyer(body, big_l, big_g, big_h, l, g, h)
     assert np.abs(back.attitude_matrix - state.attitude_matrix).max() < 1e-14
     assert np.abs((back.angular_velocity - state.angular_velocity).value).max() < 1e-14
     with pytest.raises(InvalidStateError, match="G > 0"):
-        RotationState.from_andoyer(body, 2.0, 1.0, 0.0, 0.0, 0.0, 0.0)
+        RotationState.from_andoyer(body, *[2.0, 1.0, 0.0] * u.rad / u.day, *[0.0, 0.0, 0.0] * u.rad)

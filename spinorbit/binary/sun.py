@@ -39,11 +39,13 @@ class HeliocentricOrbit:
     argument_of_pericentre: u.Quantity = 0 * u.deg
     mean_anomaly: u.Quantity = 0 * u.deg
 
-    def source(self, binary_mass_kg, g_si):
-        """The core's Kepler source of the Sun relative to the barycentre (SI; ``sign=-1``)."""
+    def __post_init__(self):
+        self._elements()  # a bare number or a wrong unit refused where it was given
+
+    def _elements(self):
+        """(a in m, e, inclination, node, argument of pericentre, mean anomaly in rad), checked."""
         a = value_in("semi_major_axis", self.semi_major_axis, u.m, "1.6444 * u.au", shape=())
-        e = value_in("eccentricity", self.eccentricity, u.dimensionless_unscaled, "0.384",
-                     plain_unit=u.dimensionless_unscaled, shape=())
+        e = value_in("eccentricity", self.eccentricity, u.dimensionless_unscaled, "0.384", shape=())
         if not (a > 0 and 0 <= e < 1):
             raise ValueError(f"heliocentric orbit: expected a > 0 and 0 ≤ e < 1 (a bound orbit about the Sun), got "
                              f"a = {a} m, e = {e}.")
@@ -51,5 +53,10 @@ class HeliocentricOrbit:
                   for name, value in (("inclination", self.inclination), ("node", self.node),
                                       ("argument_of_pericentre", self.argument_of_pericentre),
                                       ("mean_anomaly", self.mean_anomaly))]
+        return (a, e, *angles)
+
+    def source(self, binary_mass_kg, g_si):
+        """The core's Kepler source of the Sun relative to the barycentre (SI; ``sign=-1``)."""
+        a, e, *angles = self._elements()
         return kepler_source(GM_SUN_SI, a, e, *angles, epoch=0.0, mu_orbit=GM_SUN_SI + g_si * binary_mass_kg,
                              sign=-1.0)

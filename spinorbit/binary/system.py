@@ -25,7 +25,7 @@ from spinorbit.core.binary.inertia_integrals import (
 from spinorbit.core.binary.monomials import DEGREE_START, EXPONENTS, MAX_ORDER
 from spinorbit.core.binary.propagate import check_order, check_separation
 from spinorbit.core.math.rotations import quat_to_matrix
-from spinorbit.quantities import value_in
+from spinorbit.quantities import finite_result, value_in
 
 #: Newton's constant in SI (astropy, CODATA 2018).
 G_SI = constants.G.si.value
@@ -50,6 +50,7 @@ class Figure:
     to_principal: np.ndarray | None = None
 
     @classmethod
+    @finite_result("Figure.ellipsoid", "its mass or inertia integrals (up to ρ a⁷) overflow double precision")
     def ellipsoid(cls, name, semi_axes, density):
         """A homogeneous ellipsoid with semi-axes (a, b, c) along its x, y, z axes.
 
@@ -73,12 +74,14 @@ class Figure:
         return cls(name, ellipsoid_integrals(mass, axes), float(axes.max()), tuple(float(a) for a in axes))
 
     @classmethod
+    @finite_result("Figure.sphere", "its mass or inertia integrals (up to ρ r⁷) overflow double precision")
     def sphere(cls, name, radius, density):
         """A homogeneous sphere (its field is a point mass's, at every order)."""
         r = value_in("radius", radius, u.m, "390 * u.m", shape=())
         return cls.ellipsoid(name, [r, r, r] * u.m, density)
 
     @classmethod
+    @finite_result("Figure.from_shape")
     def from_shape(cls, name, shape, density=None, mass=None):
         """A constant-density polyhedron (a :class:`spinorbit.shape.Shape`) on its principal axes.
 
@@ -109,6 +112,7 @@ class Figure:
         return cls(name, rho * unit_integrals, radius, None, MAX_ORDER, rotation)
 
     @classmethod
+    @finite_result("Figure.from_inertia")
     def from_inertia(cls, name, mass, inertia, circumscribing_radius):
         """A body known by its mass and inertia tensor only: its figure supports expansion order 2.
 
@@ -183,6 +187,7 @@ class BinarySystem:
         return core.make_binary_model(G_SI, self.primary.integrals, self.secondary.integrals, self.order,
                                       self.contact_distance.to_value(u.m))
 
+    @finite_result("BinarySystem.circular_speed")
     def circular_speed(self, separation):
         """Relative speed of the circular orbit at ``separation`` with B's long axis towards A (Quantity m/s).
 
@@ -190,6 +195,7 @@ class BinarySystem:
         circular for the model that is integrated (not only for point masses).
         """
         r = value_in("separation", separation, u.m, "1200 * u.m", shape=())
+        check_separation(r, self.contact_distance.to_value(u.m), "the separation asked for")
         y = np.zeros(core.BINARY_STATE_SIZE)
         y[core.POSITION] = r
         y[core.QUAT_A] = y[core.QUAT_B] = 1.0
@@ -221,6 +227,15 @@ class BinaryState:
     primary_spin: u.Quantity
     secondary_quaternion: tuple
     secondary_spin: u.Quantity
+
+    def __post_init__(self):
+        # the units now, not at the first propagation: a bare number is refused where it was given
+        for name, value, unit, example in (("separation", self.separation, u.m, "[1200, 0, 0] * u.m"),
+                                           ("velocity", self.velocity, u.m / u.s, "[0, 0.1757, 0] * u.m / u.s"),
+                                           ("primary_spin", self.primary_spin, u.rad / u.s, "[0, 0, 7.7e-4] * u.rad / u.s"),
+                                           ("secondary_spin", self.secondary_spin, u.rad / u.s,
+                                            "[0, 0, 1.46e-4] * u.rad / u.s")):
+            value_in(name, value, unit, example, shape=(3,), finite=False)
 
     @classmethod
     def synchronous(cls, system, separation, primary_spin, speed=None, libration=0 * u.rad):
@@ -282,6 +297,7 @@ class BinaryState:
         return quat_to_matrix(np.asarray(self.secondary_quaternion, dtype=float))[:, 0]
 
 
+@finite_result("momentum_impulse", "β m v / M overflows double precision")
 def momentum_impulse(impactor_mass, impactor_velocity, beta, target_mass):
     """Δv of a target hit by an impactor, with momentum enhancement β: Δv = β m v / M.
 
@@ -298,7 +314,7 @@ def momentum_impulse(impactor_mass, impactor_velocity, beta, target_mass):
     m = value_in("impactor_mass", impactor_mass, u.kg, "579.4 * u.kg", shape=())
     v = value_in("impactor_velocity", impactor_velocity, u.m / u.s, "[0, -6144.9, 0] * u.m / u.s", shape=(3,))
     big_m = value_in("target_mass", target_mass, u.kg, "4.3e9 * u.kg", shape=())
-    b = value_in("beta", beta, u.dimensionless_unscaled, "3.61", plain_unit=u.dimensionless_unscaled, shape=())
+    b = value_in("beta", beta, u.dimensionless_unscaled, "3.61", shape=())
     if not m > 0 or not big_m > 0:
         raise ValueError(f"impactor_mass, target_mass: expected positive masses, got {m} kg and {big_m} kg.")
     return b * m * v / big_m * u.m / u.s

@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
-from spinorbit.cli import CommandError
+import contextlib
+import logging
+import sys
+
+from spinorbit.cli import EXIT_INCOMPLETE, CommandError
 from spinorbit.commands import _inputs as check
 from spinorbit.commands._common import Progress, plot_format, write_plot_output, write_table_output
 
@@ -62,7 +66,7 @@ def _executor(args):
 def run_apophis_ensemble(args, span_days) -> int:
     """Run the ensemble, print the summary, write --output (one row per member) and --plot (histograms)."""
 
-    from spinorbit.ensemble import Ensemble
+    from spinorbit.ensemble import Ensemble, EnsembleInterrupted
     from spinorbit.ensemble.apophis import apophis_member, apophis_parameters
 
     check_ensemble_arguments(args)
@@ -73,15 +77,22 @@ def run_apophis_ensemble(args, span_days) -> int:
     ensemble = Ensemble(apophis_member, parameters)
     executor = _executor(args)
     progress = Progress(args.members, "members", counted=True)
-    try:
-        table = ensemble.run(executor=executor, checkpoint=args.checkpoint_dir,
-                             progress=lambda done, total: progress.advance(done - progress.done))
-    except KeyboardInterrupt as interrupt:  # Ctrl-C or SIGTERM: say what is kept (the CLI prints it)
-        raise type(interrupt)(_kept(ensemble, args)) from None
-    finally:
-        progress.close()
-        if hasattr(executor, "close"):
-            executor.close()
+    with _quiet_dask_client():  # also while the client closes: its reconnection attempts log tracebacks
+        try:
+            table = ensemble.run(executor=executor, checkpoint=args.checkpoint_dir,
+                                 progress=lambda done, total: progress.advance(done - progress.done))
+        except KeyboardInterrupt as interrupt:  # Ctrl-C or SIGTERM: say what is kept (the CLI prints it)
+            raise type(interrupt)(_kept(ensemble, args)) from None
+        except EnsembleInterrupted as lost:  # the scheduler or the workers went away: not bad input
+            progress.close()
+            cause = " ".join(f"{type(lost.cause).__name__}: {lost.cause}".split())
+            print(f"{args._prog}: stopped: {lost.members_lost} of {ensemble.n_members} members did not come back "
+                  f"from {lost.executor} ({cause}). {_kept(ensemble, args)}", file=sys.stderr)
+            return EXIT_INCOMPLETE
+        finally:
+            progress.close()
+            if hasattr(executor, "close"):
+                executor.close()
     for line in summary(table, ensemble):
         print(line)
     if args.output is not None:
@@ -89,6 +100,23 @@ def run_apophis_ensemble(args, span_days) -> int:
     if args.plot is not None:
         write_plot_output(args.plot, lambda temporary: histograms(table, temporary, plot_format(args.plot)))
     return 0 if not ensemble.failures else 1
+
+
+@contextlib.contextmanager
+def _quiet_dask_client():
+    """Dask's client logs a lost scheduler as a traceback of its own reconnection (36 lines) before the
+    run's one-line error says the same; its logger is kept to critical messages while the run lasts."""
+    # dask's logging config gives its modules' loggers levels of their own, so each is set, not the parent
+    loggers = [logging.getLogger(name) for name in ("distributed", "distributed.client", "distributed.core",
+                                                      "distributed.comm", "distributed.utils")]
+    levels = [logger.level for logger in loggers]
+    for logger in loggers:
+        logger.setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        for logger, level in zip(loggers, levels):
+            logger.setLevel(level)
 
 
 def _seed(args) -> int:
@@ -114,7 +142,7 @@ def _seed(args) -> int:
 
 def _kept(ensemble, args) -> str:
     """What an interrupted run leaves: the members of its finished chunks, and where."""
-    done = ensemble.last_run.get("members_complete", 0)
+    done = ensemble.members_complete
     if args.checkpoint_dir is None:
         return (f"{done} of {ensemble.n_members} members had finished; without --checkpoint-dir they are not "
                 "kept (add it to keep finished chunks on disk).")

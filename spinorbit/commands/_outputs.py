@@ -41,8 +41,8 @@ def plot_rotation(table, path, title, file_format="png", encounters=None):
     A principal-axis rotator (``rotation_class`` "PA" in every row) gets :func:`_principal_axis_panels`; any
     other table the periods (h; P_ψ, P_φ where not masked or infinite, and the sidereal period), the pole
     (λ, β in deg), the obliquity (deg, when the table has it) and a strip coloured by rotation class (or
-    mode). Each closest approach in ``encounters`` ({name: {"time": ISO TDB, "distance_au": d}}) is a
-    dashed line.
+    mode). Each approach in ``encounters`` ({name: {"time": ISO TDB, "distance_au": d}} or {name: [such
+    approaches]}) is a dashed line labelled with the body and the distance.
     """
     import matplotlib.dates as mdates
     import numpy as np
@@ -67,7 +67,9 @@ def plot_rotation(table, path, title, file_format="png", encounters=None):
         _principal_axis_panels(table, dates, by_name)
     else:
         _tumbler_panels(table, dates, by_name)
-    for name, approach in (encounters or {}).items():
+    marks = [(name, approach) for name, found in (encounters or {}).items()
+             for approach in (found if isinstance(found, list) else [found])]
+    for name, approach in marks:
         when = _dates(Time(approach["time"], scale="tdb"))
         if dates[0] <= when <= dates[-1]:
             for ax in axes:

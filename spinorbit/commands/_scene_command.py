@@ -161,10 +161,43 @@ def run_and_report(args, state, start, times, orbit, name: str, title: str, peri
                   pa_threshold=pa_threshold(args))
     result = run_scene(scene, args)
     if result is not None:
+        mark_close_approaches(result, orbit, [p for p in args.perturbers if p != "sun"], start, times)
         for line in summary(result, period_unit, args.plan_seconds):
             print(line)
         write_outputs(args, result, name, title, period_unit)
     return 0
+
+
+def mark_close_approaches(result, orbit, bodies, epoch, times) -> None:
+    """Put the orbit's close approaches to ``bodies`` over the run (``epoch`` and the output ``times``) into
+    the result table's meta.
+
+    ``close_approaches``: {body: [{time (ISO TDB), distance_au, distance_km, speed_km_s}, ...]}, every
+    minimum within :data:`spinorbit.scene.orbit.APPROACH_MAX_DISTANCE` (:meth:`Orbit.approaches`, each to
+    1e-9 d); ``closest_approaches`` {body: the closest of them} replaces the route's estimate on its sample
+    grid. A body the orbit cannot be measured against (not in its simulation) is left out.
+    """
+    from spinorbit.coupling.rebound import MissingBodyError
+    from spinorbit.ephemeris import UnknownBodyError
+
+    every = times.reshape(-1)
+    start, end = min(epoch, every.min()), max(epoch, every.max())
+    if orbit is None or not end > start:
+        return
+    found = {}
+    for body in bodies:
+        try:
+            table = orbit.approaches(body, start, end)
+        except (MissingBodyError, UnknownBodyError):
+            continue
+        found[body] = [{"time": row["time"].tdb.isot, "distance_au": float(row["distance"].value),
+                        "distance_km": float(row["distance_km"].value), "speed_km_s": float(row["speed"].value)}
+                       for row in table]
+    meta = result.table.meta
+    meta["close_approaches"] = found
+    closest = dict(meta.get("closest_approaches") or {})
+    closest.update({body: min(rows, key=lambda r: r["distance_au"]) for body, rows in found.items() if rows})
+    meta["closest_approaches"] = closest
 
 
 def summary(result, period_unit: str, plan_seconds: float = 0.0) -> list[str]:
@@ -177,6 +210,16 @@ def summary(result, period_unit: str, plan_seconds: float = 0.0) -> list[str]:
     if "rotation_class" in table.colnames:
         for label, row in (("first", table[0]), ("last", table[-1])):
             lines.append(f"{label:5s} {row['time'].tdb.iso[:16]} TDB  {motion_line(row, period_unit)}")
+    from spinorbit.scene.orbit import APPROACH_MAX_DISTANCE
+
+    limit = APPROACH_MAX_DISTANCE.to_value(u.au)
+    for body, rows in (table.meta.get("close_approaches") or {}).items():
+        if rows:
+            best = min(rows, key=lambda r: r["distance_au"])
+            lines.append(f"closest approach   {body} {best['time'][:16].replace('T', ' ')} TDB, {best['distance_au']:.5f} au "
+                         f"({best['distance_km']:.4g} km), {len(rows)} within {limit:g} au in the span")
+        else:
+            lines.append(f"closest approach   {body}: none within {limit:g} au in the span")
     parts = ", ".join(f"{k} {v.to_value(u.arcsec):.2g}" for k, v in result.error_parts.items())
     lines.append(f"wall time          {plan_seconds + result.wall_seconds:.2f} s (plan {plan_seconds:.2f} s, "
                  f"run {result.wall_seconds:.2f} s)")
@@ -248,5 +291,6 @@ def plot(result, path: str, title: str, period_unit: str = "h", name: str | None
     """Periods, pole, obliquity and mode against the date, the run's closest approaches marked."""
     from spinorbit.commands._outputs import plot_rotation
 
+    meta = result.table.meta  # every close approach when the command measured them, else the route's closest
     plot_rotation(result.table, path, title, plot_format(name or path),
-                  encounters=result.table.meta.get("closest_approaches"))
+                  encounters=meta.get("close_approaches") or meta.get("closest_approaches"))

@@ -25,12 +25,14 @@ kept for comparison (it misses the 1992 approach).
 The run is a spinorbit Scene: a planner decides, within --tolerance, which perturbers can be
 dropped (with the bound that justifies it), whether the free motion alone would do, and which
 integrator; --plan prints those decisions and their reasons and stops. The span starts at the
-1992 epoch; the whole 1992-2012 run is --span 20 yr (a minute or so)."""
+1992 epoch, 1992-11-09; the whole 1992-2012 run through the 2012-12-12 approach is --span 20.1 yr
+(a minute or so; 20 yr = 7305 d ends on 2012-11-09). The summary, the ECSV metadata and the plot
+give the close approaches to Earth (within 0.2 au) in the span."""
 EXAMPLES = """\
 examples:
   spinorbit toutatis                                 # 100 d from 1992-11-09
   spinorbit toutatis --plan --span 1 d --tolerance 100 arcsec
-  spinorbit toutatis --span 20 yr --n-times 2000 --output toutatis.ecsv --plot toutatis.png
+  spinorbit toutatis --span 20.1 yr --n-times 2000 --output toutatis.ecsv --plot toutatis.png
 
 exit status: 0 on success; 2 with a one-line message if the input is wrong or an output file
 cannot be written (nothing is left half-written)."""

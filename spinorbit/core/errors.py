@@ -65,3 +65,42 @@ def require_finite(name, values, expected="finite numbers"):
         shown = flat if len(items) <= 8 else f"{len(items)} values including {bad[0]!r}"
         raise NonFiniteError(f"{name}: expected {expected}, got {shown!r}; NaN and inf are refused, check how "
                              "the value was computed.")
+
+
+def all_finite(values):
+    """True when ``values`` (a number, a sequence or an array) holds no NaN or inf; None if not numbers."""
+    if getattr(getattr(values, "dtype", None), "kind", "") in "fc" and hasattr(values, "sum"):
+        with _quiet():
+            total = values.sum()
+        if math.isfinite(abs(total)):
+            return True  # a finite sum has no NaN or inf in it: the common case at array speed
+    flat = values.ravel().tolist() if hasattr(values, "ravel") else values
+    items = flat if isinstance(flat, (list, tuple)) else [flat]
+    try:
+        return all(math.isfinite(abs(v)) for v in items)
+    except TypeError:
+        return None
+
+
+def _quiet():
+    import numpy as np  # the core's own dependency; imported here so that this module stays importable alone
+
+    return np.errstate(over="ignore", invalid="ignore")
+
+
+def require_finite_result(name, values, advice=""):
+    """Raise :class:`NonFiniteError` if a result computed from finite inputs holds NaN or inf.
+
+    The one check on the way out (``docs/stability.md``, "What bad input gets"): inputs are checked
+    finite on the way in, so a non-finite result means they were finite but beyond what double
+    precision carries through the computation (an overflow, an underflow divided by). ``advice`` says
+    what to change; without it the message asks for values in the physical range.
+    """
+    if all_finite(values) is not False:
+        return
+    flat = values.ravel().tolist() if hasattr(values, "ravel") else values
+    items = flat if isinstance(flat, (list, tuple)) else [flat]
+    shown = items if len(items) <= 6 else f"{len(items)} values including {next(v for v in items if not math.isfinite(abs(v)))!r}"
+    raise NonFiniteError(f"{name}: the result is not finite ({shown}) although every input was: "
+                         f"{advice or 'the inputs lie beyond what double precision carries through this computation'}. "
+                         "Give values in the physical range (check their units and magnitudes).")

@@ -30,7 +30,8 @@ has the measured period; Dimorphos's mass is its ellipsoid's volume times its de
 density then comes out near 2.9 g/cm³: Naidu et al.'s spheroid is the figure that fits the
 dynamics and the images, smaller than Didymos's shape-model volume, so this density is not its bulk
 density. Didymos's spin does not act on the orbit (a spheroid spinning about its axis has the same field at
-every instant).
+every instant). :func:`reshaped` turns Dimorphos at the impact into Naidu et al.'s post-impact a/b ≈ 1.3,
+a/c ≈ 1.6 (docs/binary.md, "The post-impact state against the papers").
 """
 
 from __future__ import annotations
@@ -51,7 +52,8 @@ __all__ = [
     "PERIOD_BEFORE_SIGMA", "PERIOD_CHANGE_INITIAL_NAIDU", "PERIOD_CHANGE_INITIAL_NAIDU_SIGMA", "PERIOD_CHANGE_THOMAS",
     "PERIOD_CHANGE_THOMAS_3SIGMA", "PERIOD_CHANGE_TOTAL_NAIDU", "PERIOD_CHANGE_TOTAL_NAIDU_SIGMA",
     "ECCENTRICITY_AFTER_SCHEIRICH", "ECCENTRICITY_AFTER_SCHEIRICH_3SIGMA", "APSIDAL_RATE_AFTER_NAIDU",
-    "APSIDAL_RATE_AFTER_NAIDU_SIGMA", "SEPARATION", "SEPARATION_SIGMA", "along_track", "dart_state", "dart_system",
+    "APSIDAL_RATE_AFTER_NAIDU_SIGMA", "DIMORPHOS_AXIS_RATIOS_AFTER", "SEPARATION", "SEPARATION_SIGMA", "along_track",
+    "dart_state", "dart_system", "reshaped",
 ]
 
 #: Pre-impact mutual orbit period and its 1σ (Naidu et al. 2024; ``pre_impact.mutual_orbit_period_h``).
@@ -98,6 +100,9 @@ APSIDAL_RATE_AFTER_NAIDU_SIGMA = 0.2 * u.deg / u.day
 #: Post-impact eccentricity, 3σ (Scheirich et al. 2024).
 ECCENTRICITY_AFTER_SCHEIRICH = 0.028
 ECCENTRICITY_AFTER_SCHEIRICH_3SIGMA = 0.016
+#: Dimorphos's axis ratios a/b and a/c after the impact, from the fitted C20 and C22 of a uniform
+#: triaxial ellipsoid (Naidu et al. 2024, ``measured_outcome.post_impact_dimorphos_shape``).
+DIMORPHOS_AXIS_RATIOS_AFTER = (1.3, 1.6)
 #: Mutual-potential order: 4 carries Didymos's J4 and the two figures' coupling (order 2 changes the
 #: period change by 0.08 min, docs/binary.md).
 ORDER = 4
@@ -190,3 +195,25 @@ def along_track(state, delta_v):
     dv = value_in("delta_v", delta_v, u.m / u.s, "-2.63 * u.mm / u.s", shape=())
     velocity = state.velocity.to_value(u.m / u.s)
     return dv * velocity / np.linalg.norm(velocity) * u.m / u.s
+
+
+def reshaped(state, axis_ratios=DIMORPHOS_AXIS_RATIOS_AFTER):
+    """``state`` with Dimorphos reshaped at that instant to the axis ratios (a/b, a/c), mass and volume kept.
+
+    The default ratios are Naidu et al. 2024's post-impact ones (1.3, 1.6). The reshaping is internal, so
+    Dimorphos keeps its attitude and its rotational angular momentum: its spin becomes I'⁻¹ I ω (the
+    moments change by a few percent). Didymos and the orbit are unchanged.
+    """
+    a_b, a_c = (float(r) for r in axis_ratios)
+    if not (a_c >= a_b >= 1.0):
+        raise ValueError(f"axis_ratios: expected a/b ≥ 1 and a/c ≥ a/b (semi-axes a ≥ b ≥ c), got {axis_ratios!r}.")
+    system = state.system
+    volume = float(np.prod(system.secondary.semi_axes_m))
+    a = (volume * a_b * a_c) ** (1.0 / 3.0)
+    axes = [a, a / a_b, a / a_c]
+    mass = system.secondary.mass.to_value(u.kg)
+    density = mass / (4.0 / 3.0 * math.pi * float(np.prod(axes)))
+    figure = Figure.ellipsoid("Dimorphos, reshaped", axes * u.m, density * u.kg / u.m ** 3)
+    spin = system.secondary.moments.value * state.secondary_spin.to_value(u.rad / u.s) / figure.moments.value
+    return BinaryState(BinarySystem(system.primary, figure, system.order), state.separation, state.velocity,
+                       state.primary_quaternion, state.primary_spin, state.secondary_quaternion, spin * u.rad / u.s)

@@ -48,7 +48,8 @@ ORDER = 4
 #: ``primary.equal_volume_radius_m``: inconsistent with the orbit (module docstring), not used.
 FILE_PRIMARY_RADIUS = 576.7195 * u.m
 
-#: DART's impact (defaults of ``spinorbit didymos --impact``; recalled, not from the shared data):
+#: DART's impact for the GUBAS case's examples (the published system and ``spinorbit didymos`` take theirs
+#: from :mod:`spinorbit.data.dart`); recalled, not from the shared data:
 #: impactor mass 579.4 kg and speed 6.1449 km/s (Daly et al. 2023, Nature 616, 443), momentum
 #: enhancement β = 3.61 (Cheng et al. 2023, Nature 616, 457, for a Dimorphos density of 2.4 g/cm³).
 DART_MASS = 579.4 * u.kg

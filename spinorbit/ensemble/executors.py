@@ -23,11 +23,14 @@ from __future__ import annotations
 import concurrent.futures
 import contextlib
 import os
+import threading
+import time
 
 from spinorbit.core.errors import SpinorbitError
 from spinorbit.ensemble.workers import process_pool, stop_pool
 
-__all__ = ["DaskExecutor", "ExecutorError", "available_cores", "dask_client", "open_executor", "owns_workers"]
+__all__ = ["NO_WORKERS_SECONDS", "DaskExecutor", "ExecutorError", "NoWorkersError", "available_cores", "dask_client",
+           "open_executor", "owns_workers"]
 
 
 class ExecutorError(SpinorbitError, ValueError):
@@ -50,17 +53,32 @@ def _is_dask_client(executor):
     return isinstance(executor, Client)
 
 
+#: How long a Dask run waits with no worker connected to its scheduler before its chunks fail (seconds).
+NO_WORKERS_SECONDS = 60.0
+
+
+class NoWorkersError(SpinorbitError, RuntimeError):
+    """The Dask scheduler had no worker for longer than the executor waits: the chunks cannot run."""
+
+
 class DaskExecutor(concurrent.futures.Executor):
     """A ``dask.distributed.Client`` as a concurrent.futures.Executor that forgets each result once read.
 
     Unlike ``client.get_executor()``: every submission is a new task (``pure=False``: a chunk sent
     again after its worker died is not the erred task the scheduler remembers), and the remote result
     is released as soon as it has arrived, so a worker that dies later does not make the scheduler
-    compute it again behind the ensemble's back.
+    compute it again behind the ensemble's back. A chunk cancelled here is cancelled on the cluster.
+
+    A scheduler whose workers are all gone keeps its tasks waiting for ever. While chunks are out, a
+    watching thread asks the scheduler for its worker count once a second; when it has been zero for
+    ``no_workers_seconds``, every chunk still out fails with :class:`NoWorkersError` saying so (the
+    ensemble then stops with the finished chunks kept). ``no_workers_seconds=None`` waits for ever,
+    e.g. for an adaptive cluster whose workers come from a batch queue.
     """
 
-    def __init__(self, client):
-        self.client = client
+    def __init__(self, client, no_workers_seconds=NO_WORKERS_SECONDS):
+        self.client, self.no_workers_seconds = client, no_workers_seconds
+        self._out, self._lock, self._watch = {}, threading.Lock(), None
 
     def submit(self, fn, /, *args, **kwargs):
         """Run ``fn`` with the arguments on the cluster; a concurrent.futures.Future of its result."""
@@ -69,14 +87,67 @@ class DaskExecutor(concurrent.futures.Executor):
 
         def arrived(remote):
             try:
-                local.set_result(remote.result())
+                result = remote.result()
             except BaseException as error:  # noqa: BLE001 — handed to the caller through the future
-                local.set_exception(error)
+                _settle(local, error=error)
+            else:
+                _settle(local, result=result)
             finally:
                 remote.release()
 
+        def settled(local):
+            with self._lock:
+                self._out.pop(id(local), None)
+            if local.cancelled():
+                remote.cancel()
+
+        with self._lock:
+            self._out[id(local)] = (local, remote)
+        local.add_done_callback(settled)
         remote.add_done_callback(arrived)
+        self._start_watch()
         return local
+
+    def _start_watch(self):
+        if self.no_workers_seconds is None or (self._watch is not None and self._watch.is_alive()):
+            return
+        self._watch = threading.Thread(target=self._watch_workers, name="spinorbit-dask-workers", daemon=True)
+        self._watch.start()
+
+    def _worker_count(self):
+        try:
+            return self.client.scheduler_info(n_workers=0)["n_workers"]
+        except Exception:  # noqa: BLE001 — scheduler unreachable: the lost connection fails the chunks itself
+            return None
+
+    def _watch_workers(self):
+        since = None
+        while True:
+            with self._lock:
+                out = list(self._out.values())
+            if not out:
+                return
+            count = self._worker_count()
+            now = time.monotonic()
+            since = (since or now) if count == 0 else None
+            if since is not None and now - since >= self.no_workers_seconds:
+                error = NoWorkersError(
+                    f"the Dask scheduler {self.client.scheduler.address} has had no worker for "
+                    f"{self.no_workers_seconds:g} s, so {len(out)} chunks cannot run; start workers for it "
+                    "(dask worker ADDRESS) and run again with the same checkpoint")
+                for local, remote in out:
+                    remote.cancel()
+                    _settle(local, error=error)
+                return
+            time.sleep(min(1.0, self.no_workers_seconds / 4))
+
+
+def _settle(future, result=None, error=None):
+    """Give ``future`` its result or error unless it has one already (the watch and Dask may race)."""
+    try:
+        future.set_exception(error) if error is not None else future.set_result(result)
+    except concurrent.futures.InvalidStateError:
+        pass
 
 
 def dask_client(address=None, workers=None):

@@ -31,6 +31,7 @@ from spinorbit.core.math.rotations import attitude_to_quat
 from spinorbit.ensemble.errors import EnsembleError
 from spinorbit.ensemble.outcomes import OUTCOME_UNITS, TIMED_COLUMNS, time_rows
 from spinorbit.pole import angle_between_deg, pole_angles_deg
+from spinorbit.quantities import value_in
 from spinorbit.state import MAX_FLOW_PHASE, MODE_NAMES
 from spinorbit.state_table import QUATERNION_COLUMNS
 
@@ -104,7 +105,7 @@ def free_outcome_columns(quaternions, momenta, moments, elapsed_days, attitudes=
     return columns
 
 
-def principal_members(moments, quaternions, angular_velocities):
+def principal_members(moments, quaternions, omegas_rad_day):
     """Checked (quaternions, momenta, moments) of members given along principal axes A ≤ B ≤ C.
 
     Parameters
@@ -113,16 +114,14 @@ def principal_members(moments, quaternions, angular_velocities):
         Principal moments along the body axes, in increasing order in every row (A ≤ B ≤ C).
     quaternions : (N, 4) array_like
         Attitudes, scalar first, body → inertial, unit to 1e-6 (each row is divided by its norm).
-    angular_velocities : (N, 3) Quantity or array_like
-        Body angular velocities (rad/day when plain numbers).
+    omegas_rad_day : (N, 3) array_like
+        Body angular velocities in rad/day, plain floats (:func:`free_members_table` takes the Quantity).
     """
     q = np.atleast_2d(np.asarray(quaternions, dtype=float))
     n = q.shape[0]
     if q.shape != (n, 4):
         raise EnsembleError(f"quaternions expects shape (N, 4), scalar first; got {q.shape}.")
-    omega = (angular_velocities.to_value(u.rad / u.day) if isinstance(angular_velocities, u.Quantity)
-             else np.asarray(angular_velocities, dtype=float))
-    omega = np.atleast_2d(omega)
+    omega = np.atleast_2d(np.asarray(omegas_rad_day, dtype=float))
     inertia = np.asarray(moments, dtype=float)
     inertia = np.broadcast_to(inertia, (n, 3)) if inertia.shape == (3,) else inertia
     for name, array in (("angular_velocities", omega), ("moments", inertia)):
@@ -160,10 +159,10 @@ def free_members_table(moments, quaternions, angular_velocities, elapsed, parame
         Principal moments along the body axes, A ≤ B ≤ C in each row.
     quaternions : (N, 4) array_like
         Attitudes at each member's epoch (scalar first, body → inertial).
-    angular_velocities : (N, 3) Quantity or array_like
-        Body angular velocities (rad/day when plain numbers).
-    elapsed : Quantity or array_like, shape (), (K,) or (N, K)
-        Outcome times since each member's epoch (days when plain numbers); several times suffix the
+    angular_velocities : (N, 3) Quantity
+        Body angular velocities, an angle per time (``omegas * u.rad / u.day``; bare numbers are refused).
+    elapsed : Quantity, shape (), (K,) or (N, K)
+        Outcome times since each member's epoch (a time, ``30 * u.day``); several times suffix the
         time-dependent columns ``_t0``, ``_t1``, … as ``Ensemble(at=...)`` does.
     parameters : QTable, optional
         Columns to put first (one row per member), as an Ensemble's parameter table.
@@ -177,9 +176,10 @@ def free_members_table(moments, quaternions, angular_velocities, elapsed, parame
     QTable
         One row per member.
     """
-    q, momenta, inertia = principal_members(moments, quaternions, angular_velocities)
+    omegas = value_in("angular_velocities", angular_velocities, u.rad / u.day, "omegas * u.rad / u.day", finite=False)
+    q, momenta, inertia = principal_members(moments, quaternions, omegas)
     n = q.shape[0]
-    days = elapsed.to_value(u.day) if isinstance(elapsed, u.Quantity) else np.asarray(elapsed, dtype=float)
+    days = np.asarray(value_in("elapsed", elapsed, u.day, "30 * u.day", finite=False), dtype=float)
     timed = np.ndim(days) > 0
     days = np.broadcast_to(np.atleast_1d(days), (n, np.atleast_1d(days).shape[-1])) if np.ndim(days) < 2 else days
     if days.shape[0] != n or not np.all(np.isfinite(days)):

@@ -37,6 +37,7 @@ from spinorbit.core.elements.canonical import inertia_constants, motion_from_mom
 from spinorbit.core.free_motion.summary import periods
 from spinorbit.core.math.rotations import attitude_to_quat, quat_conjugate, quat_multiply, quat_to_attitude
 from spinorbit.fit.errors import InvalidObservationError
+from spinorbit.quantities import require_quantity
 
 PERIOD_KINDS = ("rotation", "precession")
 #: Relative step of the central difference of the closed-form periods.
@@ -51,6 +52,7 @@ def _epoch(epoch, name):
 
 
 def _positive(value, unit, name, example):
+    require_quantity(name, value, unit, example or f"1 * u.Unit('{u.Unit(unit).to_string()}')")
     try:
         number = u.Quantity(value).to_value(unit)
     except (u.UnitsError, TypeError) as error:

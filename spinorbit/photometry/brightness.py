@@ -54,7 +54,7 @@ class Ellipsoid:
     Parameters
     ----------
     semi_axes : Quantity, shape (3,)
-        a, b, c along the body axes x, y, z (length; plain numbers are read in km).
+        a, b, c along the body axes x, y, z (length; a bare number is refused).
     subdivisions : int
         Icosphere level of the facet model used for the laws without a closed form (Lambert,
         Kaasalainen): 20·4^k facets, the error falling as 4^−k (``docs/photometry.md``); 5 (20 480 facets,
@@ -65,7 +65,7 @@ class Ellipsoid:
     subdivisions: int = 5
 
     def __post_init__(self):
-        axes = value_in("semi_axes", self.semi_axes, u.km, "[1.0, 0.8, 0.6] * u.km", plain_unit=u.km, shape=(3,))
+        axes = value_in("semi_axes", self.semi_axes, u.km, "[1.0, 0.8, 0.6] * u.km", shape=(3,))
         if np.any(axes <= 0):
             raise PhotometryError(f"semi_axes: expected three positive lengths; got {axes.tolist()} km.")
         object.__setattr__(self, "semi_axes", np.array(axes) * u.km)

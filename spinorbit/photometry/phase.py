@@ -34,7 +34,7 @@ from spinorbit.core.photometry.phase_functions import hg1g2_phase, linear_expone
 from spinorbit.core.photometry.scattering import DEFAULT_LAMBERT_WEIGHT, law_weights
 from spinorbit.photometry.brightness import Ellipsoid
 from spinorbit.photometry.errors import PhotometryError
-from spinorbit.quantities import value_in
+from spinorbit.quantities import QuantityInputError, value_in
 
 __all__ = ["HG1G2", "LinearExponential", "NoLightError", "equal_volume_radius", "sphere_brightness",
            "reduced_magnitudes"]
@@ -45,7 +45,14 @@ class NoLightError(PhotometryError):
 
 
 def _magnitude(name, value):
-    return value_in(name, value, u.mag, "15.5 * u.mag", plain_unit=u.mag, shape=())
+    # A magnitude is dimensionless (-2.5 log10 of a flux ratio) and mag its one unit, so a bare number is
+    # no guess: it is read in mag, as photometry writes it (docs/conventions.md, "Units").
+    if not isinstance(value, u.Quantity):
+        try:
+            value = float(value) * u.mag
+        except (TypeError, ValueError):
+            raise QuantityInputError(f"{name} expects a magnitude such as 15.5 * u.mag or 15.5; got {value!r}.") from None
+    return value_in(name, value, u.mag, "15.5 * u.mag", shape=())
 
 
 @dataclass(frozen=True)

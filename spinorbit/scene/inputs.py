@@ -18,6 +18,7 @@ from astropy import units as u
 from astropy.time import Time
 
 from spinorbit.core.errors import require_finite
+from spinorbit.quantities import require_quantity
 from spinorbit.scene.errors import SceneError
 from spinorbit.scene.orbit import Orbit
 from spinorbit.state import RotationState
@@ -47,7 +48,8 @@ _ANGLE = u.get_physical_type("angle")
 
 
 def check_gm(kind, name, gm):
-    """G·M of a user perturber in au³/day², or SceneError naming it."""
+    """G·M of a user perturber in au³/day², or SceneError naming it (QuantityInputError for a bare number)."""
+    require_quantity("gm", gm, _AU3_PER_DAY2, "3.986e14 * u.m**3 / u.s**2")
     if not isinstance(gm, u.Quantity) or gm.unit.physical_type != _GM_TYPE:
         raise SceneError(f"{kind} {name!r}: gm expects a Quantity in length³/time² such as 3.986e14 m3/s2; "
                          f"got {gm!r}.")
@@ -78,6 +80,7 @@ class FixedPerturber:
     def __post_init__(self):
         check_gm("FixedPerturber", self.name, self.gm)
         position = self.position
+        require_quantity("position", position, u.au, "[1, 0, 0] * u.au")
         if isinstance(position, u.Quantity):
             require_finite(f"FixedPerturber {self.name!r}: position", position.value, "a finite 3-vector")
         if (not isinstance(position, u.Quantity) or position.unit.physical_type != "length"
@@ -148,7 +151,9 @@ class EphemerisPerturber:
 
 
 def as_angle(tolerance):
-    """An attitude tolerance (angle Quantity) in rad, between 1e-12 and 0.1 rad, or SceneError."""
+    """An attitude tolerance (angle Quantity) in rad, between 1e-12 and 0.1 rad, or SceneError (QuantityInputError
+    for a bare number)."""
+    require_quantity("tolerance", tolerance, u.rad, "1 * u.arcsec")
     if not isinstance(tolerance, u.Quantity) or tolerance.unit.physical_type != _ANGLE or not tolerance.isscalar:
         raise SceneError(f"tolerance expects an angle Quantity such as 1 * u.arcsec or 1e-6 * u.rad; got {tolerance!r}.")
     value = float(tolerance.to_value(u.rad))

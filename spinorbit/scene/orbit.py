@@ -12,6 +12,7 @@ another (:mod:`spinorbit.coupling.approaches`). Elements and frames: :mod:`spino
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -21,10 +22,11 @@ from astropy.table import QTable
 from astropy.time import Time
 
 from spinorbit.core.errors import SpinorbitError
+from spinorbit.quantities import require_quantity, value_in
 from spinorbit.scene.errors import SceneError
 from spinorbit.time import tdb_days, time_from_tdb_days
 
-__all__ = ["NON_GRAVITATIONAL_TERMS", "ApproachError", "Orbit"]
+__all__ = ["APPROACH_MAX_DISTANCE", "NON_GRAVITATIONAL_TERMS", "ApproachError", "Orbit"]
 
 #: The non-gravitational terms a built orbit takes (JPL's small-body model, g(r) = (1 au/r)²).
 NON_GRAVITATIONAL_TERMS = ("A1", "A2", "A3")
@@ -34,6 +36,13 @@ UNITS_G_TOLERANCE = 1e-6
 
 class ApproachError(SpinorbitError, ValueError):
     """No close approach inside the span asked for, or a span an orbit cannot be asked about."""
+
+
+#: The default cut-off of :meth:`Orbit.approaches`: JPL's Close-Approach Data lists one object's approaches
+#: to 0.2 au (its documented per-object query, https://ssd-api.jpl.nasa.gov/doc/cad.html; the 0.05 au default
+#: there is the all-NEO survey's, which would drop Toutatis's 2008 approach at 0.0502 au). A minimum farther
+#: out is the body passing on the far side of its orbit, not an encounter.
+APPROACH_MAX_DISTANCE = 0.2 * u.au
 
 
 def _scalar_time(name, value):
@@ -116,6 +125,7 @@ class Orbit:
         scenes whose geometry should be simple (tests, benchmarks, tutorials)."""
         from spinorbit.ephemeris import de421_constants
 
+        require_quantity("radius", radius, u.au, "2.5 * u.au")
         if not isinstance(radius, u.Quantity) or radius.unit.physical_type != "length" or not radius.value > 0:
             raise SceneError(f"Orbit.circular expects a positive length Quantity such as 2.5 * u.au; got {radius!r}.")
         r = float(radius.to_value(u.au))
@@ -276,6 +286,53 @@ class Orbit:
         return cls._built(name, epoch, position, velocity, "sun", non_gravitational, extra_forces, description)
 
     @classmethod
+    def from_sbpy(cls, orbit, row=0, frame="ecliptic", name=None, kepler=False, non_gravitational=None,
+                  extra_forces=True):
+        """The orbit of one row of an ``sbpy.data.Orbit`` (filled from JPL Horizons or the SBDB, or built with
+        ``sbpy.data.Orbit.from_dict``): :meth:`from_elements` of its elements, or with ``kepler=True``
+        :meth:`kepler` of them.
+
+        Parameters
+        ----------
+        orbit : sbpy.data.Orbit
+            Its ``a`` (or the perihelion distance ``q``), ``e``, ``i``, ``Omega``, ``w``, ``M`` (or the time of
+            perihelion ``Tp``) and ``epoch``, by any of sbpy's alternative names, with the units the table carries
+            (:func:`spinorbit.sbpy_tables.orbit_arguments`; a field without its unit is refused).
+        row : int
+            Which row of the table.
+        frame : {"ecliptic", "ecliptic-iau2006", "icrf"}
+            What the angles are referred to. The table does not say: sbpy's ``Orbit.from_horizons`` documents
+            heliocentric elements on the ecliptic and mean equinox of J2000 (JPL's, IAU 1976 obliquity: the
+            default "ecliptic"), as the SBDB gives them; "icrf" for a Horizons query made with ``refplane="earth"``.
+        name : str, optional
+            The orbit's name; by default the row's ``targetname``, else "body".
+        kepler : bool
+            False (default): integrated among DE421's planets (:meth:`from_elements`); True: the fixed Sun-alone
+            ellipse (:meth:`kepler`, which takes no non-gravitational terms).
+        non_gravitational, extra_forces
+            As in :meth:`from_elements`.
+
+        Raises
+        ------
+        spinorbit.sbpy_tables.SbpyInputError
+            Not an sbpy Orbit, no such row, or a missing field (named, with the fields the row has).
+        spinorbit.quantities.QuantityInputError
+            A field without a unit, or of the wrong kind.
+        """
+        from spinorbit.sbpy_tables import orbit_arguments
+
+        arguments = orbit_arguments(orbit, row)
+        name = name or arguments.pop("name") or "body"
+        arguments.pop("name", None)
+        if kepler:
+            if non_gravitational is not None:
+                raise SceneError("Orbit.from_sbpy(kepler=True) is the Sun-alone ellipse and takes no non_gravitational "
+                                 f"terms; got {non_gravitational!r}. Drop kepler=True to integrate them.")
+            return cls.kepler(**arguments, frame=frame, name=name)
+        return cls.from_elements(**arguments, frame=frame, name=name, non_gravitational=non_gravitational,
+                                 extra_forces=extra_forces)
+
+    @classmethod
     def from_state(cls, position, velocity, epoch, frame="icrf", centre="sun", name="body",
                    non_gravitational=None, extra_forces=True):
         """A state vector at ``epoch``, integrated among DE421's planets in REBOUND (any conic: open
@@ -303,6 +360,7 @@ class Orbit:
         vectors = []
         for label, value, kind, unit in (("position", position, "length", u.km),
                                          ("velocity", velocity, "speed", u.km / u.day)):
+            require_quantity(label, value, unit, "[1, 0, 0] * u.au" if kind == "length" else "[0, 30, 0] * u.km / u.s")
             if (not isinstance(value, u.Quantity) or value.unit.physical_type != kind or value.shape != (3,)
                     or not np.all(np.isfinite(value.value))):
                 raise SceneError(f"{label} expects a finite {kind} Quantity of shape (3,) such as "
@@ -332,6 +390,29 @@ class Orbit:
         if extra_forces:
             description += ", EIH 1PN + Earth J2"
         return cls("rebound", name, simulation=sim, description=description, de421_planets=True)
+
+    def __reduce__(self):
+        """Pickle to the orbit's description, never REBOUND's raw simulation (issue 36).
+
+        REBOUND pickles a simulation as its binary, which holds neither the compiled extra forces'
+        function pointer nor (rebound 5.2.2) names that outlive the simulation saved: a pickled
+        orbit would run without EIH and J2 and change the physics silently (REBOUND only warns).
+        A REBOUND orbit goes as a :class:`~spinorbit.coupling.rebound.snapshot.SimulationSnapshot`
+        (binary, names, the extra forces in effect) and is rebuilt with its forces reinstalled, so
+        the copy integrates bit for bit like the original (``tests/test_orbit_pickling.py``). A
+        simulation with forces spinorbit did not install cannot be carried: refused with SceneError.
+        """
+        fields = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        if self.simulation is not None:
+            from spinorbit.coupling.rebound import ForceInstallError, SimulationSnapshot
+
+            try:
+                snapshot = SimulationSnapshot.of(self.simulation)
+            except ForceInstallError as error:
+                raise SceneError(f"the orbit of {self.name!r} cannot be pickled (sent to another process): {error}") \
+                    from None
+            fields["simulation"] = (snapshot, int(self.simulation.exact_finish_time))
+        return (_orbit_from_description, (fields,))
 
     def check_span(self, *days):
         """EphemerisRangeError if an orbit built among DE421's planets is asked about times (TDB days
@@ -383,8 +464,9 @@ class Orbit:
         states = [separation(float(day)) for day in days]
         return (np.array([r for r, _ in states]) * u.au, np.array([v for _, v in states]) * u.au / u.day)
 
-    def approaches(self, body, start, end):
-        """Every local minimum of the distance to ``body`` between ``start`` and ``end``.
+    def approaches(self, body, start, end, max_distance=APPROACH_MAX_DISTANCE):
+        """The close approaches to ``body`` between ``start`` and ``end``: each local minimum of the distance
+        within ``max_distance``.
 
         Parameters
         ----------
@@ -392,33 +474,43 @@ class Orbit:
             A particle of the REBOUND simulation (for a REBOUND orbit) or a DE421 body.
         start, end : astropy.time.Time
             Scalar, start before end, inside DE421's span.
+        max_distance : Quantity (length) or None
+            The cut-off, :data:`APPROACH_MAX_DISTANCE` (0.2 au, JPL's Close-Approach Data for one object)
+            by default; None lists every local minimum, the far side of the orbit included.
 
         Returns
         -------
         astropy.table.QTable
-            ``time`` (Time, TDB), ``distance`` (km, centre to centre), ``speed`` (km/s, relative);
-            one row per approach, in time order (empty if the distance only falls or only rises).
+            ``time`` (Time, TDB), ``distance`` (au) and ``distance_km`` (km), centre to centre, ``speed``
+            (km/s, relative); one row per approach, in time order (empty if none is within the cut-off).
         """
         from spinorbit.coupling.approaches import approaches
         from spinorbit.ephemeris import de421_constants
 
+        limit_au = math.inf if max_distance is None else value_in("max_distance", max_distance, u.au, "0.05 * u.au",
+                                                                  shape=())
+        if not limit_au > 0:
+            raise ApproachError(f"max_distance expects a positive length such as 0.05 * u.au, or None for every "
+                                f"minimum; got {max_distance!s}.")
         start_day, end_day = _scalar_time("start", start), _scalar_time("end", end)
         if not end_day > start_day:
             raise ApproachError(f"end expects a time after start; got start {start.tdb.iso}, end {end.tdb.iso}.")
         _check_inside_de421("the span", start_day, end_day)
-        found = approaches(self._separation(body), start_day, end_day)
+        found = [m for m in approaches(self._separation(body), start_day, end_day) if m[1] <= limit_au]
         au_km = de421_constants().au_km
         table = QTable()
         table["time"] = time_from_tdb_days(np.array([m[0] for m in found]))
-        table["distance"] = np.array([m[1] for m in found]) * au_km * u.km
+        table["distance"] = np.array([m[1] for m in found]) * u.au
+        table["distance_km"] = np.array([m[1] for m in found]) * au_km * u.km  # DE421's au, as the orbit's states
         table["speed"] = (np.array([m[2] for m in found]) * au_km / 86400.0) * u.km / u.s
         return table
 
     def closest_approach(self, body, start, end):
         """The closest approach to ``body`` between ``start`` and ``end``: (Time, distance Quantity).
 
-        The smallest of :meth:`approaches`: a local minimum of the distance inside the span, found
-        to 1e-9 d (0.1 ms; :mod:`spinorbit.coupling.approaches`).
+        The smallest local minimum of the distance inside the span, however far (:meth:`approaches` with
+        ``max_distance=None``), found to 1e-9 d (0.1 ms; :mod:`spinorbit.coupling.approaches`); the
+        distance in au.
 
         Raises
         ------
@@ -427,9 +519,19 @@ class Orbit:
         spinorbit.ephemeris.EphemerisRangeError
             A span outside DE421.
         """
-        table = self.approaches(body, start, end)
+        table = self.approaches(body, start, end, max_distance=None)
         if len(table) == 0:
             raise ApproachError(f"no close approach of {self.name} to {body} between {start.tdb.iso} and "
                                 f"{end.tdb.iso} TDB: the distance only falls or only rises there. Widen the span.")
         best = int(np.argmin(table["distance"].value))
         return table["time"][best], table["distance"][best]
+
+
+def _orbit_from_description(fields):
+    """The :class:`Orbit` of :meth:`Orbit.__reduce__`'s fields, its REBOUND simulation rebuilt from its snapshot."""
+    if fields.get("simulation") is not None:
+        snapshot, exact_finish_time = fields["simulation"]
+        simulation = snapshot.build()  # the names set again, the extra forces reinstalled
+        simulation.exact_finish_time = exact_finish_time
+        fields = {**fields, "simulation": simulation}
+    return Orbit(**fields)

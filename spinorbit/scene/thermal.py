@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from astropy import units as u
 
+from spinorbit.quantities import finite_result, require_quantity, value_in
 from spinorbit.scene.errors import SceneError
 
 __all__ = ["ThermalModel", "ThermalInputError", "VanishingYorpWarning", "DEFAULT_K3_SQUARED", "MOMENT_RTOL",
@@ -36,6 +37,13 @@ class ThermalInputError(SceneError):
     """A thermal model or its use that cannot be run (message: what was expected, what arrived, what to do)."""
 
 
+def _real(name, value, example):
+    """A dimensionless real number (Python's, numpy's of any width, or a dimensionless Quantity), finite."""
+    if isinstance(value, (bool, np.bool_)):
+        raise ThermalInputError(f"{name} expects a number such as {example}; got {value!r}.")
+    return value_in(name, value, u.dimensionless_unscaled, example, shape=())
+
+
 class VanishingYorpWarning(UserWarning):
     """The shape is mirror-symmetric in its three principal planes, so its YORP is zero by symmetry.
 
@@ -45,6 +53,7 @@ class VanishingYorpWarning(UserWarning):
 
 
 def _positive(name, value, unit, example):
+    require_quantity(name, value, unit, example)
     if not isinstance(value, u.Quantity) or not value.isscalar or not value.unit.is_equivalent(unit):
         raise ThermalInputError(f"{name} expects a scalar Quantity in {unit} such as {example}; got {value!r}.")
     magnitude = float(value.to_value(unit))
@@ -123,12 +132,12 @@ class ThermalModel:
         _positive("density", density, u.kg / u.m**3, "2000 * u.kg / u.m**3")
         if mu_q is not None:
             _positive("mu_q", mu_q, u.Pa, "1e9 * u.Pa")
-        if isinstance(efficiency, u.Quantity):
-            efficiency = efficiency.to_value(u.dimensionless_unscaled)
-        if not (isinstance(efficiency, (int, float)) and 0.0 < efficiency <= 1.0):
+        efficiency = _real("efficiency", efficiency, "0.9")
+        if not 0.0 < efficiency <= 1.0:
             raise ThermalInputError(f"efficiency expects 0 < η ≤ 1 (the Lambertian share of the sunlight, 1 − A "
                                     f"for a non-Lambertian Bond albedo A); got {efficiency!r}.")
-        if not (isinstance(k3_squared, (int, float)) and math.isfinite(k3_squared) and k3_squared > 0.0):
+        k3_squared = _real("k3_squared", k3_squared, str(DEFAULT_K3_SQUARED))
+        if not k3_squared > 0.0:
             raise ThermalInputError(f"k3_squared expects Burns & Safronov's positive shape factor K₃² (about "
                                     f"{DEFAULT_K3_SQUARED}); got {k3_squared!r}.")
         if torque not in TORQUES:
@@ -165,11 +174,24 @@ class ThermalModel:
         return damping_constant(float(self.mu_q.to_value(u.Pa)), float(self.density.to_value(u.kg / u.m**3)),
                                 float(self.mean_radius.to_value(u.m)), self.k3_squared)
 
+    @finite_result("ThermalModel.damping_time", "τ_D = k/ω³ overflows double precision at so slow a spin")
     def damping_time(self, spin_rate):
-        """Burns & Safronov's τ_D = μQ/(ρ K₃² R² ω³) at a spin rate (angle/time Quantity), in years."""
-        omega = float(u.Quantity(spin_rate).to_value(u.rad / u.day))
+        """Burns & Safronov's τ_D = μQ/(ρ K₃² R² ω³) at a spin rate (angle/time Quantity, > 0), in years.
+
+        Raises
+        ------
+        ThermalInputError
+            No damping (``mu_q`` None), or a spin rate that is not a positive angular velocity.
+        NonFiniteError
+            A NaN or infinite spin rate, or one so slow that τ_D overflows.
+        """
         if self.mu_q is None:
             raise ThermalInputError("damping_time needs the damping: give ThermalModel.from_shape(..., mu_q=1e9 * u.Pa).")
+        omega = value_in("spin_rate", spin_rate, u.rad / u.day, "2 * u.cycle / u.day", shape=())
+        if not omega > 0.0:
+            raise ThermalInputError(f"spin_rate expects a positive angular velocity such as 2 * u.cycle / u.day; got "
+                                    f"{spin_rate!r}. A body that does not spin has no nutation to damp (τ_D = k/ω³ "
+                                    "is infinite); its sign is the direction, give the rate |ω|.")
         return (self.damping_constant / omega**3 * u.day).to(u.yr)
 
     def check_body(self, body):
@@ -196,6 +218,7 @@ class ThermalModel:
         block[TH_PRESSURE] *= float((1.0 * u.kg * u.m**2).to_value(body.moment_unit))
         return block
 
+    @finite_result("ThermalModel.torque_bound", "the pressure P/d² overflows double precision so close to the Sun")
     def torque_bound(self, distance):
         """A bound on |T| at heliocentric ``distance`` (length Quantity): P(d) Σ_k A_k |r_k × n_k| (N m)."""
         from spinorbit.core.model.thermal import recoil_pressure
@@ -206,6 +229,7 @@ class ThermalModel:
         lever = float(np.sum(areas * np.linalg.norm(np.cross(centroids, normals), axis=1)))
         return recoil_pressure(self.efficiency) / d_au**2 * lever * u.N * u.m
 
+    @finite_result("ThermalModel.force_and_torque", "the pressure P/d² overflows double precision so close to the Sun")
     def force_and_torque(self, sun_direction, distance):
         """Recoil force (N) and torque (N m) for the Sun along ``sun_direction`` (body principal axes) at ``distance``.
 

@@ -21,6 +21,7 @@ Every reading error names the file and line, says what was expected and what arr
 
 from __future__ import annotations
 
+import math
 import os
 
 import numpy as np
@@ -111,10 +112,14 @@ def _obj_vertex(path, number, words):
     try:
         if len(words) < 4:
             raise ValueError
-        return [float(w) for w in words[1:4]]
+        values = [float(w) for w in words[1:4]]
     except ValueError:
         raise ShapeFileError(f"{path}, line {number}: expected 'v x y z' with three numbers; got "
                              f"{' '.join(words)!r}.") from None
+    if not all(math.isfinite(v) for v in values):
+        raise ShapeFileError(f"{path}, line {number}: expected 'v x y z' with three finite numbers; got "
+                             f"{' '.join(words)!r} (NaN or inf is no position).")
+    return values
 
 
 def _obj_face(path, number, words, vertex_count):
@@ -199,6 +204,9 @@ def read_icq(path, unit=None, name=None) -> Shape:
             grid[k] = [float(w) for w in words]
         except ValueError:
             raise ShapeFileError(f"{path}, vertex line {k + 1}: expected three numbers 'x y z'; got {row!r}.") from None
+        if not np.all(np.isfinite(grid[k])):
+            raise ShapeFileError(f"{path}, vertex line {k + 1}: expected three finite numbers 'x y z'; got {row!r} "
+                                 "(NaN or inf is no position).")
     vertices, faces = icq_mesh(grid.reshape(ICQ_CUBE_FACES, q + 1, q + 1, 3) * unit, source=str(path))
     return _shape(path, vertices, faces, name)
 
@@ -216,7 +224,7 @@ def icq_mesh(grid, source="ICQ grid"):
     vertices : Quantity (6 q² + 2, 3), km
     faces : ndarray (12 q², 3) int
     """
-    grid = value_in("grid", grid, u.km, "icq_grid(radius_function, q)")
+    grid = value_in("grid", grid, u.km, "grid_km * u.km")
     q = grid.shape[1] - 1
     flat = grid.reshape(-1, 3)
     vertices, inverse = np.unique(flat, axis=0, return_inverse=True)
@@ -277,7 +285,7 @@ def write_icq(path, grid, unit=u.km) -> None:
     """Write an ICQ grid (a length Quantity of shape (6, q + 1, q + 1, 3)) as an ICQ file with coordinates in
     ``unit`` (km by default; atomically). Read it back with ``read_icq(path, unit)``."""
     unit = _file_unit("write_icq", unit)
-    grid = np.asarray(value_in("grid", grid, unit, "icq_grid(radius_function, q)"), dtype=float)
+    grid = np.asarray(value_in("grid", grid, unit, "grid_km * u.km"), dtype=float)
     if grid.ndim != 4 or grid.shape[0] != ICQ_CUBE_FACES or grid.shape[1] != grid.shape[2] or grid.shape[3] != 3:
         raise ValueError(f"grid: expected shape (6, q + 1, q + 1, 3) (cube face, j, i, xyz); got {grid.shape}.")
     lines = [f"{grid.shape[1] - 1:>8d}\n"] + [f"{x!r} {y!r} {z!r}\n" for x, y, z in grid.reshape(-1, 3).tolist()]

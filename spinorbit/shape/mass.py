@@ -15,9 +15,9 @@ import numpy as np
 from astropy import units as u
 
 from spinorbit.body import RigidBody
-from spinorbit.core.errors import SpinorbitError
+from spinorbit.core.errors import SpinorbitError, require_finite_result
 from spinorbit.core.model.polyhedron import mass_properties, principal_frame, stokes_coefficients
-from spinorbit.quantities import value_in
+from spinorbit.quantities import finite_result, value_in
 from spinorbit.shape.mesh import Shape
 
 __all__ = ["ShapeMassProperties", "shape_mass_properties", "rigid_body_from_shape", "principal_shape",
@@ -63,6 +63,7 @@ class ShapeMassProperties:
     stokes_s: np.ndarray
 
 
+@finite_result("shape_mass_properties", "the mass or moments (ρ L⁵) of a shape this large or dense overflow double precision")
 def shape_mass_properties(shape: Shape, density=None, mass=None) -> ShapeMassProperties:
     """Volume, mass, centre of mass, inertia, principal frame and Stokes coefficients of a shape.
 
@@ -90,6 +91,9 @@ def shape_mass_properties(shape: Shape, density=None, mass=None) -> ShapeMassPro
     if not rho > 0:
         raise ValueError(f"density and mass must be positive; got a density of {rho!r} kg/m³.")
     inertia = inertia_per_density * rho * KM5_TO_M5
+    # Checked before the eigen-decomposition, which fails on inf with a LinAlgError that names nothing.
+    require_finite_result(f"shape_mass_properties: the inertia tensor (ρ = {rho:.4g} kg/m³, volume "
+                          f"{volume_km3:.4g} km³)", inertia, "ρ L⁵ overflows double precision")
     moments, rotation = principal_frame(inertia)
     principal_vertices = (shape.vertices_km - center_km) @ rotation.T
     radius = float(np.linalg.norm(principal_vertices, axis=1).max())
@@ -108,6 +112,7 @@ def principal_shape(shape: Shape, properties: ShapeMassProperties) -> Shape:
     return Shape(vertices * u.km, shape.faces, name=shape.name)
 
 
+@finite_result("rigid_body_from_shape", "the moments (ρ L⁵) of a shape this large or dense overflow double precision")
 def rigid_body_from_shape(shape: Shape, density=None, mass=None, name=None) -> RigidBody:
     """The :class:`~spinorbit.RigidBody` of a constant-density shape, on its principal axes.
 

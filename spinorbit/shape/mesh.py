@@ -1,7 +1,7 @@
 """A shape model: a closed triangulated surface with a length unit, and the generated shapes.
 
 A :class:`Shape` is checked once on construction (closed, two-manifold, outward oriented, no
-degenerate face: :func:`spinorbit.core.model.polyhedron.check_closed_mesh`), so everything that takes
+degenerate face, not crossing itself: :func:`spinorbit.core.model.polyhedron.check_closed_mesh`), so everything that takes
 a Shape can rely on it. Generated shapes, for tests and examples:
 
 - :func:`ellipsoid_shape`: a triaxial ellipsoid from a subdivided icosahedron. The icosahedron
@@ -50,7 +50,8 @@ class Shape:
     Raises
     ------
     InvalidMeshError
-        The surface is open, non-manifold, inverted, or has degenerate faces.
+        The surface is open, non-manifold, inverted, has degenerate faces, or crosses itself (the
+        message names the faces that intersect).
     """
 
     vertices: u.Quantity

@@ -89,7 +89,7 @@ CATALOGUE = [
     ("sheared matrix", lambda: RotationState.from_matrix(BODY, [[1, 0.1, 0], [0, 1, 0], [0, 0, 1]], [1, 0, 0] * u.rad / u.day), InvalidStateError, "not a rotation"),
     ("matrix 2x2", lambda: RotationState.from_matrix(BODY, np.eye(2), [1, 0, 0] * u.rad / u.day), InvalidStateError, r"\(2, 2\)"),
     ("zero spin has no mode", lambda: RotationState(BODY, IDENTITY, [0, 0, 0] * u.rad / u.day).mode, InvalidStateError, "zero spin"),
-    ("Andoyer |L| > G", lambda: RotationState.from_andoyer(BODY, 2.0, 1.0, 0.0, 0, 0, 0), InvalidStateError, "L=2.0"),
+    ("Andoyer |L| > G", lambda: RotationState.from_andoyer(BODY, *[2.0, 1.0, 0.0] * u.rad / u.day, *[0, 0, 0] * u.rad), InvalidStateError, "L=2.0"),
     ("unknown reference", lambda: RotationState(BODY, IDENTITY, [0.1, 0.2, 1] * u.rad / u.day).canonical_elements(reference="icrs"), ValueError, "'icrs'"),
     ("elements of a permanent rotation", lambda: RotationState(BODY, IDENTITY, [0, 1.0, 0] * u.rad / u.day).canonical_elements(), SingularElementsError, "permanent rotation"),
     # --- paper-named core maps

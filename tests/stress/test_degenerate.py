@@ -48,7 +48,7 @@ PROPERTIES = {
     "periods": lambda s: [p.value for p in s.periods],
     "energy_ratio": lambda s: s.energy_ratio,
     "angular_momentum_direction": lambda s: s.angular_momentum_direction,
-    "andoyer_variables": lambda s: s.andoyer_variables(),
+    "andoyer_variables": lambda s: [value.value for value in s.andoyer_variables()],
     "canonical_elements": lambda s: [getattr(s.canonical_elements(), k) for k in "SZHszh"],
     "propagate_torque_free": lambda s: np.concatenate([a.ravel() if not hasattr(a, "value") else a.value.ravel()
                                                        for a in s.propagate_torque_free([0.0, 1.0, 1e3] * u.day)]),

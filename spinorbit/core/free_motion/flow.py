@@ -64,6 +64,7 @@ from spinorbit.core.elements.canonical import (
     MODE_UNIFORM,
     body_from_sncndn,
 )
+from spinorbit.core.errors import require_finite, require_finite_result
 from spinorbit.core.free_motion.flow_constants import (
     FL_ARG0,
     FL_AXIS_X,
@@ -345,6 +346,12 @@ def evaluate_into(times, flow, mo, mk, pk, q_out, m_out, i):
          m_out[i, k, 0], m_out[i, k, 1], m_out[i, k, 2]) = flow_state(times[k], flow, mo, mk, pk)
 
 
+#: Largest momentum component the flow takes: its kernels form sums of squares without hypot (for
+#: speed), which stay finite below 1e150 (the units layer's RotationState refuses |I ω| outside
+#: [1e-150, 1e150] for the same reason).
+MAX_MOMENTUM = 1e150
+
+
 def _as_states(quaternions, momenta, moments):
     q = np.ascontiguousarray(quaternions, dtype=np.float64)
     m = np.ascontiguousarray(momenta, dtype=np.float64)
@@ -352,7 +359,13 @@ def _as_states(quaternions, momenta, moments):
         raise ValueError(f"quaternions: expected shape (N, 4), got {q.shape}")
     if m.shape != (q.shape[0], 3):
         raise ValueError(f"momenta: expected shape ({q.shape[0]}, 3), got {m.shape}")
+    require_finite("quaternions", q, "finite unit quaternions")
+    require_finite("momenta", m, "finite body angular momenta")
+    if np.any(np.abs(m) > MAX_MOMENTUM):
+        raise ValueError(f"momenta: expected components of magnitude ≤ {MAX_MOMENTUM:g} (the flow's sums of squares "
+                         f"must not overflow), got up to {float(np.abs(m).max()):.4g}; give them in a larger unit.")
     inertia = np.asarray(moments, dtype=np.float64)
+    require_finite("moments", inertia, "finite principal moments")
     if inertia.shape == (3,):
         inertia = np.broadcast_to(inertia, (q.shape[0], 3))
     if inertia.shape != (q.shape[0], 3):
@@ -395,9 +408,14 @@ def torque_free_states_many(quaternions, momenta, moments, times, closed_forms=T
     """
     q, m, inertia = _as_states(quaternions, momenta, moments)
     t = np.ascontiguousarray(times, dtype=np.float64).reshape(-1)
+    require_finite("times", t, "finite times since the states' epoch")
     q_out = np.empty((q.shape[0], t.shape[0], 4))
     m_out = np.empty((q.shape[0], t.shape[0], 3))
     propagate_many_into(q, m, inertia, t, q_out, m_out, bool(closed_forms))
+    require_finite_result("torque_free_states_many: the attitudes", q_out,
+                          "a phase rate × time or a momentum beyond what the flow's arithmetic carries")
+    require_finite_result("torque_free_states_many: the momenta", m_out,
+                          "a phase rate × time or a momentum beyond what the flow's arithmetic carries")
     return q_out, m_out
 
 

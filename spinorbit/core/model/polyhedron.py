@@ -28,6 +28,7 @@ from itertools import product
 import numpy as np
 
 from spinorbit.core.errors import SpinorbitError, require_finite
+from spinorbit.core.model.self_intersection import intersecting_faces
 
 __all__ = [
     "InvalidMeshError", "check_closed_mesh", "face_geometry", "mass_properties", "principal_frame",
@@ -37,6 +38,10 @@ __all__ = [
 #: A face whose area is below this fraction of the mesh's squared size is degenerate: its normal is
 #: rounding noise (a sliver with area ~1e-16 L² has no direction).
 DEGENERATE_AREA_FRACTION = 1e-14
+#: Sizes and coordinates a mesh may have (in its own length unit): its second moments are fifth powers of
+#: its size and its degree-4 Stokes sums seventh powers, which stay inside double precision for sizes
+#: within 1e±40 (1e280 ≪ 1.8e308); nothing physical in any length unit comes near either end.
+MESH_SIZE_RANGE = (1e-40, 1e40)
 #: Degree of the tetrahedron rule; 5 ≥ 4, the highest Stokes degree, so every integral is exact.
 RULE_DEGREE = 5
 
@@ -65,7 +70,8 @@ def check_closed_mesh(vertices, faces):
     InvalidMeshError
         Wrong shapes, indices out of range, repeated indices in a face, degenerate faces, an open
         or non-manifold surface (an edge not shared by exactly two faces), inconsistent orientation
-        (an edge traversed twice in the same direction), or inverted normals (negative volume).
+        (an edge traversed twice in the same direction), a surface that crosses itself (two faces
+        intersecting other than at their shared vertices and edge), or inverted normals (negative volume).
     NonFiniteError
         NaN or inf in the vertices.
     """
@@ -88,19 +94,45 @@ def check_closed_mesh(vertices, faces):
     if repeated.size:
         raise InvalidMeshError(f"faces {repeated[:5].tolist()} repeat a vertex: a triangle needs three distinct "
                                "vertices. Remove them from the mesh.")
+    scale = float(np.ptp(vertices, axis=0).max())
+    reach = float(np.abs(vertices).max())
+    if not (MESH_SIZE_RANGE[0] <= scale and reach <= MESH_SIZE_RANGE[1]):
+        raise InvalidMeshError(
+            f"vertices: the mesh spans {scale:.4g} with coordinates up to {reach:.4g} (its length unit), outside "
+            f"[{MESH_SIZE_RANGE[0]:g}, {MESH_SIZE_RANGE[1]:g}]: its second moments (size⁵) and Stokes sums would "
+            "overflow or underflow double precision. Give the vertices in a length unit that makes them "
+            "ordinary numbers (a Shape takes any length Quantity).")
     _, areas, _ = face_geometry(vertices, faces)
-    scale = np.ptp(vertices, axis=0).max()
     degenerate = np.nonzero(areas <= DEGENERATE_AREA_FRACTION * scale * scale)[0]
     if degenerate.size:
         raise InvalidMeshError(f"faces {degenerate[:5].tolist()} ({degenerate.size} in all) have zero area "
                                f"(below {DEGENERATE_AREA_FRACTION:g} of the size squared): their normals are "
                                "undefined. Remove or merge the collinear vertices.")
     _check_edges(faces)
-    volume = mass_properties(vertices, faces)[0]
+    _check_no_self_intersection(vertices, faces)
+    volume = float(mass_properties(vertices, faces)[0])
     if not volume > 0:
-        raise InvalidMeshError(f"the mesh's signed volume is {float(volume)!r} ≤ 0: its faces are ordered clockwise seen "
+        raise InvalidMeshError(f"the mesh's signed volume is {volume!r} ≤ 0: its faces are ordered clockwise seen "
                                "from outside (inverted normals). Reverse the order of every face's vertices.")
     return vertices, faces
+
+
+#: Intersecting face pairs named in the message of a self-intersecting mesh.
+SHOWN_INTERSECTIONS = 5
+
+
+def _check_no_self_intersection(vertices, faces):
+    """Refuse a surface that crosses itself (:mod:`spinorbit.core.model.self_intersection`)."""
+    # One compiled signature: C-contiguous float64 and int64, whatever layout the caller's arrays have.
+    count, pairs = intersecting_faces(np.ascontiguousarray(vertices, dtype=np.float64),
+                                      np.ascontiguousarray(faces, dtype=np.int64), SHOWN_INTERSECTIONS)
+    if count:
+        shown = ", ".join(f"{int(i)} and {int(j)}" for i, j in pairs)
+        raise InvalidMeshError(
+            f"the surface crosses itself: {count} pairs of faces intersect (faces {shown}"
+            f"{', …' if count > len(pairs) else ''}; numbered from 0). Its volume and moments would count the "
+            "overlap twice. Repair the mesh: merge overlapping parts into one surface, or move the vertices that "
+            "poke through.")
 
 
 def _check_edges(faces):

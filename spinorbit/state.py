@@ -230,6 +230,15 @@ class RotationState:
         return cls(body, _spin_forms.attitude_quaternion(attitude), omega * RAD_PER_DAY, _spin_forms.check_epoch(epoch))
 
     @classmethod
+    def from_sbpy(cls, body, phys, epoch, row=0, phase=0 * u.deg, axes=None):
+        """:meth:`from_pole` of the pole and rotation period in a row of an ``sbpy.data.Phys`` (the fields it reads:
+        :mod:`spinorbit.sbpy_tables`); ``epoch``, ``phase`` and ``axes`` as in :meth:`from_pole`."""
+        from spinorbit.sbpy_tables import pole_arguments
+
+        lon, lat, period, frame = pole_arguments(phys, row)
+        return cls.from_pole(body, lon, lat, period, epoch, phase=phase, frame=frame, axes=axes)
+
+    @classmethod
     def from_tumbling(cls, body, p_psi, p_phi, momentum_lon, momentum_lat, phi0, theta0, psi0, epoch, mode=None,
                       frame="ecliptic", axes=None, theta_tolerance=_spin_forms.THETA0_TOLERANCE):
         """A tumbler as Pravec et al. (2005, 2014) publish it: P_ψ, P_φ, (λ_L, β_L), (φ0, θ0, ψ0) at an epoch.

@@ -4,6 +4,7 @@ Hypothesis profiles: ``default`` keeps the default run short; ``thorough`` (``--
 thorough``) draws many more points for validation runs. Randomness is always seeded.
 """
 
+import pytest
 from hypothesis import HealthCheck, settings
 
 settings.register_profile(
@@ -36,3 +37,21 @@ def pytest_unconfigure(config):
 
     if getattr(config, "_spinorbit_cache", None):
         shutil.rmtree(config._spinorbit_cache, ignore_errors=True)
+
+
+@pytest.fixture(scope="session")
+def dask_client():
+    """A Dask ``LocalCluster`` of two single-threaded worker processes and its Client, for the whole run
+    (``tests/test_ensemble.py``, ``tests/test_orbit_pickling.py``; started only if a test asks for it)."""
+    distributed = pytest.importorskip("distributed")
+    import dask
+
+    # a task on a worker that dies fails at once (KilledWorker) instead of being retried: the resume test
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0")
+        client = distributed.Client(cluster)
+        try:
+            yield client
+        finally:
+            client.close()
+            cluster.close()

@@ -34,7 +34,8 @@ CORE_BASE = ("spinorbit.core.jit", "spinorbit.core.errors")
 UPPER_LAYERS = (
     ("bridge", ("spinorbit.quantities", "spinorbit.body", "spinorbit.state", "spinorbit.state_table", "spinorbit.time",
                 "spinorbit.frames", "spinorbit.ephemeris", "spinorbit.lunar_librations", "spinorbit.special",
-                "spinorbit.orbital_elements", "spinorbit.pole", "spinorbit.spin_forms", "spinorbit.yarkovsky")),
+                "spinorbit.orbital_elements", "spinorbit.pole", "spinorbit.spin_forms", "spinorbit.yarkovsky",
+                "spinorbit.sbpy_tables")),
     ("runs", ("spinorbit.runs",)),
     ("shape", ("spinorbit.shape",)),
     ("coupling", ("spinorbit.coupling",)),

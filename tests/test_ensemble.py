@@ -1,7 +1,7 @@
 """spinorbit.ensemble: the same bits on every executor, resumes that run only what is missing, failures kept.
 
 The executors are real: a ``ProcessPoolExecutor`` and a Dask ``LocalCluster`` of two worker processes
-(started once for the module). Workers die for real (``os._exit`` inside a member, in the worker).
+(``dask_client`` in ``tests/conftest.py``, started once for the test run). Workers die for real (``os._exit`` inside a member, in the worker).
 """
 
 import concurrent.futures
@@ -66,22 +66,6 @@ def assert_same_bits(a, b):
 def serial():
     ensemble = Ensemble(member, phases(), chunk_size=CHUNK)
     return ensemble.run(executor="serial")
-
-
-@pytest.fixture(scope="module")
-def dask_client():
-    distributed = pytest.importorskip("distributed")
-    import dask
-
-    # a task on a worker that dies fails at once (KilledWorker) instead of being retried: the resume test
-    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
-        cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0")
-        client = distributed.Client(cluster)
-        try:
-            yield client
-        finally:
-            client.close()
-            cluster.close()
 
 
 def test_serial_run_has_one_row_per_member_in_order_with_its_outcome(serial):

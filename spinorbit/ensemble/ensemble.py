@@ -6,9 +6,9 @@ the parameter table (``docs/ensembles.md``), or a member that runs itself
 cut into chunks of consecutive indices whose size depends on the ensemble alone (its member count, or ``chunk_size``), never on the
 executor or the number of workers; a chunk runs in one process, its members sharing the perturber
 samples of one orbit (:meth:`Scene.sharing_samples`), so the table is the same bits whichever
-executor ran it. A worker builds its members' Scenes itself: only ``make_scene`` (picklable: a
-module-level function) and the parameter rows travel, and each member is built once, where it
-runs; a worker keeps its samplings of an orbit across the chunks it runs (exact requests only, so
+executor ran it. A worker builds its members' Scenes itself: only ``make_scene`` (as bytes it loads
+itself, :mod:`~spinorbit.ensemble.shipping`) and the parameter rows travel, and each member is built
+once, where it runs; a worker keeps its samplings of an orbit across the chunks it runs (exact requests only, so
 the numbers do not depend on which chunks it ran). Members with no perturbers and no orbit need no
 integration: their outcomes come from one vectorised call per chunk
 (:func:`~spinorbit.ensemble.free.torque_free_rows`), in this process when the first member is
@@ -27,8 +27,7 @@ import math
 import time as _time
 
 import numpy as np
-from astropy import units as u
-from astropy.table import Column, MaskedColumn, QTable
+from astropy.table import Column, MaskedColumn
 from astropy.utils.masked import Masked
 
 from spinorbit.ensemble.errors import EnsembleError, EnsembleInterrupted
@@ -42,9 +41,11 @@ from spinorbit.ensemble.outcomes import (
     outcome_row,
 )
 from spinorbit.ensemble.free import torque_free_rows
+from spinorbit.ensemble.parameters import parameter_table, plain_value
 from spinorbit.ensemble.identity import ensemble_fingerprint, ensemble_identity, value_text
 from spinorbit.ensemble.process_memo import clear_process_samplings, leader_plan, process_memo, sharing_key
 from spinorbit.ensemble.samplers import SEED_COLUMNS, sample_parameters
+from spinorbit.ensemble.shipping import load_where_run, shipped_for
 from spinorbit.ensemble.self_run import checked_units, own_columns, own_row, runs_itself
 from spinorbit.ensemble.store import ChunkStore
 
@@ -59,33 +60,6 @@ MAX_DEFAULT_CHUNK = 16
 #: at the end of the run (benchmarks/bench_ensemble.py's parallel efficiency).
 BATCH_CHUNKS = 8
 MAX_BATCH_CHUNK = 64
-
-
-def _plain_value(value):
-    """A parameter value as make_scene receives it: numpy scalars as Python numbers, Quantities as they are."""
-    if isinstance(value, u.Quantity):
-        return value
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
-
-
-def _parameter_table(parameters):
-    if isinstance(parameters, QTable):
-        table = parameters.copy()
-    elif isinstance(parameters, (list, tuple)) and parameters and all(isinstance(r, dict) for r in parameters):
-        names = list(parameters[0])
-        if any(list(r) != names for r in parameters):
-            raise EnsembleError(f"parameters: every dict must have the same keys in the same order as the first "
-                                f"({names}); pad the others or use a QTable.")
-        table = QTable({name: u.Quantity([r[name] for r in parameters]) if isinstance(parameters[0][name], u.Quantity)
-                        else np.array([r[name] for r in parameters]) for name in names})
-    else:
-        raise EnsembleError(f"parameters expects a QTable or a non-empty list of dicts (one per member); got "
-                            f"{type(parameters).__name__}. For sampled parameters use Ensemble.sampled(...).")
-    if len(table) == 0:
-        raise EnsembleError("parameters has no rows: an ensemble needs at least one member.")
-    return table
 
 
 def build_member(make_scene, parameters):
@@ -159,6 +133,9 @@ def run_chunk(make_scene, members, at_days=None, keep_tables=False, scenes=None,
     from spinorbit.ensemble.batch import group_key, plan_group, run_group
     from spinorbit.scene.sampling import SharedSamples
 
+    make_scene, unloaded = load_where_run(make_scene, members)  # sent as bytes (shipping.py): loaded here
+    if unloaded:  # it could not be: every member fails with that cause
+        return {}, unloaded, {}
     rows, failures, tables, shared, free, built = {}, {}, {}, {}, [], []
     scenes = scenes or {}
     for index, parameters in members:
@@ -288,7 +265,7 @@ class Ensemble:
         self.route, self.batch_integrators = route, batch_integrators
         self.outcome_units = checked_units(outcome_units)
         self.make_scene = make_scene
-        self.parameters = _parameter_table(parameters)
+        self.parameters = parameter_table(parameters)
         n = len(self.parameters)
         if chunk_size is None:
             chunk_size = (min(MAX_BATCH_CHUNK, math.ceil(n / BATCH_CHUNKS)) if route == "auto" else
@@ -324,7 +301,7 @@ class Ensemble:
     def member_parameters(self, index):
         """The keyword arguments of make_scene for member ``index`` (the seed columns left out)."""
         row = self.parameters[index]
-        return {name: _plain_value(row[name]) for name in self.parameters.colnames if name not in SEED_COLUMNS}
+        return {name: plain_value(row[name]) for name in self.parameters.colnames if name not in SEED_COLUMNS}
 
     def _plain_columns(self):
         """{name: every member's value as :meth:`member_parameters` gives it}, of every column (seeds too),
@@ -333,9 +310,9 @@ class Ensemble:
         for name in self.parameters.colnames:
             column = self.parameters[name]
             if type(column) is Column and column.ndim == 1 and column.dtype.kind in "biufU":
-                columns[name] = column.tolist()  # numpy's item() of each element, as _plain_value takes it
+                columns[name] = column.tolist()  # numpy's item() of each element, as plain_value takes it
             else:
-                columns[name] = [_plain_value(column[i]) for i in range(len(column))]
+                columns[name] = [plain_value(column[i]) for i in range(len(column))]
         return columns
 
     def _members_of(self, indices, columns):
@@ -357,10 +334,9 @@ class Ensemble:
 
     def _chunk_store(self, checkpoint):
         """The checkpoint directory taken for this ensemble (locked, its manifest checked), or no store."""
-        if checkpoint is None:
-            return contextlib.nullcontext(None)
-        columns = self._plain_columns()
-        return ChunkStore(checkpoint, ensemble_fingerprint(self, columns), ensemble_identity(self, columns))
+        columns = None if checkpoint is None else self._plain_columns()
+        return (contextlib.nullcontext(None) if columns is None else
+                ChunkStore(checkpoint, ensemble_fingerprint(self, columns), ensemble_identity(self, columns)))
 
     @property
     def failures(self):
@@ -510,6 +486,7 @@ class Ensemble:
             classify_here = pool is None or (bool(pending) and not keep_tables
                                              and self._first_is_torque_free(pending[0]))
             partial, futures = {}, {}
+            shipped = shipped_for(self.make_scene, pool)
             columns = self._plain_columns() if pending else {}
             leader = self._leader()
             for chunk in pending:
@@ -528,7 +505,7 @@ class Ensemble:
                     finish(chunk, {**rows, **more_rows}, {**failures, **more_failures}, tables)
                 else:  # submitted at once: the workers start while the next chunks are prepared
                     partial[chunk] = (rows, failures)
-                    futures[pool.submit(run_chunk, self.make_scene, ship, self.at_days, keep_tables, None, self.route,
+                    futures[pool.submit(run_chunk, shipped, ship, self.at_days, keep_tables, None, self.route,
                                         self.batch_integrators, leader)] = chunk
             try:
                 for future in concurrent.futures.as_completed(futures):
@@ -568,10 +545,11 @@ class Ensemble:
         clock = _time.perf_counter()
         results, leader = [], self._leader()
         with open_executor(executor) as (pool, description):
+            shipped = shipped_for(self.make_scene, pool)
             for index in indices:  # each alone, by the same path as in run(): torque-free ones in this process
                 rows, failures, ship, scenes = self._split([(index, self.member_parameters(index))])
                 if ship:
-                    job = (pool.submit(run_chunk, self.make_scene, ship, self.at_days, False, None, self.route,
+                    job = (pool.submit(run_chunk, shipped, ship, self.at_days, False, None, self.route,
                                        self.batch_integrators, leader) if pool is not None else None)
                     rows, failures, _ = (job.result() if job is not None else
                                          run_chunk(self.make_scene, ship, self.at_days, False, scenes, self.route,

@@ -55,6 +55,12 @@ class _ReboundStates:
     def __init__(self, simulation, names):
         self.simulation, self.names, self.key, self.states = simulation, tuple(names), None, None
 
+    def __reduce__(self):
+        # as Orbit: never REBOUND's raw simulation (its binary loses the forces), the description instead
+        from spinorbit.scene.orbit import Orbit
+
+        return (_rebound_states_of, (Orbit("rebound", self.names[0], simulation=self.simulation), self.names))
+
     def function(self, name):
         def states(days):
             days = np.atleast_1d(np.asarray(days, dtype=float))
@@ -78,6 +84,10 @@ class _ReboundStates:
             for name, i in index.items():
                 out[name][0][j], out[name][1][j] = xyz[i], vel[i]
         return out
+
+
+def _rebound_states_of(orbit, names):
+    return _ReboundStates(orbit.simulation, names)
 
 
 def _mirrored_inputs(orbit, named, fixed, moving, epoch_day):

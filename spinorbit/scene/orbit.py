@@ -12,6 +12,7 @@ another (:mod:`spinorbit.coupling.approaches`). Elements and frames: :mod:`spino
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -285,6 +286,53 @@ class Orbit:
         return cls._built(name, epoch, position, velocity, "sun", non_gravitational, extra_forces, description)
 
     @classmethod
+    def from_sbpy(cls, orbit, row=0, frame="ecliptic", name=None, kepler=False, non_gravitational=None,
+                  extra_forces=True):
+        """The orbit of one row of an ``sbpy.data.Orbit`` (filled from JPL Horizons or the SBDB, or built with
+        ``sbpy.data.Orbit.from_dict``): :meth:`from_elements` of its elements, or with ``kepler=True``
+        :meth:`kepler` of them.
+
+        Parameters
+        ----------
+        orbit : sbpy.data.Orbit
+            Its ``a`` (or the perihelion distance ``q``), ``e``, ``i``, ``Omega``, ``w``, ``M`` (or the time of
+            perihelion ``Tp``) and ``epoch``, by any of sbpy's alternative names, with the units the table carries
+            (:func:`spinorbit.sbpy_tables.orbit_arguments`; a field without its unit is refused).
+        row : int
+            Which row of the table.
+        frame : {"ecliptic", "ecliptic-iau2006", "icrf"}
+            What the angles are referred to. The table does not say: sbpy's ``Orbit.from_horizons`` documents
+            heliocentric elements on the ecliptic and mean equinox of J2000 (JPL's, IAU 1976 obliquity: the
+            default "ecliptic"), as the SBDB gives them; "icrf" for a Horizons query made with ``refplane="earth"``.
+        name : str, optional
+            The orbit's name; by default the row's ``targetname``, else "body".
+        kepler : bool
+            False (default): integrated among DE421's planets (:meth:`from_elements`); True: the fixed Sun-alone
+            ellipse (:meth:`kepler`, which takes no non-gravitational terms).
+        non_gravitational, extra_forces
+            As in :meth:`from_elements`.
+
+        Raises
+        ------
+        spinorbit.sbpy_tables.SbpyInputError
+            Not an sbpy Orbit, no such row, or a missing field (named, with the fields the row has).
+        spinorbit.quantities.QuantityInputError
+            A field without a unit, or of the wrong kind.
+        """
+        from spinorbit.sbpy_tables import orbit_arguments
+
+        arguments = orbit_arguments(orbit, row)
+        name = name or arguments.pop("name") or "body"
+        arguments.pop("name", None)
+        if kepler:
+            if non_gravitational is not None:
+                raise SceneError("Orbit.from_sbpy(kepler=True) is the Sun-alone ellipse and takes no non_gravitational "
+                                 f"terms; got {non_gravitational!r}. Drop kepler=True to integrate them.")
+            return cls.kepler(**arguments, frame=frame, name=name)
+        return cls.from_elements(**arguments, frame=frame, name=name, non_gravitational=non_gravitational,
+                                 extra_forces=extra_forces)
+
+    @classmethod
     def from_state(cls, position, velocity, epoch, frame="icrf", centre="sun", name="body",
                    non_gravitational=None, extra_forces=True):
         """A state vector at ``epoch``, integrated among DE421's planets in REBOUND (any conic: open
@@ -342,6 +390,29 @@ class Orbit:
         if extra_forces:
             description += ", EIH 1PN + Earth J2"
         return cls("rebound", name, simulation=sim, description=description, de421_planets=True)
+
+    def __reduce__(self):
+        """Pickle to the orbit's description, never REBOUND's raw simulation (issue 36).
+
+        REBOUND pickles a simulation as its binary, which holds neither the compiled extra forces'
+        function pointer nor (rebound 5.2.2) names that outlive the simulation saved: a pickled
+        orbit would run without EIH and J2 and change the physics silently (REBOUND only warns).
+        A REBOUND orbit goes as a :class:`~spinorbit.coupling.rebound.snapshot.SimulationSnapshot`
+        (binary, names, the extra forces in effect) and is rebuilt with its forces reinstalled, so
+        the copy integrates bit for bit like the original (``tests/test_orbit_pickling.py``). A
+        simulation with forces spinorbit did not install cannot be carried: refused with SceneError.
+        """
+        fields = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        if self.simulation is not None:
+            from spinorbit.coupling.rebound import ForceInstallError, SimulationSnapshot
+
+            try:
+                snapshot = SimulationSnapshot.of(self.simulation)
+            except ForceInstallError as error:
+                raise SceneError(f"the orbit of {self.name!r} cannot be pickled (sent to another process): {error}") \
+                    from None
+            fields["simulation"] = (snapshot, int(self.simulation.exact_finish_time))
+        return (_orbit_from_description, (fields,))
 
     def check_span(self, *days):
         """EphemerisRangeError if an orbit built among DE421's planets is asked about times (TDB days
@@ -454,3 +525,13 @@ class Orbit:
                                 f"{end.tdb.iso} TDB: the distance only falls or only rises there. Widen the span.")
         best = int(np.argmin(table["distance"].value))
         return table["time"][best], table["distance"][best]
+
+
+def _orbit_from_description(fields):
+    """The :class:`Orbit` of :meth:`Orbit.__reduce__`'s fields, its REBOUND simulation rebuilt from its snapshot."""
+    if fields.get("simulation") is not None:
+        snapshot, exact_finish_time = fields["simulation"]
+        simulation = snapshot.build()  # the names set again, the extra forces reinstalled
+        simulation.exact_finish_time = exact_finish_time
+        fields = {**fields, "simulation": simulation}
+    return Orbit(**fields)

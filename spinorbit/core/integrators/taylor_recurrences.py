@@ -67,12 +67,25 @@ from spinorbit.core.dynamics.equations import MODEL_PERTURBERS, STATE_SIZE
 from spinorbit.core.jit import FUSED_MULTIPLY_ADD, INLINE, jit
 from spinorbit.core.math.ddouble import fma
 from spinorbit.core.math.lanes import (
+    choose,
+    constant_like,
     load_broadcast_quad,
     load_quad,
     quad,
     quad_lane,
     quad_shuffle,
     store_quad,
+)
+from spinorbit.core.math.lanes_generic import (
+    all_above,
+    any_below,
+    first_member,
+    largest,
+    load_one,
+    member_rows,
+    order_like,
+    quad_zero,
+    store_one,
 )
 from spinorbit.core.model.gravity_field import BODY_A, BODY_B, BODY_C
 from spinorbit.core.model.perturbers import (
@@ -154,7 +167,7 @@ def _store_attitude(f, row, q, w):
 def _inner_sum(f, ncol, a, b, k, first):
     """Σ_{j=first}^{k−1} A^[j] ⊙ B^[k−j] of the quads at columns a and b (component by component). The terms
     with j = 0 and j = k, which hold the newest coefficients, are the caller's (module docstring, *Latency*)."""
-    total = quad(0.0, 0.0, 0.0, 0.0)
+    total = quad_zero(f)
     for j in range(first, k):
         total = fma(load_quad(f, j * ncol + a), load_quad(f, (k - j) * ncol + b), total)
     return total
@@ -165,7 +178,7 @@ def _attitude_inner(f, ncol, k):
     """The terms j = 1 … k − 1 of q ω_x, q ω_y, q ω_z (the quaternion times one broadcast component of ω)
     and of Euler's (ω_y ω_z, ω_z ω_x, ω_x ω_y), in one pass: all the attitude's products of order k but
     those with the newest coefficients."""
-    zero = quad(0.0, 0.0, 0.0, 0.0)
+    zero = quad_zero(f)
     x, y, z, euler = zero, zero, zero, zero
     for j in range(1, k):
         row, other = j * ncol, (k - j) * ncol
@@ -182,7 +195,7 @@ def _perturber_inner(f, ncol, b, k, first_cross):
     """The terms j = 1 … k − 1 of perturber block b's q c_a (a = x, y, z) and of the pair products of
     ρ_body, and the terms j = first_cross … k − 1 of u × ρ, in one pass (ρ^[k−j] is zero before
     first_cross = k − m)."""
-    zero = quad(0.0, 0.0, 0.0, 0.0)
+    zero = quad_zero(f)
     x, y, z, pairs, cross, cross_back = zero, zero, zero, zero, zero, zero
     for j in range(1, k):
         row, other = j * ncol, (k - j) * ncol
@@ -229,7 +242,8 @@ def _perturber_pairs(f, ncol, b, k, m, q):
     c = u × ρ (ρ truncated at order m, so the sum is short), then ρ_body = ρ + 2 (u × c − q₀ c) as
     ρ − 2 vec((0, c) ⊗ q); q^[k] comes in a register.
     """
-    lo = max(0, k - m)  # ρ is zero above order m
+    top = largest(m)  # m itself; in lanes the largest member's (ρ is zero above each member's own m)
+    lo = max(0, k - top)  # ρ is zero above order m
     x, y, z, pairs, cross = _perturber_inner(f, ncol, b, k, lo)
     if lo == 0 and k > 0:
         cross = fma(load_quad(f, _U_YZX), load_quad(f, k * ncol + b + _RHO + _ZXY), cross)
@@ -240,7 +254,10 @@ def _perturber_pairs(f, ncol, b, k, m, q):
     x, y, z = _with_newest(f, b + _C, k, q, cross, x, y, z)
     product = quad(1.0, -1.0, 1.0, 0.0) * _e_x(x) + quad(1.0, 1.0, -1.0, 0.0) * _e_y(y) \
         + quad(-1.0, 1.0, 1.0, 0.0) * _e_z(z)
-    body = load_quad(f, k * ncol + b + _RHO) - 2.0 * product if k <= m else -2.0 * product
+    if k <= top:
+        body = choose(k <= m, load_quad(f, k * ncol + b + _RHO) - 2.0 * product, -2.0 * product)
+    else:
+        body = -2.0 * product
     _store_rotated(f, k * ncol + b + _B, body)
     return _pairs_with_newest(f, b + _B, k, body, pairs)
 
@@ -264,7 +281,7 @@ def _orbit_series_into(f, ncol, b, kind, order, mu_orbit, h_bound, orbit_tol_sq)
     k |r|²^[0] u^[k] = Σ_{j<k} (α(k − j) − j) |r|²^[k−j] u^[j]; each order's newest r and v stay in
     registers, and every sum adds its newest terms last (module docstring, *Latency*).
     """
-    m = 0 if kind == KIND_FIXED else order
+    m = order_like(h_bound, 0 if kind == KIND_FIXED else order)
     kepler = kind == KIND_KEPLER
     r0 = load_quad(f, b + _X)
     v = load_quad(f, b + _V)
@@ -274,38 +291,43 @@ def _orbit_series_into(f, ncol, b, kind, order, mu_orbit, h_bound, orbit_tol_sq)
     root = math.sqrt(r2_0)
     s52_0 = 1.0 / (r2_0 * math.sqrt(root))  # |r|⁻⁵ᐟ² and |r|⁻³ without a power function
     s3_0 = 1.0 / (r2_0 * root)
-    f[b + _R2], f[b + _S52], f[b + _S3] = r2_0, s52_0, s3_0
+    store_one(f, b + _R2, r2_0)
+    store_one(f, b + _S52, s52_0)
+    store_one(f, b + _S3, s3_0)
     r = r0
     s52, s3 = s52_0, s3_0
-    h_pow_sq = 1.0  # h_bound^(2k), by one product per order (no power function in the loop)
+    h_pow_sq = constant_like(h_bound, 1.0)  # h_bound^(2k), by one product per order (no power function)
     for k in range(order):
-        if k > m:
+        if all_above(k, m):
             break
         row = k * ncol + b
         if not kepler:
             r = load_quad(f, row + _X)  # given (sampled) or constant (fixed)
-        rho = quad(0.0, 0.0, 0.0, 0.0)
-        acceleration = quad(0.0, 0.0, 0.0, 0.0)
+        rho = quad_zero(f)
+        acceleration = quad_zero(f)
         if k > 0:
             r2 = 2.0 * _dot(r0, r) + _dot(_inner_sum(f, ncol, b + _X, b + _X, k, 1), quad(1.0, 1.0, 1.0, 0.0))
-            power52 = 0.0
-            power3 = 0.0
+            power52 = constant_like(r2_0, 0.0)
+            power3 = constant_like(r2_0, 0.0)
             for j in range(1, k):
-                r2_j = f[(k - j) * ncol + b + _R2]
-                power52 += (-1.25 * (k - j) - j) * r2_j * f[j * ncol + b + _S52]
-                power3 += (-1.5 * (k - j) - j) * r2_j * f[j * ncol + b + _S3]
+                r2_j = load_one(f, (k - j) * ncol + b + _R2)
+                power52 += (-1.25 * (k - j) - j) * r2_j * load_one(f, j * ncol + b + _S52)
+                power3 += (-1.5 * (k - j) - j) * r2_j * load_one(f, j * ncol + b + _S3)
                 r_j = load_quad(f, (k - j) * ncol + b + _X)
                 rho = fma(load_broadcast_quad(f, j * ncol + b + _S52), r_j, rho)
                 acceleration = fma(load_broadcast_quad(f, j * ncol + b + _S3), r_j, acceleration)
             inverse_k_a0 = inv_r2 * _RECIPROCALS[k - 1]
             s52 = (power52 - 1.25 * k * r2 * s52_0) * inverse_k_a0
             s3 = (power3 - 1.5 * k * r2 * s3_0) * inverse_k_a0
-            f[row + _R2], f[row + _S52], f[row + _S3] = r2, s52, s3
+            store_one(f, row + _R2, r2)
+            store_one(f, row + _S52, s52)
+            store_one(f, row + _S3, s3)
             rho = fma(quad(s52_0, s52_0, s52_0, s52_0), r, rho)
             acceleration = fma(quad(s3_0, s3_0, s3_0, s3_0), r, acceleration)
         rho = fma(quad(s52, s52, s52, s52), r0, rho)
-        _store_rotated(f, row + _RHO, rho)
-        if kepler and k < m:
+        # zero above a member's own m (in lanes, where another member's m is larger), as the products read it
+        _store_rotated(f, row + _RHO, choose(k <= m, rho, quad_zero(f)))
+        if kepler and any_below(k, m):
             acceleration = fma(quad(s3, s3, s3, s3), r0, acceleration)
             inverse = _RECIPROCALS[k]
             r_next = v * inverse
@@ -313,9 +335,10 @@ def _orbit_series_into(f, ncol, b, kind, order, mu_orbit, h_bound, orbit_tol_sq)
             store_quad(f, row + ncol + _X, r_next)
             store_quad(f, row + ncol + _V, v_next)
             h_pow_sq_next = h_pow_sq * h_bound * h_bound
-            if k >= 1 and _orbit_term_sq(r, v, inv_r2, inv_v2) * h_pow_sq < orbit_tol_sq \
-                    and _orbit_term_sq(r_next, v_next, inv_r2, inv_v2) * h_pow_sq_next < orbit_tol_sq:
-                m = k + 1
+            if k >= 1:
+                m = choose((k < m) & (_orbit_term_sq(r, v, inv_r2, inv_v2) * h_pow_sq < orbit_tol_sq)
+                           & (_orbit_term_sq(r_next, v_next, inv_r2, inv_v2) * h_pow_sq_next < orbit_tol_sq),
+                           order_like(h_bound, k + 1), m)
             r, v = r_next, v_next
             h_pow_sq = h_pow_sq_next
     return m
@@ -336,28 +359,29 @@ def taylor_coefficients_into(t, model, s, n_pert, order, h_bound, orbit_tol, orb
     (:func:`_orbit_series_into`); then order by order the torque and the attitude.
     """
     ncol = s.shape[1]
-    f = s.reshape(-1)
-    a_mom, b_mom, c_mom = model[BODY_A], model[BODY_B], model[BODY_C]
+    f = member_rows(s)
+    a_mom, b_mom, c_mom = load_one(model, BODY_A), load_one(model, BODY_B), load_one(model, BODY_C)
     inverse_moments = quad(1.0 / a_mom, 1.0 / b_mom, 1.0 / c_mom, 0.0)
     euler_factors = quad(b_mom - c_mom, c_mom - a_mom, a_mom - b_mom, 0.0)
     torque_factors = quad(c_mom - b_mom, a_mom - c_mom, b_mom - a_mom, 0.0)
     signs_x, signs_y, signs_z = quad(-1.0, 1.0, 1.0, -1.0), quad(-1.0, -1.0, 1.0, 1.0), quad(-1.0, 1.0, -1.0, 1.0)
-    zero = quad(0.0, 0.0, 0.0, 0.0)
+    zero = quad_zero(f)
     q = load_quad(f, _Q)
-    w = quad(f[_W], f[_W + 1], f[_W + 2], 0.0)  # fourth lane zero: callers write only y's seven columns
+    # fourth lane zero: callers write only y's seven columns
+    w = quad(load_one(f, _W), load_one(f, _W + 1), load_one(f, _W + 2), 0.0)
     _store_attitude(f, 0, q, w)
     orbit_tol_sq = orbit_tol * orbit_tol
     for p in range(n_pert):
         row = MODEL_PERTURBERS + 1 + p * PERTURBER_ROW
-        kind = int(model[row])
-        orbit_orders[p] = _orbit_series_into(f, ncol, _HEAD_COLUMNS + p * _BLOCK_COLUMNS, kind, order,
-                                             model[row + 2 + K_MU], h_bound, orbit_tol_sq)
+        kind = int(first_member(model, row))  # the same for every member in lanes (the caller's grouping)
+        store_one(orbit_orders, p, _orbit_series_into(f, ncol, _HEAD_COLUMNS + p * _BLOCK_COLUMNS, kind, order,
+                                                      load_one(model, row + 2 + K_MU), h_bound, orbit_tol_sq))
     for k in range(order):
         # --- torque N^[k] = Σ 3μ ((C − B) ρ_y ρ_z, (A − C) ρ_z ρ_x, (B − A) ρ_x ρ_y) of each ρ_body
         torque = zero
         for p in range(n_pert):
-            mu = model[MODEL_PERTURBERS + 1 + p * PERTURBER_ROW + 1]
-            pairs = _perturber_pairs(f, ncol, _HEAD_COLUMNS + p * _BLOCK_COLUMNS, k, orbit_orders[p], q)
+            mu = load_one(model, MODEL_PERTURBERS + 1 + p * PERTURBER_ROW + 1)
+            pairs = _perturber_pairs(f, ncol, _HEAD_COLUMNS + p * _BLOCK_COLUMNS, k, load_one(orbit_orders, p), q)
             torque = fma(torque_factors * (3.0 * mu), pairs, torque)
         store_quad(f, k * ncol + _N, torque)
         # --- Euler: A ω̇x = (B − C) ωy ωz + Nx, cyclic; and q̇ = ½ q ⊗ (0, ω) = ½ Σ_a P_a(q ω_a)
@@ -447,8 +471,8 @@ def _orbit_term_sq(r, v, inv_r2, inv_v2):
     """
     scaled = r * r * inv_r2
     speeds = v * v * inv_v2
-    return max(quad_lane(scaled, 0), quad_lane(scaled, 1), quad_lane(scaled, 2),
-               quad_lane(speeds, 0), quad_lane(speeds, 1), quad_lane(speeds, 2))
+    return max(max(quad_lane(scaled, 0), quad_lane(scaled, 1), quad_lane(scaled, 2)),
+               max(quad_lane(speeds, 0), quad_lane(speeds, 1), quad_lane(speeds, 2)))
 
 
 @jit

@@ -14,6 +14,10 @@ Why: the set-up of one torque-free state is bound by the divider and the square 
 Carlson's duplication), which a scalar loop uses one double at a time; ``<8 x double>`` issues eight
 (``docs/design.md``, "Eight states in one register").
 
+``QuadLanes`` (``<32 x double>``, component c of member l in element 8c + l): the Quad kernels compiled on
+member rows (2-d arrays (n, 8), row i one quantity of eight members) run eight members in lanes, each
+member's arithmetic the Quad kernel's, bit for bit (the Quad helpers take both forms).
+
 ``Quad`` is an LLVM ``<4 x double>`` with +, −, ×, /, unary − and :func:`~spinorbit.core.math.ddouble.fma`
 (not ``abs``, ``math.sqrt`` or comparisons, which no Quad kernel needs), plus what component-wise
 vector code needs: :func:`quad` (four doubles packed), :func:`quad_lane` (one
@@ -52,10 +56,13 @@ class LaneMaskType(types.Type):
 
 lanes_type = LanesType(WIDTH, "Lanes")
 quad_type = LanesType(QUAD_WIDTH, "Quad")
+#: Four components of eight members: component c of member l in element c·8 + l (``QuadLanes``).
+quad_lanes_type = LanesType(QUAD_WIDTH * WIDTH, "QuadLanes")
 mask_type = LaneMaskType()
 _VECTOR = ir.VectorType(ir.DoubleType(), WIDTH)
 _QUAD = ir.VectorType(ir.DoubleType(), QUAD_WIDTH)
 _MASK = ir.VectorType(ir.IntType(1), WIDTH)
+_QUAD_LANES = ir.VectorType(ir.DoubleType(), QUAD_WIDTH * WIDTH)
 
 
 @register_model(LanesType)
@@ -71,15 +78,26 @@ class _MaskModel(models.PrimitiveModel):
 
 
 def _vector_type_of(*operand_types):
-    """The one vector type among the operands (None if there is none, or two of different widths)."""
+    """The one vector type among the operands (None if there is none, or two of different widths), where
+    QuadLanes absorbs Lanes and Quad (spread over its components or its members, :func:`_as_vector`)."""
     vectors = {t for t in operand_types if isinstance(t, LanesType)}
+    if quad_lanes_type in vectors:
+        vectors -= {lanes_type, quad_type}
     return vectors.pop() if len(vectors) == 1 else None
 
 
 def _as_vector(context, builder, value, value_type, width=WIDTH):
-    """The LLVM vector of a Lanes or Quad value, or of a number broadcast to ``width`` lanes."""
+    """The LLVM vector of a Lanes or Quad value, or of a number broadcast to ``width`` lanes; into a
+    QuadLanes (width 32) a Lanes value goes to every component (one value per member) and a Quad value
+    to every member (one value per component)."""
     if isinstance(value_type, LanesType):
-        return value
+        if value_type.width == width:
+            return value
+        if value_type == lanes_type:
+            mask = [lane for _ in range(QUAD_WIDTH) for lane in range(WIDTH)]
+        else:
+            mask = [component for component in range(QUAD_WIDTH) for _ in range(WIDTH)]
+        return builder.shuffle_vector(value, value, ir.Constant(ir.VectorType(ir.IntType(32), width), mask))
     scalar = context.cast(builder, value, value_type, types.float64)
     return _splat(builder, scalar, width)
 
@@ -258,16 +276,26 @@ def fma_typing(a, b, c):
 
 @intrinsic
 def select(typingctx, mask, a, b):
-    """Lane by lane: a where ``mask`` holds, else b (numbers broadcast)."""
-    if mask != mask_type or not (_is_lanes_operand(a) and _is_lanes_operand(b)):
+    """Lane by lane: a where ``mask`` holds, else b (numbers broadcast); with a QuadLanes operand, member
+    by member in all four components."""
+    if mask != mask_type:
         return None
+    wide = quad_lanes_type in (a, b)
+    if not all(_is_lanes_operand(t) or (wide and t == quad_lanes_type) for t in (a, b)):
+        return None
+    result_type = quad_lanes_type if wide else lanes_type
 
     def codegen(context, builder, signature, args):
-        x = _as_vector(context, builder, args[1], signature.args[1])
-        y = _as_vector(context, builder, args[2], signature.args[2])
-        return builder.select(args[0], x, y)
+        x = _as_vector(context, builder, args[1], signature.args[1], result_type.width)
+        y = _as_vector(context, builder, args[2], signature.args[2], result_type.width)
+        condition = args[0]
+        if wide:  # the member's mask in each of the four components
+            mask_wide = [lane for _ in range(QUAD_WIDTH) for lane in range(WIDTH)]
+            condition = builder.shuffle_vector(condition, condition,
+                                               ir.Constant(ir.VectorType(ir.IntType(32), len(mask_wide)), mask_wide))
+        return builder.select(condition, x, y)
 
-    return lanes_type(mask, a, b), codegen
+    return result_type(mask, a, b), codegen
 
 
 @intrinsic
@@ -438,7 +466,19 @@ def lane_of(typingctx, values, lane):
 
 @intrinsic
 def quad(typingctx, a, b, c, d):
-    """The four numbers (a, b, c, d) as one Quad."""
+    """The four numbers (a, b, c, d) as one Quad; with a Lanes among them (one value per member), the
+    QuadLanes of the four components (numbers in every member)."""
+    if any(t == lanes_type for t in (a, b, c, d)) and all(_is_lanes_operand(t) for t in (a, b, c, d)):
+        def wide(context, builder, signature, args):
+            parts = [_as_vector(context, builder, v, t) for v, t in zip(args, signature.args)]
+            first = builder.shuffle_vector(parts[0], parts[1], ir.Constant(ir.VectorType(ir.IntType(32), 16),
+                                                                           list(range(16))))
+            second = builder.shuffle_vector(parts[2], parts[3], ir.Constant(ir.VectorType(ir.IntType(32), 16),
+                                                                            list(range(16))))
+            return builder.shuffle_vector(first, second, ir.Constant(ir.VectorType(ir.IntType(32), 32),
+                                                                     list(range(32))))
+
+        return quad_lanes_type(a, b, c, d), wide
     if not all(isinstance(t, (types.Float, types.Integer)) for t in (a, b, c, d)):
         return None
 
@@ -454,8 +494,21 @@ def quad(typingctx, a, b, c, d):
 
 @intrinsic
 def quad_lane(typingctx, value, lane):
-    """One lane of a Quad, as a double."""
-    if value != quad_type or not isinstance(lane, types.Integer):
+    """One lane of a Quad, as a double; of a QuadLanes, one component of every member (Lanes)."""
+    if not isinstance(lane, types.Integer):
+        return None
+    if value == quad_lanes_type:
+        def component(context, builder, signature, args):
+            out = ir.Constant(_VECTOR, ir.Undefined)
+            first = builder.mul(context.cast(builder, args[1], signature.args[1], types.int32),
+                                ir.Constant(ir.IntType(32), WIDTH))
+            for member in range(WIDTH):
+                element = builder.extract_element(args[0], builder.add(first, ir.Constant(ir.IntType(32), member)))
+                out = builder.insert_element(out, element, ir.Constant(ir.IntType(32), member))
+            return out
+
+        return lanes_type(value, lane), component
+    if value != quad_type:
         return None
     return types.float64(value, lane), lambda context, builder, signature, args: builder.extract_element(*args)
 
@@ -466,31 +519,111 @@ def quad_shuffle(indices):
     if len(indices) != QUAD_WIDTH or not all(i in range(QUAD_WIDTH + 1) for i in indices):
         raise ValueError(f"indices: expected four lanes in 0..4, got {indices!r}.")
     mask = ir.Constant(ir.VectorType(ir.IntType(32), QUAD_WIDTH), list(indices))
+    # on a QuadLanes the same permutation of the components, every member alike (4 → the zeros' vector)
+    wide = [i * WIDTH + lane for i in indices for lane in range(WIDTH)]
+    mask_wide = ir.Constant(ir.VectorType(ir.IntType(32), QUAD_WIDTH * WIDTH), wide)
 
     @intrinsic
     def shuffle(typingctx, value):
-        if value != quad_type:
+        if value not in (quad_type, quad_lanes_type):
             return None
+        vector, chosen = (_QUAD, mask) if value == quad_type else (_QUAD_LANES, mask_wide)
 
         def codegen(context, builder, signature, args):
-            return builder.shuffle_vector(args[0], ir.Constant(_QUAD, [0.0] * QUAD_WIDTH), mask)
+            return builder.shuffle_vector(args[0], ir.Constant(vector, [0.0] * vector.count), chosen)
 
-        return quad_type(value), codegen
+        return value(value), codegen
 
     return shuffle
 
 
-load_quad = _vector_load(quad_type, "array[start:start + 4] of a C-contiguous float64 array (the caller keeps "
-                                    "it in bounds).")
-store_quad = _vector_store(quad_type, "array[start:start + 4] = value (C-contiguous float64; the caller keeps it "
-                                      "in bounds).")
+def _is_member_rows(t):
+    """A two-dimensional C-contiguous float64 array of rows of eight members: row i is one quantity."""
+    return isinstance(t, types.Array) and t.dtype == types.float64 and t.ndim == 2 and t.layout == "C"
+
+
+@intrinsic
+def load_quad(typingctx, array, start):
+    """array[start:start + 4] of a C-contiguous float64 array as a Quad, or of member rows (n, 8) as the
+    QuadLanes of rows start … start + 3 (the caller keeps it in bounds)."""
+    if not isinstance(start, types.Integer):
+        return None
+    vector_type = quad_type if _is_vector_array(array) else quad_lanes_type if _is_member_rows(array) else None
+    if vector_type is None:
+        return None
+
+    def codegen(context, builder, signature, args):
+        pointer = _row_pointer(context, builder, signature.args[0], *args)
+        vector = ir.VectorType(ir.DoubleType(), vector_type.width)
+        return builder.load(builder.bitcast(pointer, vector.as_pointer()), align=8)
+
+    return vector_type(array, start), codegen
+
+
+@intrinsic
+def store_quad(typingctx, array, start, value):
+    """array[start:start + 4] = value (Quad, C-contiguous float64), or rows start … start + 3 of member
+    rows (n, 8) = value (QuadLanes); the caller keeps it in bounds."""
+    if not (isinstance(start, types.Integer) and ((_is_vector_array(array) and value == quad_type)
+                                                  or (_is_member_rows(array) and value == quad_lanes_type))):
+        return None
+
+    def codegen(context, builder, signature, args):
+        pointer = _row_pointer(context, builder, signature.args[0], args[0], args[1])
+        builder.store(args[2], builder.bitcast(pointer, args[2].type.as_pointer()), align=8)
+        return context.get_dummy_value()
+
+    return types.none(array, start, value), codegen
+
+
+def _row_pointer(context, builder, array_type, array, index):
+    """Pointer to element ``index`` of a 1-d array, or to row ``index`` of member rows (n, 8)."""
+    if array_type.ndim == 2:
+        index = builder.mul(index, ir.Constant(index.type, WIDTH))
+    return _element_pointer(context, builder, array_type, array, index)
+
+
+@intrinsic
+def load_member_row(typingctx, array, index):
+    """Row ``index`` of member rows (n, 8) as Lanes: one quantity of eight members (in bounds)."""
+    if not (_is_member_rows(array) and isinstance(index, types.Integer)):
+        return None
+
+    def codegen(context, builder, signature, args):
+        pointer = _row_pointer(context, builder, signature.args[0], *args)
+        return builder.load(builder.bitcast(pointer, _VECTOR.as_pointer()), align=8)
+
+    return lanes_type(array, index), codegen
+
+
+@intrinsic
+def store_member_row(typingctx, array, index, value):
+    """Row ``index`` of member rows (n, 8) = value (Lanes; in bounds)."""
+    if not (_is_member_rows(array) and isinstance(index, types.Integer) and value == lanes_type):
+        return None
+
+    def codegen(context, builder, signature, args):
+        pointer = _row_pointer(context, builder, signature.args[0], args[0], args[1])
+        builder.store(args[2], builder.bitcast(pointer, _VECTOR.as_pointer()), align=8)
+        return context.get_dummy_value()
+
+    return types.none(array, index, value), codegen
 
 
 @intrinsic
 def load_broadcast_quad(typingctx, array, index):
-    """array[index] in every lane (C-contiguous float64; the caller keeps ``index`` in bounds: no
-    wrap-around of negative indices, which would cost a branch in an inner loop)."""
-    if not (_is_vector_array(array) and isinstance(index, types.Integer)):
+    """array[index] in every lane (C-contiguous float64, ``index`` in bounds: no wrap-around, a branch in an
+    inner loop); of member rows (n, 8), row ``index`` (each member's value) in all four components."""
+    if not isinstance(index, types.Integer):
+        return None
+    if _is_member_rows(array):
+        def rows(context, builder, signature, args):
+            pointer = _row_pointer(context, builder, signature.args[0], *args)
+            row = builder.load(builder.bitcast(pointer, _VECTOR.as_pointer()), align=8)
+            return _as_vector(context, builder, row, lanes_type, QUAD_WIDTH * WIDTH)
+
+        return quad_lanes_type(array, index), rows
+    if not _is_vector_array(array):
         return None
 
     def codegen(context, builder, signature, args):

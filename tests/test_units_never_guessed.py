@@ -95,6 +95,10 @@ NOT_DIMENSIONAL_IN = {
     "reshaped": {"axis_ratios"},  # Dimorphos's a/b and a/c after the impact
     "Normal": {"sigma"},  # a sampler of numbers or Quantities, for the user's own make_scene
     "free_members_table": {"parameters"},
+    # an sbpy table (its Quantities read), a row index; phase goes as it came to from_pole, whose bare-number
+    # refusal the walk checks (importing sbpy here would raise astropy's deprecation warning at collection)
+    "RotationState.from_sbpy": {"phys", "row", "phase"},
+    "Orbit.from_sbpy": {"row", "kepler"},  # an sbpy table or row, and a switch
 }
 #: A unit in the parameter's own name: the number is in that unit, not guessed.
 UNIT_SUFFIX = re.compile(r"(^|_)(days?|au|km|km2|m|s|kg|si|deg|rad|arcsec)$")
